@@ -1,0 +1,244 @@
+//! Diagnostics shared by every kinpost reader (CL files, machine files, dialect
+//! files, NC programs).
+//!
+//! A [`Diagnostic`] always names the file, the 1-based line and column, and
+//! carries the text of the offending source line so that it can be shown
+//! without re-reading the input (inputs may be streams).
+//!
+//! ```text
+//! error: malformed number `1.2.3`
+//!   --> part.cls:12:6
+//!    |
+//! 12 | GOTO/1.2.3,4,5
+//!    |      ^^^^^
+//! ```
+
+use std::fmt;
+
+/// How bad a diagnostic is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    /// Harmless: the input is still used (an unknown statement, a cut-short record).
+    Warning,
+    /// The input cannot be used as it is.
+    Error,
+}
+
+impl fmt::Display for Severity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        })
+    }
+}
+
+/// One message about one place in one input file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostic {
+    pub severity: Severity,
+    /// File name as the user gave it (`-` or `<stdin>` for standard input).
+    pub file: String,
+    /// 1-based line number; 0 when the message concerns the whole file.
+    pub line: usize,
+    /// 1-based column, counted in characters; 0 when not known.
+    pub column: usize,
+    /// Number of characters to underline, at least 1 when `column > 0`.
+    pub width: usize,
+    /// The message, without the severity prefix.
+    pub message: String,
+    /// The text of line `line`, without its line ending.
+    pub source_line: String,
+}
+
+impl Diagnostic {
+    /// An error at a character position of a source line.
+    pub fn error(
+        file: impl Into<String>,
+        line: usize,
+        column: usize,
+        width: usize,
+        source_line: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Self::new(
+            Severity::Error,
+            file,
+            line,
+            column,
+            width,
+            source_line,
+            message,
+        )
+    }
+
+    /// A warning at a character position of a source line.
+    pub fn warning(
+        file: impl Into<String>,
+        line: usize,
+        column: usize,
+        width: usize,
+        source_line: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Self::new(
+            Severity::Warning,
+            file,
+            line,
+            column,
+            width,
+            source_line,
+            message,
+        )
+    }
+
+    fn new(
+        severity: Severity,
+        file: impl Into<String>,
+        line: usize,
+        column: usize,
+        width: usize,
+        source_line: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Diagnostic {
+            severity,
+            file: file.into(),
+            line,
+            column,
+            width: width.max(1),
+            message: message.into(),
+            source_line: source_line.into(),
+        }
+    }
+
+    /// Builds a diagnostic from a byte range of a whole in-memory source text
+    /// (as TOML parsers report them): finds the line, the character column and
+    /// the width.
+    pub fn at_byte_span(
+        severity: Severity,
+        file: impl Into<String>,
+        source: &str,
+        span: std::ops::Range<usize>,
+        message: impl Into<String>,
+    ) -> Self {
+        let start = floor_char_boundary(source, span.start.min(source.len()));
+        let end = floor_char_boundary(source, span.end.clamp(start, source.len()));
+        let line_start = source[..start].rfind('\n').map_or(0, |i| i + 1);
+        let line_end = source[start..]
+            .find('\n')
+            .map_or(source.len(), |i| start + i);
+        let line = source[..start].matches('\n').count() + 1;
+        let column = source[line_start..start].chars().count() + 1;
+        let width = source[start..end.min(line_end).max(start)].chars().count();
+        let text = source[line_start..line_end].trim_end_matches('\r');
+        Self::new(severity, file, line, column, width, text, message)
+    }
+
+    /// The `file:line:column` location, as editors understand it.
+    pub fn location(&self) -> String {
+        match (self.line, self.column) {
+            (0, _) => self.file.clone(),
+            (l, 0) => format!("{}:{}", self.file, l),
+            (l, c) => format!("{}:{}:{}", self.file, l, c),
+        }
+    }
+
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+}
+
+fn floor_char_boundary(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// Renders the diagnostic the way rustc does: severity and message, the
+/// location, the source line and a caret under the offending text.
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{}: {}", self.severity, self.message)?;
+        if self.line == 0 {
+            return write!(f, "  --> {}", self.file);
+        }
+        let number = self.line.to_string();
+        let pad = " ".repeat(number.len());
+        writeln!(f, "{pad}--> {}", self.location())?;
+        writeln!(f, "{pad} |")?;
+        // Tabs would shift the caret; show them as single spaces.
+        let shown: String = self
+            .source_line
+            .chars()
+            .map(|c| if c == '\t' { ' ' } else { c })
+            .collect();
+        write!(f, "{number} | {shown}")?;
+        if self.column > 0 {
+            write!(
+                f,
+                "\n{pad} | {}{}",
+                " ".repeat(self.column - 1),
+                "^".repeat(self.width)
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+/// Several diagnostics, e.g. every mistake found in one machine file.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Diagnostics(pub Vec<Diagnostic>);
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.0.iter().enumerate() {
+            if i > 0 {
+                f.write_str("\n\n")?;
+            }
+            write!(f, "{d}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Diagnostics {}
+
+impl From<Diagnostic> for Diagnostics {
+    fn from(d: Diagnostic) -> Self {
+        Diagnostics(vec![d])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renders_location_source_and_caret() {
+        let d = Diagnostic::error("part.cls", 12, 6, 5, "GOTO/1.2.3,4,5", "malformed number `1.2.3`");
+        assert_eq!(
+            d.to_string(),
+            "error: malformed number `1.2.3`\n  --> part.cls:12:6\n   |\n12 | GOTO/1.2.3,4,5\n   |      ^^^^^"
+        );
+    }
+
+    #[test]
+    fn byte_span_finds_line_and_character_column() {
+        let src = "a = 1\nname = \"平板\" x\n";
+        // byte offset of the `x` on line 2
+        let at = src.find(" x").unwrap() + 1;
+        let d = Diagnostic::at_byte_span(Severity::Error, "m.toml", src, at..at + 1, "bad");
+        assert_eq!((d.line, d.column, d.width), (2, 12, 1));
+        assert_eq!(d.source_line, "name = \"平板\" x");
+    }
+
+    #[test]
+    fn byte_span_past_the_end_is_clamped() {
+        let d = Diagnostic::at_byte_span(Severity::Error, "m.toml", "ab", 10..20, "eof");
+        assert_eq!((d.line, d.column), (1, 3));
+    }
+}
