@@ -232,7 +232,7 @@ mod tests {
         // byte offset of the `x` on line 2
         let at = src.find(" x").unwrap() + 1;
         let d = Diagnostic::at_byte_span(Severity::Error, "m.toml", src, at..at + 1, "bad");
-        assert_eq!((d.line, d.column, d.width), (2, 12, 1));
+        assert_eq!((d.line, d.column, d.width), (2, 13, 1));
         assert_eq!(d.source_line, "name = \"平板\" x");
     }
 
