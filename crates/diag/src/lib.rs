@@ -219,7 +219,14 @@ mod tests {
 
     #[test]
     fn renders_location_source_and_caret() {
-        let d = Diagnostic::error("part.cls", 12, 6, 5, "GOTO/1.2.3,4,5", "malformed number `1.2.3`");
+        let d = Diagnostic::error(
+            "part.cls",
+            12,
+            6,
+            5,
+            "GOTO/1.2.3,4,5",
+            "malformed number `1.2.3`",
+        );
         assert_eq!(
             d.to_string(),
             "error: malformed number `1.2.3`\n  --> part.cls:12:6\n   |\n12 | GOTO/1.2.3,4,5\n   |      ^^^^^"

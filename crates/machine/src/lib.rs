@@ -1,1 +1,24 @@
+//! The machine model of kinpost: machine files, forward and inverse
+//! kinematics (DESIGN.md §2).
+//!
+//! ```
+//! use kinpost_machine::{builtin, Kinematics};
+//! let machine = builtin::load("mts1600").unwrap().unwrap();
+//! let kin = Kinematics::new(&machine);
+//! let mut q = machine.home_joints();
+//! q[machine.axis_index("X").unwrap()] = 459.0;
+//! let pose = kin.fk(&q);
+//! let mut solutions = Vec::new();
+//! kin.ik(&pose, None, &mut solutions).unwrap();
+//! assert!(solutions.iter().any(|s| (s.joints[0] - 459.0).abs() < 1e-9));
+//! ```
 
+pub mod builtin;
+mod file;
+mod kinematics;
+mod model;
+pub mod subproblems;
+
+pub use file::machine_from_toml;
+pub use kinematics::{IkError, Joints, Kinematics, Solution, Violation, wrap180};
+pub use model::{Axis, AxisKind, MAX_AXES, Machine, Pose, PostSettings, Side, Tool};

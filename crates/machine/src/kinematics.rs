@@ -1,0 +1,597 @@
+//! Forward and inverse kinematics of a [`Machine`] by the product of
+//! exponentials over the home configuration (DESIGN.md §2).
+//!
+//! Conventions: `G_i(q)` is the rigid motion of axis `i` at NC value `q` in the
+//! home frame (translation `q·u` or rotation by `q` degrees about the line
+//! through `p` along `u`). With the axes of each side in chain order,
+//!
+//! ```text
+//! W(q) = Π_workpiece G_i(q_i) · W0      pose of the part frame in the machine
+//! T(q) = Π_tool      G_i(q_i) · T0      pose of the tool frame in the machine
+//! tool pose in the part frame = W(q)⁻¹ · T(q)
+//! ```
+//!
+//! Inverse kinematics: orientation depends only on the rotary axes. Writing
+//! `R_W(q)ᵀ R_T(q) a0 = R_W0 a` as one chain of rotations
+//! `E = R_wkᵀ ⋯ R_w1ᵀ · R_t1 ⋯ R_tm` (workpiece axes outermost first, each
+//! turning by `−q` about its direction), two free rotary axes are Paden–Kahan
+//! subproblem 2 and a third one, when the pose carries a reference direction,
+//! subproblem 1. With every angle known the tool point is affine in the
+//! linear axis values: a 3×3 linear solve.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
+use crate::subproblems::{FREE_EPS, rotation, sp1, sp2};
+
+/// Joint values of one configuration, in machine-file axis order.
+pub type Joints = [f64; MAX_AXES];
+
+/// Why a solution cannot be used as it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Violation {
+    /// Index of the axis outside its travel.
+    pub axis: usize,
+    /// The value it would need.
+    pub value: f64,
+}
+
+/// One inverse-kinematics solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solution {
+    /// NC values of every axis (fixed axes at their value); only the first
+    /// `Machine::axes.len()` entries are used.
+    pub joints: Joints,
+    /// Which orientation branch of the closed form this is (0 or 1).
+    pub branch: u8,
+    /// A rotary angle was free (tool axis on a rotary axis line) and was
+    /// taken from the hint.
+    pub singular: bool,
+    /// The first axis outside its travel, for a branch that has no
+    /// equivalent inside the limits.
+    pub violation: Option<Violation>,
+}
+
+impl Solution {
+    pub fn is_valid(&self) -> bool {
+        self.violation.is_none()
+    }
+}
+
+/// Inverse kinematics failures that no branch escapes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IkError {
+    /// No setting of the rotary axes gives this tool axis.
+    OrientationUnreachable,
+    /// Three free rotary axes and a pose without a reference direction.
+    NeedsReference,
+    /// The linear axes cannot reach the point with these angles (fewer than
+    /// three linear axes, or a degenerate chain).
+    PositionUnreachable,
+}
+
+impl std::fmt::Display for IkError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            IkError::OrientationUnreachable => "no setting of the rotary axes gives this tool axis",
+            IkError::NeedsReference => {
+                "the machine has three free rotary axes: the CL must give a reference direction (GOTO with 9 values)"
+            }
+            IkError::PositionUnreachable => "the linear axes cannot reach this point",
+        })
+    }
+}
+
+impl std::error::Error for IkError {}
+
+#[derive(Debug, Clone, Copy)]
+struct Link {
+    kind: AxisKind,
+    dir: Vector3<f64>,
+    point: Vector3<f64>,
+    /// Machine-file index of the axis.
+    index: usize,
+}
+
+/// A machine compiled for fast kinematics.
+#[derive(Debug, Clone)]
+pub struct Kinematics {
+    n: usize,
+    tool_chain: Vec<Link>,
+    work_chain: Vec<Link>,
+    rw0: Matrix3<f64>,
+    ow0: Vector3<f64>,
+    t0: Vector3<f64>,
+    a0: Vector3<f64>,
+    r0: Option<Vector3<f64>>,
+    fixed: Joints,
+    is_fixed: [bool; MAX_AXES],
+    limits: [Option<[f64; 2]>; MAX_AXES],
+    rotary: [bool; MAX_AXES],
+    /// Free rotary axes in effective-chain order: (axis index, signed direction).
+    free_rot: Vec<(usize, Vector3<f64>)>,
+    /// Constant rotations between the free rotary axes in the effective chain:
+    /// `E = C[0]·F1·C[1]·F2·C[2]…`.
+    between: Vec<Matrix3<f64>>,
+    /// Free linear axes, machine-file indices.
+    free_lin: Vec<usize>,
+}
+
+#[inline]
+fn rad(deg: f64) -> f64 {
+    deg.to_radians()
+}
+
+/// A rigid motion `x ↦ r·x + t`.
+#[derive(Clone, Copy)]
+struct Rigid {
+    r: Matrix3<f64>,
+    t: Vector3<f64>,
+}
+
+impl Rigid {
+    const IDENTITY: Rigid = Rigid {
+        r: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+        t: Vector3::new(0.0, 0.0, 0.0),
+    };
+
+    /// `self · G(link, q)`.
+    #[inline]
+    fn then(&self, link: &Link, q: f64, rot: Option<&Matrix3<f64>>) -> Rigid {
+        match link.kind {
+            AxisKind::Linear => Rigid {
+                r: self.r,
+                t: self.t + self.r * (link.dir * q),
+            },
+            AxisKind::Rotary => {
+                let owned;
+                let g = match rot {
+                    Some(g) => g,
+                    None => {
+                        owned = rotation(&link.dir, rad(q));
+                        &owned
+                    }
+                };
+                // G x = g (x − p) + p  ⇒  translation p − g p
+                let gt = link.point - g * link.point;
+                Rigid {
+                    r: self.r * g,
+                    t: self.t + self.r * gt,
+                }
+            }
+        }
+    }
+}
+
+impl Kinematics {
+    /// Compiles a validated machine.
+    pub fn new(machine: &Machine) -> Kinematics {
+        let n = machine.axes.len();
+        let mut fixed = [0.0; MAX_AXES];
+        let mut is_fixed = [false; MAX_AXES];
+        let mut limits = [None; MAX_AXES];
+        let mut rotary = [false; MAX_AXES];
+        let (mut tool_chain, mut work_chain) = (Vec::new(), Vec::new());
+        for (i, a) in machine.axes.iter().enumerate() {
+            fixed[i] = a.fixed.unwrap_or(0.0);
+            is_fixed[i] = a.fixed.is_some();
+            limits[i] = a.limits;
+            rotary[i] = a.is_rotary();
+            let link = Link {
+                kind: a.kind,
+                dir: a.direction,
+                point: a.point,
+                index: i,
+            };
+            match a.side {
+                Side::Tool => tool_chain.push(link),
+                Side::Workpiece => work_chain.push(link),
+            }
+        }
+        // Effective orientation chain: workpiece rotaries outermost first,
+        // direction negated (R(u, q)ᵀ = R(−u, q)), then tool rotaries.
+        let effective: Vec<(usize, Vector3<f64>)> = work_chain
+            .iter()
+            .rev()
+            .filter(|l| l.kind == AxisKind::Rotary)
+            .map(|l| (l.index, -l.dir))
+            .chain(
+                tool_chain
+                    .iter()
+                    .filter(|l| l.kind == AxisKind::Rotary)
+                    .map(|l| (l.index, l.dir)),
+            )
+            .collect();
+        let mut free_rot = Vec::new();
+        let mut between = vec![Matrix3::identity()];
+        for (i, w) in effective {
+            if is_fixed[i] {
+                let last = between.last_mut().expect("never empty");
+                *last *= rotation(&w, rad(fixed[i]));
+            } else {
+                free_rot.push((i, w));
+                between.push(Matrix3::identity());
+            }
+        }
+        let free_lin = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
+        Kinematics {
+            n,
+            tool_chain,
+            work_chain,
+            rw0: machine.workpiece_rotation,
+            ow0: machine.workpiece_origin,
+            t0: machine.tool.point,
+            a0: machine.tool.axis,
+            r0: machine.tool.reference,
+            fixed,
+            is_fixed,
+            limits,
+            rotary,
+            free_rot,
+            between,
+            free_lin,
+        }
+    }
+
+    /// Number of axes.
+    pub fn axis_count(&self) -> usize {
+        self.n
+    }
+
+    /// Forward kinematics: the tool pose in the part frame for NC values `q`
+    /// (machine-file order; every axis, fixed ones included).
+    pub fn fk(&self, q: &[f64]) -> Pose {
+        let (w, t) = self.frames(q, None);
+        let rt = w.r.transpose();
+        Pose {
+            point: rt * (t.r * self.t0 + t.t - w.t),
+            axis: rt * (t.r * self.a0),
+            reference: self.r0.map(|r| rt * (t.r * r)),
+        }
+    }
+
+    /// `W(q)` and `T(q)`; `rots` are precomputed rotary matrices by axis index.
+    #[inline]
+    fn frames(&self, q: &[f64], rots: Option<&[Matrix3<f64>; MAX_AXES]>) -> (Rigid, Rigid) {
+        let chain = |links: &[Link]| {
+            links.iter().fold(Rigid::IDENTITY, |acc, l| {
+                acc.then(l, q[l.index], rots.map(|r| &r[l.index]))
+            })
+        };
+        let t = chain(&self.tool_chain);
+        let w = chain(&self.work_chain);
+        let w = Rigid {
+            r: w.r * self.rw0,
+            t: w.r * self.ow0 + w.t,
+        };
+        (w, t)
+    }
+
+    /// Inverse kinematics: every solution branch of `pose` and its 360°
+    /// equivalents inside the rotary limits, appended to `out` (cleared
+    /// first). A branch with no equivalent inside the limits, or whose linear
+    /// values are outside theirs, appears once with its `violation` set.
+    ///
+    /// `hint` (e.g. the previous block) gives the value of an angle that is
+    /// free at a singular pose, and the turn of rotary axes without limits.
+    pub fn ik(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+    ) -> Result<(), IkError> {
+        out.clear();
+        let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
+        let target = self.rw0 * pose.axis;
+        let mut orientations: [(Joints, bool); 2] = [(self.fixed, false); 2];
+        let count;
+        match self.free_rot.len() {
+            0 => {
+                if (self.between[0] * self.a0 - target).norm() > 1e-9 {
+                    return Err(IkError::OrientationUnreachable);
+                }
+                count = 1;
+            }
+            1 => {
+                let (i, w) = self.free_rot[0];
+                let u = self.between[1] * self.a0;
+                let v = self.between[0].transpose() * target;
+                if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
+                    return Err(IkError::OrientationUnreachable);
+                }
+                let (q, singular) = match sp1(&w, &u, &v) {
+                    Some(t) => (t.to_degrees(), false),
+                    None => (hint_of(i), true),
+                };
+                orientations[0].0[i] = q;
+                orientations[0].1 = singular;
+                count = 1;
+            }
+            nfree => {
+                let (i1, w1) = self.free_rot[0];
+                let (i2, w2) = self.free_rot[1];
+                let c = &self.between;
+                let w2e = c[1] * w2;
+                // With a third free axis, the vector it leaves unchanged (its
+                // own direction) must be carried to where the full target
+                // rotation puts it; otherwise the tool axis.
+                let (p, q, full) = if nfree == 3 {
+                    let Some(reference) = pose.reference else {
+                        return Err(IkError::NeedsReference);
+                    };
+                    let (_, w3) = self.free_rot[2];
+                    let r0 = self.r0.ok_or(IkError::NeedsReference)?;
+                    let target_rot =
+                        frame(&target, &(self.rw0 * reference)) * frame(&self.a0, &r0).transpose();
+                    let p = c[1] * c[2] * w3;
+                    let q = c[0].transpose() * target_rot * c[3].transpose() * w3;
+                    (p, q, Some(target_rot))
+                } else {
+                    (c[1] * c[2] * self.a0, c[0].transpose() * target, None)
+                };
+                let (sols, n) = sp2(&w1, &w2e, &p, &q, 1e-10);
+                if n == 0 {
+                    return Err(IkError::OrientationUnreachable);
+                }
+                for (k, s) in sols[..n].iter().enumerate() {
+                    let mut j = self.fixed;
+                    let mut singular = false;
+                    let mut pick = |theta: Option<f64>, i: usize| match theta {
+                        Some(t) => t.to_degrees(),
+                        None => {
+                            singular = true;
+                            hint_of(i)
+                        }
+                    };
+                    j[i1] = pick(s.theta1, i1);
+                    j[i2] = pick(s.theta2, i2);
+                    if s.theta1.is_none() || s.theta2.is_none() {
+                        // One angle was free: solve the other one for the
+                        // chosen value so that the tool axis is exact.
+                        let r1 = rotation(&w1, rad(j[i1]));
+                        let r2 = rotation(&w2e, rad(j[i2]));
+                        if s.theta1.is_none()
+                            && let Some(t) = sp1(&w2e, &p, &(r1.transpose() * q))
+                        {
+                            j[i2] = t.to_degrees();
+                        } else if s.theta2.is_none()
+                            && let Some(t) = sp1(&w1, &(r2 * p), &q)
+                        {
+                            j[i1] = t.to_degrees();
+                        }
+                    }
+                    if let Some(target_rot) = full {
+                        let (i3, w3) = self.free_rot[2];
+                        let r12 = c[0]
+                            * rotation(&w1, rad(j[i1]))
+                            * c[1]
+                            * rotation(&w2, rad(j[i2]))
+                            * c[2];
+                        let f3 = r12.transpose() * target_rot * c[3].transpose();
+                        // Any vector off the axis shows the angle of F3.
+                        let x = any_perpendicular(&w3);
+                        j[i3] = match sp1(&w3, &x, &(f3 * x)) {
+                            Some(t) => t.to_degrees(),
+                            None => hint_of(i3),
+                        };
+                    }
+                    orientations[k] = (j, singular);
+                }
+                count = n;
+            }
+        }
+
+        for (k, (angles, singular)) in orientations[..count].iter().enumerate() {
+            let Some(joints) = self.solve_linear(angles, &pose.point) else {
+                continue;
+            };
+            self.push_equivalents(joints, k as u8, *singular, hint, out);
+        }
+        if out.is_empty() {
+            return Err(IkError::PositionUnreachable);
+        }
+        Ok(())
+    }
+
+    /// With every rotary angle set in `joints`, solves the free linear axes so
+    /// that the tool point lands on `target` (part frame).
+    fn solve_linear(&self, joints: &Joints, target: &Vector3<f64>) -> Option<Joints> {
+        let mut rots = [Matrix3::zeros(); MAX_AXES];
+        for i in 0..self.n {
+            if self.rotary[i] {
+                rots[i] = rotation_of(&self.tool_chain, &self.work_chain, i, joints[i]);
+            }
+        }
+        let mut q = *joints;
+        for &i in &self.free_lin {
+            q[i] = 0.0;
+        }
+        let (w, t) = self.frames(&q, Some(&rots));
+        let wrt = w.r.transpose();
+        let p0 = wrt * (t.r * self.t0 + t.t - w.t);
+
+        // Column of each free linear axis: how the tool point in the part
+        // frame moves per unit of that axis.
+        let mut cols = [Vector3::zeros(); 3];
+        let mut acc = Matrix3::identity();
+        for l in &self.tool_chain {
+            if l.kind == AxisKind::Linear {
+                if let Some(k) = self.free_lin.iter().position(|&i| i == l.index) {
+                    cols[k] = wrt * (acc * l.dir);
+                }
+            } else {
+                acc *= rots[l.index];
+            }
+        }
+        let mut suffix = self.rw0;
+        for l in self.work_chain.iter().rev() {
+            if l.kind == AxisKind::Linear {
+                if let Some(k) = self.free_lin.iter().position(|&i| i == l.index) {
+                    cols[k] = -(suffix.transpose() * l.dir);
+                }
+            } else {
+                suffix = rots[l.index] * suffix;
+            }
+        }
+        let rhs = target - p0;
+        let m = self.free_lin.len();
+        let values: [f64; 3] = match m {
+            3 => {
+                let j = Matrix3::from_columns(&cols);
+                let x = j.lu().solve(&rhs)?;
+                [x.x, x.y, x.z]
+            }
+            0 => [0.0; 3],
+            _ => {
+                // Least squares over the available axes, then the residual
+                // tells whether the point is reachable at all.
+                let j = nalgebra::DMatrix::from_fn(3, m, |r, c| cols[c][r]);
+                let b = nalgebra::DVector::from_column_slice(rhs.as_slice());
+                let x = j.clone().svd(true, true).solve(&b, 1e-12).ok()?;
+                let mut out = [0.0; 3];
+                out[..m].copy_from_slice(x.as_slice());
+                out
+            }
+        };
+        let mut moved = Vector3::zeros();
+        for (k, &i) in self.free_lin.iter().enumerate() {
+            q[i] = values[k];
+            moved += cols[k] * values[k];
+        }
+        if m < 3 && (moved - rhs).norm() > 1e-9 * (1.0 + rhs.norm()) {
+            return None;
+        }
+        if !values.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        Some(q)
+    }
+
+    fn push_equivalents(
+        &self,
+        joints: Joints,
+        branch: u8,
+        singular: bool,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+    ) {
+        // Linear axes first: their values do not change between equivalents.
+        let linear_violation = (0..self.n)
+            .filter(|&i| !self.rotary[i] && !self.is_fixed[i])
+            .find(|&i| !accepts(self.limits[i], joints[i]))
+            .map(|i| Violation {
+                axis: i,
+                value: joints[i],
+            });
+        let start = out.len();
+        let mut stack = joints;
+        self.expand(0, &mut stack, branch, singular, hint, out);
+        if out.len() == start {
+            // No equivalent inside the limits: report the principal value.
+            let (i, v) = self
+                .free_rot
+                .iter()
+                .map(|&(i, _)| (i, wrap180(joints[i])))
+                .find(|&(i, v)| !has_equivalent(self.limits[i], v))
+                .unwrap_or((0, joints[0]));
+            out.push(Solution {
+                joints,
+                branch,
+                singular,
+                violation: Some(Violation { axis: i, value: v }),
+            });
+        } else if let Some(v) = linear_violation {
+            for s in &mut out[start..] {
+                s.violation = Some(v);
+            }
+            out.truncate(start + 1);
+        }
+    }
+
+    fn expand(
+        &self,
+        k: usize,
+        joints: &mut Joints,
+        branch: u8,
+        singular: bool,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+    ) {
+        let Some(&(i, _)) = self.free_rot.get(k) else {
+            out.push(Solution {
+                joints: *joints,
+                branch,
+                singular,
+                violation: None,
+            });
+            return;
+        };
+        let principal = wrap180(joints[i]);
+        match self.limits[i] {
+            None => {
+                // Unlimited: the turn nearest the hint (continuous output).
+                let h = hint.map_or(0.0, |h| h[i]);
+                joints[i] = principal + 360.0 * ((h - principal) / 360.0).round();
+                self.expand(k + 1, joints, branch, singular, hint, out);
+            }
+            Some([lo, hi]) => {
+                let first = ((lo - 1e-9 - principal) / 360.0).ceil() as i64;
+                let last = ((hi + 1e-9 - principal) / 360.0).floor() as i64;
+                for turn in first..=last {
+                    joints[i] = principal + 360.0 * turn as f64;
+                    self.expand(k + 1, joints, branch, singular, hint, out);
+                }
+            }
+        }
+    }
+}
+
+fn accepts(limits: Option<[f64; 2]>, v: f64) -> bool {
+    match limits {
+        None => v.is_finite(),
+        Some([lo, hi]) => v >= lo - 1e-9 && v <= hi + 1e-9,
+    }
+}
+
+fn has_equivalent(limits: Option<[f64; 2]>, principal: f64) -> bool {
+    match limits {
+        None => true,
+        Some([lo, hi]) => {
+            ((lo - 1e-9 - principal) / 360.0).ceil() <= ((hi + 1e-9 - principal) / 360.0).floor()
+        }
+    }
+}
+
+/// Angle in degrees wrapped to (−180, 180].
+#[inline]
+pub fn wrap180(deg: f64) -> f64 {
+    let w = deg.rem_euclid(360.0);
+    if w > 180.0 { w - 360.0 } else { w }
+}
+
+fn rotation_of(tool: &[Link], work: &[Link], index: usize, q: f64) -> Matrix3<f64> {
+    let l = tool
+        .iter()
+        .chain(work)
+        .find(|l| l.index == index)
+        .expect("every axis is in a chain");
+    rotation(&l.dir, rad(q))
+}
+
+/// Orthonormal frame (columns a, b', a×b') from a direction and a second,
+/// not parallel one (Gram–Schmidt).
+fn frame(a: &Vector3<f64>, b: &Vector3<f64>) -> Matrix3<f64> {
+    let b = (b - a * a.dot(b)).normalize();
+    Matrix3::from_columns(&[*a, b, a.cross(&b)])
+}
+
+fn any_perpendicular(w: &Vector3<f64>) -> Vector3<f64> {
+    let seed = if w.x.abs() < 0.6 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let p = seed - w * w.dot(&seed);
+    debug_assert!(p.norm() > FREE_EPS);
+    p.normalize()
+}

@@ -1,0 +1,157 @@
+//! The machine model of DESIGN.md §2: a serial chain of linear and rotary axes
+//! described at home (every NC value zero), all vectors in one fixed machine
+//! frame, lengths in mm, angles in degrees.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Largest number of axes a machine may have (free and fixed together).
+pub const MAX_AXES: usize = 9;
+
+/// Whether an axis translates or rotates what it carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisKind {
+    Linear,
+    Rotary,
+}
+
+/// What an axis carries: the part (a table) or the tool (a head).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    Workpiece,
+    Tool,
+}
+
+/// One NC axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// The NC address, e.g. `X` or `A`.
+    pub name: String,
+    pub kind: AxisKind,
+    pub side: Side,
+    /// Unit vector in the machine frame at home. A linear axis at value `q`
+    /// moves what it carries by `q·direction`; a rotary axis turns it by `q`
+    /// degrees about the line (`point`, `direction`), right-hand rule.
+    pub direction: Vector3<f64>,
+    /// A point on the rotation line (rotary axes; zero for linear ones).
+    pub point: Vector3<f64>,
+    /// Travel in NC values `[min, max]`, if the machine has any.
+    pub limits: Option<[f64; 2]>,
+    /// The value the axis is locked at, if it does not move in this mode.
+    pub fixed: Option<f64>,
+}
+
+impl Axis {
+    pub fn is_rotary(&self) -> bool {
+        self.kind == AxisKind::Rotary
+    }
+
+    pub fn is_free(&self) -> bool {
+        self.fixed.is_none()
+    }
+
+    /// Whether `value` lies inside the travel (with a tolerance of 1e-9 for
+    /// values computed exactly at a limit).
+    pub fn accepts(&self, value: f64) -> bool {
+        match self.limits {
+            None => value.is_finite(),
+            Some([lo, hi]) => value >= lo - 1e-9 && value <= hi + 1e-9,
+        }
+    }
+}
+
+/// The controlled tool frame at home.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tool {
+    /// Tool tip or, for a grinding wheel, the contact point.
+    pub point: Vector3<f64>,
+    /// Unit vector from the contact point towards the tool (for a belt wheel,
+    /// the surface normal at contact).
+    pub axis: Vector3<f64>,
+    /// Optional second direction for full 6-DOF orientation (e.g. the wheel's
+    /// rotation axis or the feed direction); orthogonal to `axis`.
+    pub reference: Option<Vector3<f64>>,
+}
+
+/// Settings for writing programs for this machine.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PostSettings {
+    /// Name of the dialect used when the command line names none.
+    pub dialect: Option<String>,
+    /// Header template replacing the dialect's own.
+    pub header: Option<String>,
+    /// Footer template replacing the dialect's own.
+    pub footer: Option<String>,
+}
+
+/// A whole machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Machine {
+    pub name: String,
+    pub description: String,
+    /// Axes in chain order from the machine base outwards (per side).
+    pub axes: Vec<Axis>,
+    /// Part (program) frame at home: columns x, y, z of the part axes in the
+    /// machine frame.
+    pub workpiece_rotation: Matrix3<f64>,
+    /// Part frame origin at home, machine frame.
+    pub workpiece_origin: Vector3<f64>,
+    pub tool: Tool,
+    pub post: PostSettings,
+}
+
+/// A tool pose in the part frame: what one CL point asks for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Tool (contact) point, mm.
+    pub point: Vector3<f64>,
+    /// Unit tool axis.
+    pub axis: Vector3<f64>,
+    /// Unit reference direction, when the CL gives one (6-axis output).
+    pub reference: Option<Vector3<f64>>,
+}
+
+impl Machine {
+    /// Index of the axis called `name` (case-insensitive).
+    pub fn axis_index(&self, name: &str) -> Option<usize> {
+        self.axes
+            .iter()
+            .position(|a| a.name.eq_ignore_ascii_case(name))
+    }
+
+    /// Number of free (not `fixed`) rotary axes.
+    pub fn free_rotary_count(&self) -> usize {
+        self.axes
+            .iter()
+            .filter(|a| a.is_rotary() && a.is_free())
+            .count()
+    }
+
+    /// The joint vector with every axis at home, fixed axes at their value.
+    pub fn home_joints(&self) -> Vec<f64> {
+        self.axes.iter().map(|a| a.fixed.unwrap_or(0.0)).collect()
+    }
+
+    /// Largest distance between the home tool point and a rotary axis line,
+    /// plus the diagonal of the linear travel box (1 m per linear axis where
+    /// the travel is not given): an upper bound of the lever through which an
+    /// angle error moves the tool point.
+    pub fn largest_pivot_distance(&self) -> f64 {
+        let travel: f64 = self
+            .axes
+            .iter()
+            .filter(|a| !a.is_rotary())
+            .map(|a| match a.limits {
+                Some([lo, hi]) => (hi - lo).powi(2),
+                None => 1000.0f64.powi(2),
+            })
+            .sum::<f64>()
+            .sqrt();
+        let lever = self
+            .axes
+            .iter()
+            .filter(|a| a.is_rotary())
+            .map(|a| (self.tool.point - a.point).cross(&a.direction).norm())
+            .fold(0.0, f64::max);
+        lever + travel
+    }
+}

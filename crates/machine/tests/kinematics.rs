@@ -1,0 +1,185 @@
+//! Properties of the kinematics over every built-in machine and the test
+//! machines in `tests/machines/`: `fk(ik(pose)) == pose` for every branch and
+//! `ik(fk(q))` contains `q`; plus the seed-000 numbers and the paper's
+//! orientation law as independent checks.
+
+use kinpost_machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use nalgebra::Vector3;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+
+fn test_machines() -> Vec<Machine> {
+    let mut out: Vec<Machine> = builtin::names()
+        .map(|n| builtin::load(n).unwrap().unwrap())
+        .collect();
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/machines");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    for f in files {
+        let src = std::fs::read_to_string(&f).unwrap();
+        out.push(machine_from_toml(&src, &f.display().to_string()).unwrap());
+    }
+    assert!(out.len() >= 5);
+    out
+}
+
+/// Random joint values inside the limits (±170° / ±500 mm where none).
+fn joints(m: &Machine) -> impl Strategy<Value = Vec<f64>> {
+    let ranges: Vec<_> = m
+        .axes
+        .iter()
+        .map(|a| match (a.fixed, a.limits, a.is_rotary()) {
+            (Some(v), _, _) => v..=v,
+            (None, Some([lo, hi]), _) => lo..=hi,
+            (None, None, true) => -170.0..=170.0,
+            (None, None, false) => -500.0..=500.0,
+        })
+        .collect();
+    ranges
+}
+
+fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+fn assert_same_pose(m: &Machine, want: &Pose, got: &Pose) -> Result<(), TestCaseError> {
+    prop_assert!(
+        (want.point - got.point).norm() < 1e-9,
+        "{}: point {} vs {}",
+        m.name,
+        want.point,
+        got.point
+    );
+    prop_assert!(
+        angle_between(&want.axis, &got.axis) < 1e-9,
+        "{}: axis",
+        m.name
+    );
+    if let (Some(a), Some(b)) = (want.reference, got.reference) {
+        prop_assert!(angle_between(&a, &b) < 1e-9, "{}: reference", m.name);
+    }
+    Ok(())
+}
+
+#[test]
+fn fk_of_ik_is_the_pose_for_every_branch_and_ik_of_fk_contains_q() {
+    for m in test_machines() {
+        let kin = Kinematics::new(&m);
+        let mut runner = TestRunner::new(Config::with_cases(2000));
+        let two_branches = std::cell::Cell::new(0usize);
+        runner
+            .run(&joints(&m), |q| {
+                let mut sols = Vec::new();
+                let pose = kin.fk(&q);
+                kin.ik(&pose, Some(&q), &mut sols)
+                    .map_err(|e| TestCaseError::fail(format!("{}: {e} at {q:?}", m.name)))?;
+                let mut contains = false;
+                for s in &sols {
+                    let j = &s.joints[..m.axes.len()];
+                    assert_same_pose(&m, &pose, &kin.fk(j))?;
+                    if s.is_valid() {
+                        for (i, a) in m.axes.iter().enumerate() {
+                            prop_assert!(a.accepts(j[i]), "{}: {} outside limits", m.name, a.name);
+                        }
+                    }
+                    if j.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-7) {
+                        contains = true;
+                    }
+                }
+                prop_assert!(contains, "{}: q {q:?} not among {:?}", m.name, sols);
+                if sols.iter().any(|s| s.branch == 1) {
+                    two_branches.set(two_branches.get() + 1);
+                }
+                Ok(())
+            })
+            .unwrap();
+        // Both closed-form branches are exercised, not only the one that
+        // contains q.
+        assert!(
+            two_branches.get() > 100,
+            "{}: second branch seen {} times",
+            m.name,
+            two_branches.get()
+        );
+    }
+}
+
+#[test]
+fn singular_pose_keeps_the_hinted_angle_and_is_exact() {
+    // Tool axis along the trunnion's C axis: A = 0, C is free.
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/machines/trunnion-ac-offset.toml"
+    ))
+    .unwrap();
+    let m = machine_from_toml(&src, "t").unwrap();
+    let kin = Kinematics::new(&m);
+    let q = [10.0, -20.0, 30.0, 0.0, 37.5];
+    let pose = kin.fk(&q);
+    let mut sols = Vec::new();
+    kin.ik(&pose, Some(&q), &mut sols).unwrap();
+    assert!(sols.iter().all(|s| s.singular));
+    let s = sols
+        .iter()
+        .find(|s| (s.joints[4] - 37.5).abs() < 1e-9)
+        .expect("hint kept");
+    assert!((kin.fk(&s.joints[..5]).point - pose.point).norm() < 1e-9);
+}
+
+/// Seed 000, Figure 28: the CL points and the NC values the authors' post
+/// printed, to the printed decimals.
+#[test]
+fn seed000_figure28_points() {
+    let m = builtin::load("mts1600").unwrap().unwrap();
+    let kin = Kinematics::new(&m);
+    let cases = [
+        ([-416.0, 70.3931, 11.3684], [459.000, 8.807, 361.368]),
+        ([-416.0, 70.0741, 9.7648], [459.000, 9.126, 359.765]),
+        ([-416.0, 58.0000, 0.5000], [459.000, 21.200, 350.500]),
+    ];
+    let mut sols = Vec::new();
+    for (p, nc) in cases {
+        let pose = Pose {
+            point: Vector3::from(p),
+            axis: Vector3::z(),
+            reference: None,
+        };
+        kin.ik(&pose, None, &mut sols).unwrap();
+        let s = sols
+            .iter()
+            .filter(|s| s.is_valid())
+            .min_by(|a, b| {
+                let r = |s: &kinpost_machine::Solution| s.joints[1].abs() + s.joints[4].abs();
+                r(a).total_cmp(&r(b))
+            })
+            .unwrap();
+        let got = [s.joints[0], s.joints[2], s.joints[3]];
+        for k in 0..3 {
+            assert!(
+                (got[k] - nc[k]).abs() <= 0.0005 + 1e-12,
+                "{got:?} vs {nc:?}"
+            );
+        }
+        assert!(s.joints[1].abs() < 1e-9 && s.joints[4].abs() < 1e-9);
+    }
+}
+
+/// Seed 000 eq. 3.18: the tool axis in the part frame is
+/// (sin B, −sin A·cos B, cos A·cos B), written here independently of the chain.
+#[test]
+fn mts1600_orientation_law_of_eq_3_18() {
+    let m = builtin::load("mts1600").unwrap().unwrap();
+    let kin = Kinematics::new(&m);
+    for a in [-170.0f64, -33.0, 0.0, 12.5, 90.0, 300.0] {
+        for b in [-45.0f64, -10.0, 0.0, 7.5, 45.0] {
+            let q = [100.0, a, 5.0, 7.0, b, 0.0];
+            let got = kin.fk(&q).axis;
+            let (ar, br) = (a.to_radians(), b.to_radians());
+            let want = Vector3::new(br.sin(), -ar.sin() * br.cos(), ar.cos() * br.cos());
+            assert!((got - want).norm() < 1e-12, "A{a} B{b}: {got} vs {want}");
+        }
+    }
+}
