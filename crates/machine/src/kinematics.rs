@@ -91,6 +91,8 @@ struct Link {
     point: Vector3<f64>,
     /// Machine-file index of the axis.
     index: usize,
+    /// Position among the free linear axes (the column of the linear solve).
+    free_lin: Option<usize>,
 }
 
 /// A machine compiled for fast kinematics.
@@ -115,6 +117,8 @@ pub struct Kinematics {
     between: Vec<Matrix3<f64>>,
     /// Free linear axes, machine-file indices.
     free_lin: Vec<usize>,
+    /// Rotation of every rotary axis locked by `fixed` (identity elsewhere).
+    fixed_rots: [Matrix3<f64>; MAX_AXES],
 }
 
 #[inline]
@@ -122,45 +126,13 @@ fn rad(deg: f64) -> f64 {
     deg.to_radians()
 }
 
-/// A rigid motion `x ↦ r·x + t`.
-#[derive(Clone, Copy)]
-struct Rigid {
-    r: Matrix3<f64>,
-    t: Vector3<f64>,
-}
-
-impl Rigid {
-    const IDENTITY: Rigid = Rigid {
-        r: Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0),
-        t: Vector3::new(0.0, 0.0, 0.0),
-    };
-
-    /// `self · G(link, q)`.
-    #[inline]
-    fn then(&self, link: &Link, q: f64, rot: Option<&Matrix3<f64>>) -> Rigid {
-        match link.kind {
-            AxisKind::Linear => Rigid {
-                r: self.r,
-                t: self.t + self.r * (link.dir * q),
-            },
-            AxisKind::Rotary => {
-                let owned;
-                let g = match rot {
-                    Some(g) => g,
-                    None => {
-                        owned = rotation(&link.dir, rad(q));
-                        &owned
-                    }
-                };
-                // G x = g (x − p) + p  ⇒  translation p − g p
-                let gt = link.point - g * link.point;
-                Rigid {
-                    r: self.r * g,
-                    t: self.t + self.r * gt,
-                }
-            }
-        }
-    }
+/// The tool pose in the part frame for some joint values, and how the tool
+/// point moves per unit of each free linear axis.
+struct Eval {
+    point: Vector3<f64>,
+    axis: Vector3<f64>,
+    reference: Option<Vector3<f64>>,
+    cols: [Vector3<f64>; 3],
 }
 
 impl Kinematics {
@@ -177,11 +149,18 @@ impl Kinematics {
             is_fixed[i] = a.fixed.is_some();
             limits[i] = a.limits;
             rotary[i] = a.is_rotary();
+            let free_lin = (!a.is_rotary() && a.fixed.is_none()).then(|| {
+                machine.axes[..i]
+                    .iter()
+                    .filter(|b| !b.is_rotary() && b.fixed.is_none())
+                    .count()
+            });
             let link = Link {
                 kind: a.kind,
                 dir: a.direction,
                 point: a.point,
                 index: i,
+                free_lin,
             };
             match a.side {
                 Side::Tool => tool_chain.push(link),
@@ -214,6 +193,12 @@ impl Kinematics {
             }
         }
         let free_lin = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
+        let mut fixed_rots = [Matrix3::identity(); MAX_AXES];
+        for (i, a) in machine.axes.iter().enumerate() {
+            if let (true, Some(v)) = (a.is_rotary(), a.fixed) {
+                fixed_rots[i] = rotation(&a.direction, rad(v));
+            }
+        }
         Kinematics {
             n,
             tool_chain,
@@ -230,6 +215,7 @@ impl Kinematics {
             free_rot,
             between,
             free_lin,
+            fixed_rots,
         }
     }
 
@@ -241,36 +227,90 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
-        let (w, t) = self.frames(q, None);
-        let rt = w.r.transpose();
+        let e = self.eval(q, &self.rotations(q));
         Pose {
-            point: rt * (t.r * self.t0 + t.t - w.t),
-            axis: rt * (t.r * self.a0),
-            reference: self.r0.map(|r| rt * (t.r * r)),
+            point: e.point,
+            axis: e.axis,
+            reference: e.reference,
         }
     }
 
-    /// `W(q)` and `T(q)`; `rots` are precomputed rotary matrices by axis index.
+    /// Rotation matrix of every rotary axis at `q` (fixed axes from the cache).
     #[inline]
-    fn frames(&self, q: &[f64], rots: Option<&[Matrix3<f64>; MAX_AXES]>) -> (Rigid, Rigid) {
-        let chain = |links: &[Link]| {
-            links.iter().fold(Rigid::IDENTITY, |acc, l| {
-                acc.then(l, q[l.index], rots.map(|r| &r[l.index]))
-            })
-        };
-        let t = chain(&self.tool_chain);
-        let w = chain(&self.work_chain);
-        let w = Rigid {
-            r: w.r * self.rw0,
-            t: w.r * self.ow0 + w.t,
-        };
-        (w, t)
+    fn rotations(&self, q: &[f64]) -> [Matrix3<f64>; MAX_AXES] {
+        let mut rots = self.fixed_rots;
+        for l in self.tool_chain.iter().chain(&self.work_chain) {
+            if l.kind == AxisKind::Rotary && !self.is_fixed[l.index] {
+                rots[l.index] = rotation(&l.dir, rad(q[l.index]));
+            }
+        }
+        rots
+    }
+
+    /// One pass over both chains: the tool pose in the part frame at `q`, and
+    /// the column of each free linear axis (the pose is affine in them).
+    #[inline]
+    fn eval(&self, q: &[f64], rots: &[Matrix3<f64>; MAX_AXES]) -> Eval {
+        // Tool chain, base outwards: T = G_t1 ⋯ G_tm, G x = g (x − p) + p.
+        let mut r = Matrix3::identity();
+        let mut t = Vector3::zeros();
+        let mut tool_cols = [Vector3::zeros(); 3];
+        for l in &self.tool_chain {
+            match l.kind {
+                AxisKind::Linear => {
+                    let d = r * l.dir;
+                    if let Some(k) = l.free_lin {
+                        tool_cols[k] = d;
+                    }
+                    t += d * q[l.index];
+                }
+                AxisKind::Rotary => {
+                    let g = &rots[l.index];
+                    t += r * (l.point - g * l.point);
+                    r *= g;
+                }
+            }
+        }
+        let x = r * self.t0 + t;
+        // Workpiece chain, outermost first: S_j = G_w(j+1) ⋯ G_wk · W0 ends
+        // as W. A linear axis j moves the part point by −S_jᵀ u_j per unit.
+        let mut sr = self.rw0;
+        let mut st = self.ow0;
+        let mut cols = [Vector3::zeros(); 3];
+        for l in self.work_chain.iter().rev() {
+            match l.kind {
+                AxisKind::Linear => {
+                    if let Some(k) = l.free_lin {
+                        cols[k] = -(sr.tr_mul(&l.dir));
+                    }
+                    st += l.dir * q[l.index];
+                }
+                AxisKind::Rotary => {
+                    let g = &rots[l.index];
+                    sr = g * sr;
+                    st = g * st + (l.point - g * l.point);
+                }
+            }
+        }
+        for l in &self.tool_chain {
+            if let Some(k) = l.free_lin {
+                cols[k] = sr.tr_mul(&tool_cols[k]);
+            }
+        }
+        Eval {
+            point: sr.tr_mul(&(x - st)),
+            axis: sr.tr_mul(&(r * self.a0)),
+            reference: self.r0.map(|v| sr.tr_mul(&(r * v))),
+            cols,
+        }
     }
 
     /// Inverse kinematics: every solution branch of `pose` and its 360°
     /// equivalents inside the rotary limits, appended to `out` (cleared
-    /// first). A branch with no equivalent inside the limits, or whose linear
-    /// values are outside theirs, appears once with its `violation` set.
+    /// first). A branch whose linear values are outside their travel appears
+    /// once with its `violation` set; so does a branch with no equivalent
+    /// inside the rotary limits, when no branch is inside every limit (see
+    /// [`Kinematics::ik_all_branches`]).
     ///
     /// `hint` (e.g. the previous block) gives the value of an angle that is
     /// free at a singular pose, and the turn of rotary axes without limits.
@@ -279,6 +319,28 @@ impl Kinematics {
         pose: &Pose,
         hint: Option<&[f64]>,
         out: &mut Vec<Solution>,
+    ) -> Result<(), IkError> {
+        self.solve(pose, hint, out, false)
+    }
+
+    /// Like [`Kinematics::ik`], but every branch is solved in full, also those
+    /// with no equivalent inside the rotary limits while another branch has
+    /// one (which [`Kinematics::ik`] leaves out to save time).
+    pub fn ik_all_branches(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+    ) -> Result<(), IkError> {
+        self.solve(pose, hint, out, true)
+    }
+
+    fn solve(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+        all_branches: bool,
     ) -> Result<(), IkError> {
         out.clear();
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
@@ -381,11 +443,26 @@ impl Kinematics {
             }
         }
 
-        for (k, (angles, singular)) in orientations[..count].iter().enumerate() {
-            let Some(joints) = self.solve_linear(angles, &pose.point) else {
-                continue;
-            };
-            self.push_equivalents(joints, k as u8, *singular, hint, out);
+        // Branches whose rotary angles fit the travel first; the others are
+        // only needed to say why nothing fits.
+        let fits = |j: &Joints| {
+            self.free_rot
+                .iter()
+                .all(|&(i, _)| has_equivalent(self.limits[i], wrap180(j[i])))
+        };
+        for pass in [true, false] {
+            if !pass && !all_branches && out.iter().any(Solution::is_valid) {
+                break;
+            }
+            for (k, (angles, singular)) in orientations[..count].iter().enumerate() {
+                if fits(angles) != pass {
+                    continue;
+                }
+                let Some(joints) = self.solve_linear(angles, &pose.point) else {
+                    continue;
+                };
+                self.push_equivalents(joints, k as u8, *singular, hint, out);
+            }
         }
         if out.is_empty() {
             return Err(IkError::PositionUnreachable);
@@ -396,58 +473,35 @@ impl Kinematics {
     /// With every rotary angle set in `joints`, solves the free linear axes so
     /// that the tool point lands on `target` (part frame).
     fn solve_linear(&self, joints: &Joints, target: &Vector3<f64>) -> Option<Joints> {
-        let mut rots = [Matrix3::zeros(); MAX_AXES];
-        for i in 0..self.n {
-            if self.rotary[i] {
-                rots[i] = rotation_of(&self.tool_chain, &self.work_chain, i, joints[i]);
-            }
-        }
         let mut q = *joints;
         for &i in &self.free_lin {
             q[i] = 0.0;
         }
-        let (w, t) = self.frames(&q, Some(&rots));
-        let wrt = w.r.transpose();
-        let p0 = wrt * (t.r * self.t0 + t.t - w.t);
-
-        // Column of each free linear axis: how the tool point in the part
-        // frame moves per unit of that axis.
-        let mut cols = [Vector3::zeros(); 3];
-        let mut acc = Matrix3::identity();
-        for l in &self.tool_chain {
-            if l.kind == AxisKind::Linear {
-                if let Some(k) = self.free_lin.iter().position(|&i| i == l.index) {
-                    cols[k] = wrt * (acc * l.dir);
-                }
-            } else {
-                acc *= rots[l.index];
-            }
-        }
-        let mut suffix = self.rw0;
-        for l in self.work_chain.iter().rev() {
-            if l.kind == AxisKind::Linear {
-                if let Some(k) = self.free_lin.iter().position(|&i| i == l.index) {
-                    cols[k] = -(suffix.transpose() * l.dir);
-                }
-            } else {
-                suffix = rots[l.index] * suffix;
-            }
-        }
-        let rhs = target - p0;
+        let e = self.eval(&q, &self.rotations(&q));
+        let rhs = target - e.point;
+        let c = &e.cols;
         let m = self.free_lin.len();
         let values: [f64; 3] = match m {
             3 => {
-                let j = Matrix3::from_columns(&cols);
-                let x = j.lu().solve(&rhs)?;
-                [x.x, x.y, x.z]
+                // Cramer's rule with triple products.
+                let c12 = c[1].cross(&c[2]);
+                let det = c[0].dot(&c12);
+                if det.abs() < 1e-12 {
+                    return None;
+                }
+                [
+                    rhs.dot(&c12) / det,
+                    c[0].dot(&rhs.cross(&c[2])) / det,
+                    c[0].dot(&c[1].cross(&rhs)) / det,
+                ]
             }
             0 => [0.0; 3],
             _ => {
-                // Least squares over the available axes, then the residual
+                // Least squares over the available axes; the residual then
                 // tells whether the point is reachable at all.
-                let j = nalgebra::DMatrix::from_fn(3, m, |r, c| cols[c][r]);
+                let j = nalgebra::DMatrix::from_fn(3, m, |r, k| c[k][r]);
                 let b = nalgebra::DVector::from_column_slice(rhs.as_slice());
-                let x = j.clone().svd(true, true).solve(&b, 1e-12).ok()?;
+                let x = j.svd(true, true).solve(&b, 1e-12).ok()?;
                 let mut out = [0.0; 3];
                 out[..m].copy_from_slice(x.as_slice());
                 out
@@ -456,7 +510,7 @@ impl Kinematics {
         let mut moved = Vector3::zeros();
         for (k, &i) in self.free_lin.iter().enumerate() {
             q[i] = values[k];
-            moved += cols[k] * values[k];
+            moved += c[k] * values[k];
         }
         if m < 3 && (moved - rhs).norm() > 1e-9 * (1.0 + rhs.norm()) {
             return None;
@@ -567,15 +621,6 @@ fn has_equivalent(limits: Option<[f64; 2]>, principal: f64) -> bool {
 pub fn wrap180(deg: f64) -> f64 {
     let w = deg.rem_euclid(360.0);
     if w > 180.0 { w - 360.0 } else { w }
-}
-
-fn rotation_of(tool: &[Link], work: &[Link], index: usize, q: f64) -> Matrix3<f64> {
-    let l = tool
-        .iter()
-        .chain(work)
-        .find(|l| l.index == index)
-        .expect("every axis is in a chain");
-    rotation(&l.dir, rad(q))
 }
 
 /// Orthonormal frame (columns a, b', a×b') from a direction and a second,

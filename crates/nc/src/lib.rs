@@ -1,1 +1,226 @@
-pub mod placeholder {}
+//! NC dialects for kinpost: data-driven writers and readers of CNC programs.
+//!
+//! A [`Dialect`] is data, loaded from a TOML file (the built-in ones are
+//! embedded, see [`Dialect::builtin_names`]; the format is documented in
+//! `DIALECTS.md`). [`NcWriter`] writes a program in a dialect: header and
+//! footer templates, tool changes, comments and — on the hot path — motion
+//! blocks, formatted without allocation. [`read_program`] reads such a program
+//! back into blocks of axis values, for closed-loop checks and simulation.
+//!
+//! ```
+//! use kinpost_nc::{AxisSpec, Block, Dialect, Motion, NcWriter};
+//! let dialect = Dialect::builtin("sinumerik").unwrap();
+//! let axes = [AxisSpec::linear("X"), AxisSpec::rotary("A"), AxisSpec::linear("Y"),
+//!             AxisSpec::linear("Z"), AxisSpec::rotary("B"), AxisSpec::rotary("C").fixed()];
+//! let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+//! w.block(&Block { cl_line: Some(16), motion: Motion::Feed,
+//!                  axes: &[459.0, 0.0, 8.80694, 361.36839, 0.0, 0.0], feed: Some(250.0) }).unwrap();
+//! let text = String::from_utf8(w.finish().unwrap()).unwrap();
+//! assert_eq!(text, "X=459.000 Y=8.807 Z361.368 B0.000 A=DC(0.000) F250\n");
+//! ```
+
+use std::collections::BTreeMap;
+
+mod dialect;
+mod number;
+mod reader;
+mod template;
+mod writer;
+
+pub use dialect::{
+    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MotionWords, Numbering,
+    TemplateKind, WordFormat,
+};
+pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
+pub use minijinja::Value;
+pub use number::{MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
+pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
+pub use template::{TemplateError, check_template, template_span_in_toml};
+pub use writer::{NcWriter, Spindle};
+
+/// One machine axis as the writer and reader need it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AxisSpec {
+    /// Axis name as in the machine file (`X`, `A`, `H1`).
+    pub name: String,
+    /// Rotary (degrees) or linear (mm).
+    pub rotary: bool,
+    /// Locked by the machine (e.g. C in 5-axis mode).
+    pub fixed: bool,
+}
+
+impl AxisSpec {
+    /// A free linear axis.
+    pub fn linear(name: &str) -> AxisSpec {
+        AxisSpec {
+            name: name.to_string(),
+            rotary: false,
+            fixed: false,
+        }
+    }
+
+    /// A free rotary axis.
+    pub fn rotary(name: &str) -> AxisSpec {
+        AxisSpec {
+            name: name.to_string(),
+            rotary: true,
+            fixed: false,
+        }
+    }
+
+    /// The same axis, locked.
+    pub fn fixed(mut self) -> AxisSpec {
+        self.fixed = true;
+        self
+    }
+}
+
+/// How a block moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Motion {
+    /// Positioning at rapid traverse (`G0`).
+    Rapid,
+    /// Linear interpolation at the programmed feed (`G1`).
+    Feed,
+}
+
+impl Motion {
+    /// `rapid` or `feed` (the CSV spelling).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Motion::Rapid => "rapid",
+            Motion::Feed => "feed",
+        }
+    }
+}
+
+/// One motion block to write.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Block<'a> {
+    /// 1-based line of the CL record this block reaches; `None` for a block
+    /// the post inserted (retract, linearization).
+    pub cl_line: Option<usize>,
+    /// Rapid or feed.
+    pub motion: Motion,
+    /// NC values in machine order (one per axis given to [`NcWriter::new`]),
+    /// not yet rounded.
+    pub axes: &'a [f64],
+    /// Feed rate of a feed block (mm/min, or inverse time for a dialect with
+    /// `inverse_time`); ignored on rapid blocks. `None` keeps the last one.
+    pub feed: Option<f64>,
+}
+
+/// What the header and footer templates get to see.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ProgramInfo {
+    /// Program name (`program_name`).
+    pub program_name: String,
+    /// Date as the caller wants it printed (`date`); passed in so output is
+    /// deterministic.
+    pub date: String,
+    /// Machine name (`machine`).
+    pub machine: String,
+    /// Tool name (`tool`).
+    pub tool: String,
+    /// Tool number (`tool_number`), 0 when unknown.
+    pub tool_number: u32,
+    /// CL file the program was made from (`cl_file`).
+    pub cl_file: String,
+    /// Further variables: each is available by its own name (unless it
+    /// collides with a built-in one) and in the map `extra`.
+    pub extra: BTreeMap<String, String>,
+}
+
+impl ProgramInfo {
+    /// The template variables: `program_name`, `date`, `machine`, `tool`,
+    /// `tool_number`, `cl_file`, `dialect`, `axes` (list of names), `extra`
+    /// and every extra key.
+    pub fn template_vars(&self, dialect: &str, axes: &[AxisSpec]) -> BTreeMap<String, Value> {
+        let mut vars: BTreeMap<String, Value> = self
+            .extra
+            .iter()
+            .map(|(k, v)| (k.clone(), Value::from(v.as_str())))
+            .collect();
+        let mut put = |k: &str, v: Value| {
+            vars.insert(k.to_string(), v);
+        };
+        put("program_name", Value::from(self.program_name.as_str()));
+        put("date", Value::from(self.date.as_str()));
+        put("machine", Value::from(self.machine.as_str()));
+        put("tool", Value::from(self.tool.as_str()));
+        put("tool_number", Value::from(self.tool_number));
+        put("cl_file", Value::from(self.cl_file.as_str()));
+        put("dialect", Value::from(dialect));
+        put(
+            "axes",
+            Value::from(
+                axes.iter()
+                    .map(|a| Value::from(a.name.as_str()))
+                    .collect::<Vec<_>>(),
+            ),
+        );
+        put(
+            "extra",
+            Value::from(
+                self.extra
+                    .iter()
+                    .map(|(k, v)| (k.clone(), Value::from(v.as_str())))
+                    .collect::<BTreeMap<String, Value>>(),
+            ),
+        );
+        vars
+    }
+}
+
+/// Errors of the template-driven parts of the writer.
+#[derive(Debug)]
+pub enum NcError {
+    /// Writing failed.
+    Io(std::io::Error),
+    /// A template could not be compiled or rendered.
+    Template {
+        /// `header`, `footer`, `tool_change`, ... or `template` for an override.
+        template: String,
+        /// 1-based line in the template, when known.
+        line: Option<usize>,
+        /// Byte range in the template, when known.
+        range: Option<std::ops::Range<usize>>,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl std::fmt::Display for NcError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NcError::Io(e) => write!(f, "cannot write the NC program: {e}"),
+            NcError::Template {
+                template,
+                line,
+                message,
+                ..
+            } => {
+                write!(f, "template `{template}`")?;
+                if let Some(l) = line {
+                    write!(f, " line {l}")?;
+                }
+                write!(f, ": {message}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for NcError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            NcError::Io(e) => Some(e),
+            NcError::Template { .. } => None,
+        }
+    }
+}
+
+impl From<std::io::Error> for NcError {
+    fn from(e: std::io::Error) -> Self {
+        NcError::Io(e)
+    }
+}

@@ -1,0 +1,1048 @@
+//! The streaming CL reader.
+
+use std::io::BufRead;
+
+use kinpost_diag::{Diagnostic, Severity};
+
+use crate::number::{parse_number, scan_number};
+use crate::words::suggest;
+use crate::{ClEvent, FeedUnit, Motion, SpindleDir, Statement, Units, Vec3};
+
+/// A byte range in the logical statement text.
+type Span = (usize, usize);
+
+/// One physical line of the current logical statement.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    /// 1-based line number.
+    line: usize,
+    /// The line's text in `raw` (no line end, no byte-order mark).
+    raw_start: usize,
+    raw_end: usize,
+    /// The part of the line that went into `text` (always a prefix of the
+    /// line: only the line end, a `$$` comment, trailing blanks and the
+    /// continuation `$` are cut off).
+    text_start: usize,
+    text_end: usize,
+}
+
+/// What [`ClReader::read_statement`] found.
+enum Read {
+    /// End of input.
+    Eof,
+    /// A `$$` comment line.
+    Comment(usize, String),
+    /// A logical statement, now in `text` / `segments`.
+    Statement,
+}
+
+/// Streaming reader of NX CLSF / APT text: one [`Statement`] at a time.
+///
+/// The reader keeps the modal state of the CL file: the current tool axis and
+/// reference direction (a three-value `GOTO` repeats them), the one-shot
+/// `RAPID`, and the units (for `FEDRAT` without a unit). It allocates nothing
+/// per `GOTO` line: lines are read into a reused buffer and numbers are parsed
+/// in place.
+///
+/// **Errors** ([`Severity::Error`]) are returned by
+/// [`next_statement`](Self::next_statement) and mean the input cannot be
+/// posted as it is. The failed statement has no effect; the reader stays
+/// usable and the next call goes on with the following line (so a checker can
+/// list every error), except after an I/O error, after which it reports end
+/// of input.
+///
+/// **Warnings** (unknown statements, a cut-short `MSYS`, ignored cutter
+/// compensation, …) are collected in order and handed out, drained, by
+/// [`take_warnings`](Self::take_warnings).
+///
+/// The reader is also an [`Iterator`] over `Result<Statement, Diagnostic>`.
+pub struct ClReader<R> {
+    input: R,
+    file: String,
+    /// Physical lines of the current statement, back to back.
+    raw: Vec<u8>,
+    /// The logical statement: continuation lines joined, comments removed.
+    text: String,
+    segments: Vec<Segment>,
+    /// Comma-separated fields of the current statement's arguments.
+    fields: Vec<Span>,
+    /// Physical lines read so far.
+    line: usize,
+    /// Set after an I/O error.
+    finished: bool,
+    warnings: Vec<Diagnostic>,
+    axis: Option<Vec3>,
+    reference: Option<Vec3>,
+    rapid: bool,
+    units: Units,
+    spindle: Option<(f64, SpindleDir)>,
+}
+
+impl<R: BufRead> ClReader<R> {
+    /// A reader of `input`; `file_name` is used in diagnostics (`-` or
+    /// `<stdin>` for standard input).
+    pub fn new(input: R, file_name: impl Into<String>) -> Self {
+        ClReader {
+            input,
+            file: file_name.into(),
+            raw: Vec::with_capacity(256),
+            text: String::with_capacity(256),
+            segments: Vec::with_capacity(4),
+            fields: Vec::with_capacity(16),
+            line: 0,
+            finished: false,
+            warnings: Vec::new(),
+            axis: None,
+            reference: None,
+            rapid: false,
+            units: Units::Mm,
+            spindle: None,
+        }
+    }
+
+    /// Sets the tool axis used by three-value `GOTO`s until a six- or
+    /// nine-value `GOTO` gives one, for 3-axis APT files that never state it
+    /// (usually `[0.0, 0.0, 1.0]`). Without it, a `GOTO/x,y,z` before any
+    /// tool axis is known is an error. The vector is normalized.
+    ///
+    /// # Panics
+    ///
+    /// If `axis` is zero or not finite.
+    pub fn with_default_axis(mut self, axis: Vec3) -> Self {
+        let axis = normalize(axis).expect("default tool axis must be a finite, non-zero vector");
+        self.axis = Some(axis);
+        self
+    }
+
+    /// The file name given to [`new`](Self::new).
+    pub fn file_name(&self) -> &str {
+        &self.file
+    }
+
+    /// The current tool axis (unit length), if known.
+    pub fn tool_axis(&self) -> Option<Vec3> {
+        self.axis
+    }
+
+    /// The current units (`Mm` until a `UNITS` statement says otherwise).
+    pub fn units(&self) -> Units {
+        self.units
+    }
+
+    /// The number of physical lines read so far.
+    pub fn lines_read(&self) -> usize {
+        self.line
+    }
+
+    /// The warnings found since the last call, in input order; the reader's
+    /// list is emptied. Call it after each statement to interleave warnings
+    /// with the output, or once at the end.
+    pub fn take_warnings(&mut self) -> Vec<Diagnostic> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    /// A diagnostic about the statement last returned by
+    /// [`next_statement`](Self::next_statement), for problems found after
+    /// reading (a pose the machine cannot reach, a feed move without a feed
+    /// rate): placed on the statement's first line, underlining its text.
+    pub fn statement_diagnostic(
+        &self,
+        severity: Severity,
+        message: impl Into<String>,
+    ) -> Diagnostic {
+        let end = self.segments.last().map_or(0, |s| s.text_end);
+        let start = skip_blanks(self.text.as_bytes(), 0).min(end);
+        self.diag(severity, (start, end), message)
+    }
+
+    /// The next statement that means something; `Ok(None)` at the end of the
+    /// input. Blank lines and silently ignored statements (`RAPID`, which only
+    /// marks the next `GOTO`, `PAINT/…`, unknown statements, …) are skipped.
+    ///
+    /// An `Err` is an error diagnostic (never a warning): the input cannot be
+    /// posted as it is. See the type's documentation for what happens after.
+    pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
+        loop {
+            if self.finished {
+                return Ok(None);
+            }
+            match self.read_statement()? {
+                Read::Eof => return Ok(None),
+                Read::Comment(line, text) => {
+                    return Ok(Some(Statement {
+                        line,
+                        event: ClEvent::Comment(text),
+                    }));
+                }
+                Read::Statement => {
+                    if let Some(event) = self.interpret()? {
+                        let line = self.segments[0].line;
+                        return Ok(Some(Statement { line, event }));
+                    }
+                }
+            }
+        }
+    }
+
+    // ----- lines -----
+
+    /// Reads physical lines until a logical statement is complete.
+    #[inline(always)]
+    fn read_statement(&mut self) -> Result<Read, Diagnostic> {
+        self.raw.clear();
+        self.text.clear();
+        self.segments.clear();
+        loop {
+            let mut start = self.raw.len();
+            match self.input.read_until(b'\n', &mut self.raw) {
+                Ok(0) => {
+                    let Some(last) = self.segments.last() else {
+                        return Ok(Read::Eof);
+                    };
+                    // Point at the `$` that promised a continuation.
+                    let at = last.text_end;
+                    return Err(self.diag(
+                        Severity::Error,
+                        (at, at + 1),
+                        "the statement continues (`$`) past the end of the file",
+                    ));
+                }
+                Ok(_) => {}
+                Err(e) => {
+                    self.finished = true;
+                    return Err(Diagnostic::error(
+                        &self.file,
+                        self.line + 1,
+                        0,
+                        0,
+                        "",
+                        format!("cannot read the file: {e}"),
+                    ));
+                }
+            }
+            self.line += 1;
+            let mut end = self.raw.len();
+            if self.raw[end - 1] == b'\n' {
+                end -= 1;
+            }
+            if end > start && self.raw[end - 1] == b'\r' {
+                end -= 1;
+            }
+            self.raw.truncate(end);
+            if self.line == 1 && self.raw.starts_with(b"\xEF\xBB\xBF") {
+                start += 3;
+            }
+            let line = match std::str::from_utf8(&self.raw[start..end]) {
+                Ok(line) => line,
+                Err(e) => return Err(self.invalid_utf8(start, end, e)),
+            };
+            let mut body = line;
+            if line.as_bytes().contains(&b'$')
+                && let Some(p) = line.find("$$")
+            {
+                if line[..p].trim().is_empty() {
+                    if self.segments.is_empty() {
+                        let comment = line[p + 2..].trim().to_string();
+                        return Ok(Read::Comment(self.line, comment));
+                    }
+                    // A comment line inside a continued statement.
+                    self.raw.truncate(start);
+                    continue;
+                }
+                body = &line[..p];
+            }
+            let body = body.trim_end();
+            let (body, continued) = match body.strip_suffix('$') {
+                Some(body) => (body, true),
+                None => (body, false),
+            };
+            let text_start = self.text.len();
+            self.text.push_str(body);
+            self.segments.push(Segment {
+                line: self.line,
+                raw_start: start,
+                raw_end: end,
+                text_start,
+                text_end: self.text.len(),
+            });
+            if !continued {
+                return Ok(Read::Statement);
+            }
+        }
+    }
+
+    fn invalid_utf8(&self, start: usize, end: usize, e: std::str::Utf8Error) -> Diagnostic {
+        let bytes = &self.raw[start..end];
+        let valid = e.valid_up_to();
+        let column = String::from_utf8_lossy(&bytes[..valid]).chars().count() + 1;
+        Diagnostic::error(
+            &self.file,
+            self.line,
+            column,
+            1,
+            String::from_utf8_lossy(bytes),
+            format!(
+                "invalid UTF-8 (byte 0x{:02X}); CL files must be UTF-8 text (convert it, e.g. with `iconv -f GBK -t UTF-8`)",
+                bytes[valid]
+            ),
+        )
+    }
+
+    // ----- diagnostics -----
+
+    /// A diagnostic about `span` of the logical text, placed on the physical
+    /// line that holds the start of the span.
+    fn diag(&self, severity: Severity, span: Span, message: impl Into<String>) -> Diagnostic {
+        let index = self
+            .segments
+            .iter()
+            .position(|s| span.0 < s.text_end)
+            .unwrap_or(self.segments.len().saturating_sub(1));
+        let Some(seg) = self.segments.get(index) else {
+            return make(severity, &self.file, self.line, 0, 0, "", message);
+        };
+        // Spans end at the statement's end.
+        let end = self.segments.last().map_or(0, |s| s.text_end);
+        let span = (span.0.min(end), span.1.min(end));
+        let raw = String::from_utf8_lossy(&self.raw[seg.raw_start..seg.raw_end]);
+        let from = floor_char_boundary(&raw, span.0.saturating_sub(seg.text_start));
+        let to = span.1.min(seg.text_end).saturating_sub(seg.text_start);
+        let to = floor_char_boundary(&raw, to.max(from));
+        let column = raw[..from].chars().count() + 1;
+        let width = raw[from..to].chars().count();
+        make(severity, &self.file, seg.line, column, width, raw, message)
+    }
+
+    fn error(&self, span: Span, message: impl Into<String>) -> Diagnostic {
+        self.diag(Severity::Error, span, message)
+    }
+
+    fn warn(&mut self, span: Span, message: impl Into<String>) {
+        let d = self.diag(Severity::Warning, span, message);
+        self.warnings.push(d);
+    }
+
+    // ----- statements -----
+
+    /// Interprets the logical statement in `text`.
+    #[inline(always)]
+    fn interpret(&mut self) -> Result<Option<ClEvent>, Diagnostic> {
+        let b = self.text.as_bytes();
+        let start = skip_blanks(b, 0);
+        if start == b.len() {
+            return Ok(None);
+        }
+        let mut word_end = start;
+        while word_end < b.len() && is_word_byte(b[word_end]) {
+            word_end += 1;
+        }
+        if word_end - start >= 4 && b[start..start + 4].eq_ignore_ascii_case(b"CSI_") {
+            return Ok(None); // CAMWorks display / tool-library records
+        }
+        let mut key = [0u8; 12];
+        let n = word_end - start;
+        let key: &[u8] = if n <= key.len() {
+            for (k, &c) in key.iter_mut().zip(&b[start..word_end]) {
+                *k = c.to_ascii_uppercase();
+            }
+            &key[..n]
+        } else {
+            b""
+        };
+        let mut word: Span = (start, word_end);
+        let mut tool_path = false;
+        if key == b"TOOL" {
+            let p = skip_blanks(b, word_end);
+            if p > word_end
+                && b.len() >= p + 4
+                && b[p..p + 4].eq_ignore_ascii_case(b"PATH")
+                && b.get(p + 4).is_none_or(|&c| !is_word_byte(c))
+            {
+                word.1 = p + 4;
+                tool_path = true;
+            }
+        }
+        let after = skip_blanks(b, word.1);
+        let slash = after < b.len() && b[after] == b'/';
+        let args: Span = (if slash { after + 1 } else { after }, b.len());
+        let has_args = skip_blanks(b, args.0) < args.1;
+
+        if tool_path {
+            return self.tool_path(args).map(Some);
+        }
+        // Statements that take arguments after a slash.
+        let needs_slash = matches!(
+            key,
+            b"GOTO"
+                | b"FEDRAT"
+                | b"TLDATA"
+                | b"CUTTER"
+                | b"MSYS"
+                | b"LOAD"
+                | b"SELECT"
+                | b"SPINDL"
+                | b"COOLNT"
+                | b"UNITS"
+                | b"UNIT"
+                | b"PRESSURE"
+                | b"CSYS"
+                | b"MULTAX"
+        );
+        if needs_slash && !slash && has_args {
+            let name = self.text[word.0..word.1].to_ascii_uppercase();
+            return Err(self.error((after, after + 1), format!("expected `/` after `{name}`")));
+        }
+        match key {
+            b"GOTO" => self.goto(args).map(Some),
+            b"RAPID" => {
+                self.rapid = true;
+                Ok(None)
+            }
+            b"FEDRAT" => self.fedrat(args).map(Some),
+            b"TLDATA" => self.tool_data(args, false).map(Some),
+            b"CUTTER" => self.tool_data(args, true).map(Some),
+            b"MSYS" => self.msys(args),
+            b"LOAD" => Ok(Some(ClEvent::LoadTool {
+                number: self.tool_number("LOAD", word, args)?,
+            })),
+            b"SELECT" => Ok(Some(ClEvent::SelectTool {
+                number: self.tool_number("SELECT", word, args)?,
+            })),
+            b"SPINDL" => self.spindle(args).map(Some),
+            b"COOLNT" => self.coolant(args).map(Some),
+            b"INSERT" => Ok(Some(ClEvent::Insert(
+                self.text[args.0..].trim_end().to_string(),
+            ))),
+            b"PPRINT" => Ok(Some(ClEvent::Comment(
+                self.text[args.0..].trim().to_string(),
+            ))),
+            b"END-OF-PATH" => Ok(Some(ClEvent::EndOfPath)),
+            b"PARTNO" => Ok(Some(ClEvent::PartNo(
+                self.text[args.0..].trim().to_string(),
+            ))),
+            b"UNITS" | b"UNIT" => self.units_statement(word, args).map(Some),
+            b"MULTAX" => self.multax(args).map(Some),
+            b"PRESSURE" => self.pressure(word, args).map(Some),
+            b"FINI" => Ok(Some(ClEvent::Fini)),
+            b"PAINT" | b"TRNTYP" => Ok(None),
+            b"CSYS" => self.csys(word, args),
+            b"CUTCOM" => {
+                self.split(args);
+                let off = self.fields.first().is_some_and(|&f| self.is(f, "OFF"));
+                if !off {
+                    self.warn(
+                        (word.0, args.1),
+                        "cutter compensation ignored: the GOTO points are used as tool positions",
+                    );
+                }
+                Ok(None)
+            }
+            b"CIRCLE" => Err(self.error(
+                word,
+                "CIRCLE is not supported yet; have the CAM system output arcs as GOTO points (linearized)",
+            )),
+            b"NURBS" => Err(self.error(
+                word,
+                "NURBS is not supported yet; have the CAM system output GOTO points instead",
+            )),
+            b"CYCLE" => {
+                self.split(args);
+                if self.fields.len() == 1 && self.is(self.fields[0], "OFF") {
+                    return Ok(None);
+                }
+                Err(self.error(
+                    word,
+                    "CYCLE is not supported yet; have the CAM system output canned cycles as GOTO moves",
+                ))
+            }
+            _ => {
+                self.unknown(word);
+                Ok(None)
+            }
+        }
+    }
+
+    fn unknown(&mut self, word: Span) {
+        let mut word = word;
+        if word.0 == word.1 {
+            // Not a word at all: show the token up to a blank or a slash.
+            let b = self.text.as_bytes();
+            let mut end = word.0;
+            while end < b.len() && !b[end].is_ascii_whitespace() && b[end] != b'/' {
+                end += 1;
+            }
+            if end == word.0 {
+                end += 1;
+            }
+            word.1 = floor_char_boundary(&self.text, end.min(b.len()));
+            if word.1 == word.0 {
+                word.1 = self.text[word.0..]
+                    .chars()
+                    .next()
+                    .map_or(word.0, |c| word.0 + c.len_utf8());
+            }
+        }
+        let text = &self.text[word.0..word.1];
+        let message = match suggest(text) {
+            Some(known) => format!("unknown statement `{text}` (did you mean `{known}`?) ignored"),
+            None => format!("unknown statement `{text}` ignored"),
+        };
+        self.warn(word, message);
+    }
+
+    /// Parses the values of a `GOTO` in one pass, without splitting into
+    /// fields first. `None` if a field is not a plain number: the caller then
+    /// takes the slow path, which finds the field and reports it.
+    #[inline(always)]
+    fn goto_values(&self, args: Span, v: &mut [f64; 9]) -> Option<usize> {
+        let b = &self.text.as_bytes()[..args.1];
+        let mut i = skip_blanks(b, args.0);
+        if i == b.len() {
+            return Some(0);
+        }
+        let mut count = 0;
+        loop {
+            let (x, end) = scan_number(b, i)?;
+            if let Some(slot) = v.get_mut(count) {
+                *slot = x;
+            }
+            count += 1;
+            let k = match b.get(end) {
+                Some(b',') => end,
+                _ => skip_blanks(b, end),
+            };
+            match b.get(k) {
+                None => return Some(count),
+                Some(b',') => i = skip_blanks(b, k + 1),
+                Some(_) => return None,
+            }
+            if i == b.len() {
+                return None; // trailing empty field
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn goto(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        let mut v = [0.0; 9];
+        let count = match self.goto_values(args, &mut v) {
+            Some(count) => count,
+            None => {
+                self.split(args);
+                for (value, &field) in v.iter_mut().zip(&self.fields) {
+                    *value = self.number(field)?;
+                }
+                self.fields.len()
+            }
+        };
+        if !matches!(count, 3 | 6 | 9) {
+            self.split(args);
+            let extra = match count {
+                0..=2 => args,
+                4 | 5 => (self.fields[3].0, args.1),
+                7 | 8 => (self.fields[6].0, args.1),
+                _ => (self.fields[9].0, args.1),
+            };
+            return Err(self.error(
+                extra,
+                format!(
+                    "GOTO has {count} value{}, expected 3 (x,y,z), 6 (x,y,z,i,j,k) or 9 (x,y,z,i,j,k,u,v,w)",
+                    if count == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        let point = [v[0], v[1], v[2]];
+        let axis = if count >= 6 {
+            match normalize([v[3], v[4], v[5]]) {
+                Some(axis) => axis,
+                None => {
+                    self.split(args);
+                    return Err(self.error(
+                        (self.fields[3].0, self.fields[5].1),
+                        "the tool axis (i,j,k) is zero or not finite",
+                    ));
+                }
+            }
+        } else {
+            match self.axis {
+                Some(axis) => axis,
+                None => {
+                    self.split(args);
+                    return Err(self.error(
+                        (self.fields[0].0, self.fields[2].1),
+                        "GOTO/x,y,z before any tool axis is known: give the first GOTO as x,y,z,i,j,k (or set a default tool axis for a 3-axis file)",
+                    ));
+                }
+            }
+        };
+        let reference = if count == 9 {
+            let r = normalize([v[6], v[7], v[8]]);
+            let problem = match r {
+                None => Some("the reference direction (u,v,w) is zero or not finite"),
+                Some(r) => {
+                    let c = cross(axis, r);
+                    ((c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() < 1e-9)
+                        .then_some("the reference direction (u,v,w) is parallel to the tool axis")
+                }
+            };
+            if let Some(message) = problem {
+                self.split(args);
+                return Err(self.error((self.fields[6].0, self.fields[8].1), message));
+            }
+            r
+        } else {
+            self.reference
+        };
+        self.axis = Some(axis);
+        self.reference = reference;
+        let motion = if std::mem::take(&mut self.rapid) {
+            Motion::Rapid
+        } else {
+            Motion::Feed
+        };
+        Ok(ClEvent::Goto {
+            point,
+            axis,
+            reference,
+            motion,
+        })
+    }
+
+    fn fedrat(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let mut value: Option<(f64, Span)> = None;
+        let mut unit: Option<FeedUnit> = None;
+        for k in 0..self.fields.len() {
+            let f = self.fields[k];
+            if self.is_word(f) {
+                let u = match self.field(f).to_ascii_uppercase().as_str() {
+                    "MMPM" => FeedUnit::Mmpm,
+                    "IPM" => FeedUnit::Ipm,
+                    "MMPR" => FeedUnit::Mmpr,
+                    "IPR" => FeedUnit::Ipr,
+                    other => {
+                        return Err(self.error(
+                            f,
+                            format!("unknown feed unit `{other}`; expected MMPM, IPM, MMPR or IPR"),
+                        ));
+                    }
+                };
+                if unit.is_some() {
+                    return Err(self.error(f, "FEDRAT has two units"));
+                }
+                unit = Some(u);
+            } else {
+                if value.is_some() {
+                    return Err(self.error(f, "FEDRAT has two feed values"));
+                }
+                value = Some((self.number(f)?, f));
+            }
+        }
+        let Some((value, span)) = value else {
+            return Err(self.error(args, "FEDRAT without a feed value"));
+        };
+        if value <= 0.0 {
+            return Err(self.error(
+                span,
+                format!("the feed rate must be positive, got `{}`", self.field(span)),
+            ));
+        }
+        let unit = unit.unwrap_or(match self.units {
+            Units::Mm => FeedUnit::Mmpm,
+            Units::Inch => FeedUnit::Ipm,
+        });
+        Ok(ClEvent::Feedrate { value, unit })
+    }
+
+    fn tool_path(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let mut fields = self.fields.iter().map(|&f| self.field(f).to_string());
+        let name = fields.next().unwrap_or_default();
+        let words = fields.collect();
+        Ok(ClEvent::ToolPath { name, words })
+    }
+
+    fn tool_data(&mut self, args: Span, cutter: bool) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let mut first = 0;
+        let kind = if cutter {
+            "CUTTER".to_string()
+        } else if let Some(&f) = self.fields.first().filter(|&&f| self.is_word(f)) {
+            first = 1;
+            self.field(f).to_string()
+        } else {
+            String::new()
+        };
+        let mut values = Vec::with_capacity(self.fields.len());
+        for k in first..self.fields.len() {
+            values.push(self.number(self.fields[k])?);
+        }
+        Ok(ClEvent::ToolData { kind, values })
+    }
+
+    fn msys(&mut self, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
+        self.split(args);
+        let mut count = self.fields.len();
+        // A record cut short often keeps its trailing comma.
+        if count > 1 && self.fields[count - 1].0 == self.fields[count - 1].1 {
+            count -= 1;
+        }
+        let mut v = [0.0; 9];
+        for (k, value) in v.iter_mut().enumerate().take(count) {
+            *value = self.number(self.fields[k])?;
+        }
+        if count < 3 {
+            return Err(self.error(args, "MSYS needs at least the origin x,y,z"));
+        }
+        let origin = [v[0], v[1], v[2]];
+        let x = (count >= 6).then_some([v[3], v[4], v[5]]);
+        let y = (count >= 9).then_some([v[6], v[7], v[8]]);
+        if count != 3 && count != 9 {
+            let detail = match count {
+                4 | 5 => "only the origin is used",
+                6..=8 => {
+                    "the line looks cut short: the origin and the X axis are used, the Y axis is missing"
+                }
+                _ => "the values after the ninth are ignored",
+            };
+            self.warn(
+                args,
+                format!("MSYS has {count} values, expected 3 or 9; {detail}"),
+            );
+        }
+        Ok(Some(ClEvent::MachineSystem { origin, x, y }))
+    }
+
+    fn tool_number(&mut self, name: &str, word: Span, args: Span) -> Result<u32, Diagnostic> {
+        self.split(args);
+        let usage = format!("expected `{name}/TOOL,n`");
+        let Some(&first) = self.fields.first() else {
+            return Err(self.error(word, usage));
+        };
+        if !self.is(first, "TOOL") {
+            return Err(self.error(first, usage));
+        }
+        let Some(&f) = self.fields.get(1) else {
+            return Err(self.error(
+                (first.1, first.1),
+                format!("{usage}: the tool number is missing"),
+            ));
+        };
+        let n = self.number(f)?;
+        if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
+            return Err(self.error(
+                f,
+                format!(
+                    "the tool number must be a whole number from 0 to {}, got `{}`",
+                    u32::MAX,
+                    self.field(f)
+                ),
+            ));
+        }
+        if self.fields.len() > 2 {
+            let rest = (self.fields[2].0, args.1);
+            let text = self.text[rest.0..rest.1].trim().to_string();
+            self.warn(rest, format!("`{text}` after the tool number ignored"));
+        }
+        Ok(n as u32)
+    }
+
+    fn spindle(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let mut rpm: Option<(f64, Span)> = None;
+        let mut dir: Option<SpindleDir> = None;
+        for k in 0..self.fields.len() {
+            let f = self.fields[k];
+            if self.is_word(f) {
+                match self.field(f).to_ascii_uppercase().as_str() {
+                    "OFF" => return Ok(ClEvent::SpindleOff),
+                    "ON" | "RPM" => {}
+                    "CLW" => dir = Some(SpindleDir::Clockwise),
+                    "CCLW" => dir = Some(SpindleDir::CounterClockwise),
+                    "SFM" | "SMM" => {
+                        return Err(self.error(
+                            f,
+                            "constant surface speed (SFM/SMM) is not supported; give the speed in RPM",
+                        ));
+                    }
+                    _ => {
+                        let text = self.field(f).to_string();
+                        self.warn(f, format!("`{text}` in SPINDL ignored"));
+                    }
+                }
+            } else if rpm.is_none() {
+                rpm = Some((self.number(f)?, f));
+            } else {
+                let text = self.field(f).to_string();
+                self.warn(f, format!("`{text}` in SPINDL ignored"));
+            }
+        }
+        let (rpm, dir) = match rpm {
+            Some((value, span)) => {
+                if value <= 0.0 {
+                    return Err(self.error(
+                        span,
+                        format!(
+                            "the spindle speed must be positive, got `{}` (use SPINDL/OFF to stop it)",
+                            self.field(span)
+                        ),
+                    ));
+                }
+                (value, dir.unwrap_or(SpindleDir::Clockwise))
+            }
+            None => match self.spindle {
+                Some((value, last)) => (value, dir.unwrap_or(last)),
+                None => {
+                    return Err(self.error(
+                        args,
+                        "SPINDL without a speed, and no earlier speed to restart",
+                    ));
+                }
+            },
+        };
+        self.spindle = Some((rpm, dir));
+        Ok(ClEvent::Spindle { rpm, dir })
+    }
+
+    fn coolant(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let Some(&first) = self.fields.first() else {
+            return Ok(ClEvent::Coolant {
+                on: true,
+                mode: "ON".to_string(),
+            });
+        };
+        let on = !self.fields.iter().any(|&f| self.is(f, "OFF"));
+        Ok(ClEvent::Coolant {
+            on,
+            mode: self.field(first).to_ascii_uppercase(),
+        })
+    }
+
+    fn units_statement(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let units = match self.fields.as_slice() {
+            [f] => match self.field(*f).to_ascii_uppercase().as_str() {
+                "MM" | "MILLIMETERS" | "MILLIMETRES" => Units::Mm,
+                "IN" | "INCH" | "INCHES" => Units::Inch,
+                _ => {
+                    return Err(self.error(
+                        *f,
+                        format!("unknown units `{}`; expected MM or INCHES", self.field(*f)),
+                    ));
+                }
+            },
+            [] => return Err(self.error(word, "expected `UNITS/MM` or `UNITS/INCHES`")),
+            [_, second, ..] => {
+                return Err(self.error((second.0, args.1), "expected `UNITS/MM` or `UNITS/INCHES`"));
+            }
+        };
+        self.units = units;
+        Ok(ClEvent::Units(units))
+    }
+
+    fn multax(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        match self.fields.as_slice() {
+            [] => Ok(ClEvent::Multax(true)),
+            [f] if self.is(*f, "ON") => Ok(ClEvent::Multax(true)),
+            [f] if self.is(*f, "OFF") => Ok(ClEvent::Multax(false)),
+            _ => Err(self.error(args, "expected `MULTAX`, `MULTAX/ON` or `MULTAX/OFF`")),
+        }
+    }
+
+    fn pressure(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let (name, f) = match self.fields.as_slice() {
+            [f] => (None, *f),
+            [w, f] if self.is_word(*w) => (Some(self.field(*w).to_string()), *f),
+            [] => return Err(self.error(word, "expected `PRESSURE/[word,]value`")),
+            _ => return Err(self.error(args, "expected `PRESSURE/[word,]value`")),
+        };
+        let value = self.number(f)?;
+        if value < 0.0 {
+            return Err(self.error(
+                f,
+                format!("the pressure must not be negative, got `{}`", self.field(f)),
+            ));
+        }
+        Ok(ClEvent::Pressure { word: name, value })
+    }
+
+    /// `CSYS/` with the identity matrix is a no-op; any other matrix would
+    /// have to transform the following GOTOs, which is not supported.
+    fn csys(&mut self, word: Span, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
+        self.split(args);
+        if self.fields.len() != 12 {
+            return Err(self.error(
+                if self.fields.is_empty() { word } else { args },
+                format!(
+                    "CSYS has {} values, expected 12 (a 3x4 matrix)",
+                    self.fields.len()
+                ),
+            ));
+        }
+        const IDENTITY: [f64; 12] = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
+        for (k, expected) in IDENTITY.iter().enumerate() {
+            if (self.number(self.fields[k])? - expected).abs() > 1e-9 {
+                return Err(self.error(
+                    args,
+                    "CSYS with a non-identity matrix is not supported yet (the following GOTOs would have to be transformed); output the tool path in one coordinate system",
+                ));
+            }
+        }
+        Ok(None)
+    }
+
+    // ----- fields -----
+
+    /// Splits `args` at commas into trimmed fields (`self.fields`). Blank
+    /// arguments give no field; an empty field between commas is a
+    /// zero-width span at its comma (or at the end).
+    fn split(&mut self, args: Span) {
+        self.fields.clear();
+        let b = self.text.as_bytes();
+        let (mut s, end) = args;
+        if skip_blanks(b, s) >= end {
+            return;
+        }
+        loop {
+            let e = b[s..end]
+                .iter()
+                .position(|&c| c == b',')
+                .map_or(end, |p| s + p);
+            let mut ts = s;
+            let mut te = e;
+            while ts < te && b[ts].is_ascii_whitespace() {
+                ts += 1;
+            }
+            while te > ts && b[te - 1].is_ascii_whitespace() {
+                te -= 1;
+            }
+            self.fields.push((ts, te));
+            if e == end {
+                break;
+            }
+            s = e + 1;
+        }
+    }
+
+    fn field(&self, f: Span) -> &str {
+        &self.text[f.0..f.1]
+    }
+
+    /// Whether field `f` is `keyword` (case-insensitive).
+    fn is(&self, f: Span, keyword: &str) -> bool {
+        self.field(f).eq_ignore_ascii_case(keyword)
+    }
+
+    /// Whether field `f` is a word rather than a number.
+    fn is_word(&self, f: Span) -> bool {
+        self.text.as_bytes()[f.0..f.1]
+            .first()
+            .is_some_and(|c| c.is_ascii_alphabetic())
+    }
+
+    fn number(&self, f: Span) -> Result<f64, Diagnostic> {
+        let text = self.field(f);
+        if let Some(v) = parse_number(text) {
+            return Ok(v);
+        }
+        let message = if text.is_empty() {
+            "empty field: expected a number".to_string()
+        } else if text
+            .bytes()
+            .all(|c| c.is_ascii_digit() || matches!(c, b'.' | b'+' | b'-' | b'e' | b'E'))
+            && text.parse::<f64>().is_ok_and(f64::is_infinite)
+        {
+            format!("number `{text}` is out of range")
+        } else {
+            format!("malformed number `{text}`")
+        };
+        Err(self.error(f, message))
+    }
+}
+
+impl<R: BufRead> Iterator for ClReader<R> {
+    type Item = Result<Statement, Diagnostic>;
+
+    /// Same as [`ClReader::next_statement`], transposed.
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_statement().transpose()
+    }
+}
+
+impl<R> std::fmt::Debug for ClReader<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClReader")
+            .field("file", &self.file)
+            .field("line", &self.line)
+            .field("axis", &self.axis)
+            .field("reference", &self.reference)
+            .field("rapid", &self.rapid)
+            .field("units", &self.units)
+            .finish_non_exhaustive()
+    }
+}
+
+fn make(
+    severity: Severity,
+    file: &str,
+    line: usize,
+    column: usize,
+    width: usize,
+    source_line: impl Into<String>,
+    message: impl Into<String>,
+) -> Diagnostic {
+    match severity {
+        Severity::Error => Diagnostic::error(file, line, column, width, source_line, message),
+        Severity::Warning => Diagnostic::warning(file, line, column, width, source_line, message),
+    }
+}
+
+fn is_word_byte(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_' || c == b'-'
+}
+
+#[inline(always)]
+fn skip_blanks(b: &[u8], mut i: usize) -> usize {
+    while let Some(&c) = b.get(i) {
+        // One comparison for the common case of a printable byte.
+        if c > b' ' || !c.is_ascii_whitespace() {
+            break;
+        }
+        i += 1;
+    }
+    i
+}
+
+fn floor_char_boundary(s: &str, i: usize) -> usize {
+    let mut i = i.min(s.len());
+    while !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
+fn normalize(v: Vec3) -> Option<Vec3> {
+    if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] == 1.0 {
+        return Some(v); // already unit length, e.g. 0,0,1
+    }
+    // Scale first so that huge or tiny components neither overflow nor vanish.
+    let m = v[0].abs().max(v[1].abs()).max(v[2].abs());
+    if !(m.is_finite() && m > 1e-300) {
+        return None;
+    }
+    let s = [v[0] / m, v[1] / m, v[2] / m];
+    let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+    Some([s[0] / n, s[1] / n, s[2] / n])
+}
+
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}

@@ -1,0 +1,500 @@
+//! Unit tests, one or more per statement kind.
+
+use super::*;
+
+fn read(cl: &str) -> (Vec<Statement>, Vec<Diagnostic>) {
+    let mut r = ClReader::new(cl.as_bytes(), "t.cls");
+    let mut out = Vec::new();
+    while let Some(s) = r.next_statement().unwrap_or_else(|e| panic!("{e}")) {
+        out.push(s);
+    }
+    (out, r.take_warnings())
+}
+
+fn events(cl: &str) -> Vec<ClEvent> {
+    let (s, w) = read(cl);
+    assert!(w.is_empty(), "unexpected warnings: {w:?}");
+    s.into_iter().map(|s| s.event).collect()
+}
+
+fn one(cl: &str) -> ClEvent {
+    let mut e = events(cl);
+    assert_eq!(e.len(), 1, "{e:?}");
+    e.pop().unwrap()
+}
+
+fn error(cl: &str) -> Diagnostic {
+    let mut r = ClReader::new(cl.as_bytes(), "t.cls").with_default_axis([0.0, 0.0, 1.0]);
+    loop {
+        match r.next_statement() {
+            Ok(Some(_)) => {}
+            Ok(None) => panic!("no error in {cl:?}"),
+            Err(e) => {
+                assert_eq!(e.severity, Severity::Error);
+                return e;
+            }
+        }
+    }
+}
+
+fn goto(point: Vec3, axis: Vec3, motion: Motion) -> ClEvent {
+    ClEvent::Goto {
+        point,
+        axis,
+        reference: None,
+        motion,
+    }
+}
+
+#[test]
+fn goto_rapid_is_one_shot_and_axis_is_modal() {
+    let e = events("RAPID\nGOTO/1,2,3,0,0,2\nGOTO/4,5,6\nRAPID/\nGOTO/7,8,9\nGOTO/1,1,1,0,3,4\n");
+    assert_eq!(
+        e,
+        vec![
+            goto([1., 2., 3.], [0., 0., 1.], Motion::Rapid),
+            goto([4., 5., 6.], [0., 0., 1.], Motion::Feed),
+            goto([7., 8., 9.], [0., 0., 1.], Motion::Rapid),
+            goto([1., 1., 1.], [0., 0.6, 0.8], Motion::Feed),
+        ]
+    );
+}
+
+#[test]
+fn goto_nine_values_sets_reference() {
+    let e = events("GOTO/1,2,3,0,0,1,2,0,0\nGOTO/1,2,4\nGOTO/1,2,5,0,1,0\n");
+    let refs: Vec<_> = e
+        .iter()
+        .map(|e| match e {
+            ClEvent::Goto { reference, .. } => *reference,
+            _ => panic!(),
+        })
+        .collect();
+    assert_eq!(refs, vec![Some([1., 0., 0.]); 3]);
+}
+
+#[test]
+fn goto_errors() {
+    let e = error("GOTO/1,2,3,0,0,0\n");
+    assert_eq!((e.line, e.column, e.width), (1, 12, 5));
+    assert!(e.message.contains("tool axis"), "{}", e.message);
+    let e = error("GOTO/1,2,3,0,0,1,1,0,0\nGOTO/1,2,3,0,0,1,0,0,2\n");
+    assert_eq!((e.line, e.column, e.width), (2, 18, 5));
+    assert!(e.message.contains("parallel"), "{}", e.message);
+    let e = error("GOTO/1,2,3,0,0,1,0,0,0\n");
+    assert!(e.message.contains("reference"), "{}", e.message);
+    let e = error("GOTO/1,2,3,4\n");
+    assert_eq!((e.column, e.width), (12, 1));
+    assert!(e.message.starts_with("GOTO has 4 values"), "{}", e.message);
+    let e = error("GOTO/1,2\n");
+    assert!(e.message.starts_with("GOTO has 2 values"), "{}", e.message);
+    let e = error("GOTO\n");
+    assert!(e.message.starts_with("GOTO has 0 values"), "{}", e.message);
+    let e = error("GOTO 1,2,3\n");
+    assert_eq!(e.message, "expected `/` after `GOTO`");
+    let e = error("GOTO/1,2,3,0,0,1,0,0,1,5\n");
+    assert_eq!(e.column, 24);
+    let e = error("GOTO/1,2,3,0,0,1e999\n");
+    assert_eq!(e.message, "number `1e999` is out of range");
+}
+
+#[test]
+fn goto_without_axis_needs_a_default() {
+    let mut r = ClReader::new("GOTO/1,2,3\n".as_bytes(), "t.cls");
+    let e = r.next_statement().unwrap_err();
+    assert_eq!((e.line, e.column, e.width), (1, 6, 5));
+    let mut r = ClReader::new("GOTO/1,2,3\n".as_bytes(), "t.cls").with_default_axis([0., 0., 5.]);
+    assert_eq!(r.tool_axis(), Some([0., 0., 1.]));
+    assert_eq!(
+        r.next_statement().unwrap().unwrap().event,
+        goto([1., 2., 3.], [0., 0., 1.], Motion::Feed)
+    );
+}
+
+#[test]
+fn malformed_numbers_point_at_the_field() {
+    let e = error("GOTO/1.2.3,4,5\n");
+    assert_eq!(
+        e.to_string(),
+        "error: malformed number `1.2.3`\n --> t.cls:1:6\n  |\n1 | GOTO/1.2.3,4,5\n  |      ^^^^^"
+    );
+    let e = error("GOTO / 1, abc , 3\n");
+    assert_eq!((e.column, e.width), (11, 3));
+    let e = error("GOTO/1,,3\n");
+    assert_eq!((e.column, e.width), (8, 1));
+    assert_eq!(e.message, "empty field: expected a number");
+    let e = error("GOTO/1,2,\n");
+    assert_eq!((e.column, e.width), (10, 1));
+}
+
+#[test]
+fn apt_numbers() {
+    assert_eq!(
+        one("GOTO/94.0375,.9625,-3.,0,0,1E0\n"),
+        goto([94.0375, 0.9625, -3.0], [0., 0., 1.], Motion::Feed)
+    );
+}
+
+#[test]
+fn catia_spacing_and_case() {
+    let e = events("multax\n  goto / 1 , 2 ,3, 0 , 0 , 1\nFedRat /  250 ,  mmpm\nFINI\n");
+    assert_eq!(
+        e,
+        vec![
+            ClEvent::Multax(true),
+            goto([1., 2., 3.], [0., 0., 1.], Motion::Feed),
+            ClEvent::Feedrate {
+                value: 250.0,
+                unit: FeedUnit::Mmpm
+            },
+            ClEvent::Fini,
+        ]
+    );
+}
+
+#[test]
+fn fedrat_both_orders_and_units() {
+    let f = |value, unit| ClEvent::Feedrate { value, unit };
+    assert_eq!(
+        events(
+            "FEDRAT/MMPM,250.0000\nFEDRAT/ 250, MMPM\nFEDRAT/ipm,10\nFEDRAT/0.1,MMPR\nFEDRAT/IPR,.01\nFEDRAT/300\nUNITS/INCHES\nFEDRAT/20\n"
+        ),
+        vec![
+            f(250.0, FeedUnit::Mmpm),
+            f(250.0, FeedUnit::Mmpm),
+            f(10.0, FeedUnit::Ipm),
+            f(0.1, FeedUnit::Mmpr),
+            f(0.01, FeedUnit::Ipr),
+            f(300.0, FeedUnit::Mmpm),
+            ClEvent::Units(Units::Inch),
+            f(20.0, FeedUnit::Ipm),
+        ]
+    );
+    assert!(error("FEDRAT/MMPM,0\n").message.contains("positive"));
+    let e = error("FEDRAT/-5,MMPM\n");
+    assert_eq!((e.column, e.width), (8, 2));
+    assert!(
+        error("FEDRAT/INVERS,5\n")
+            .message
+            .contains("unknown feed unit `INVERS`")
+    );
+    assert!(
+        error("FEDRAT/MMPM\n")
+            .message
+            .contains("without a feed value")
+    );
+    assert!(
+        error("FEDRAT/MMPM,1,2\n")
+            .message
+            .contains("two feed values")
+    );
+}
+
+#[test]
+fn tool_path_any_utf8() {
+    assert_eq!(
+        one("TOOL PATH/平板件测试,TOOL,代砂轮\n"),
+        ClEvent::ToolPath {
+            name: "平板件测试".into(),
+            words: vec!["TOOL".into(), "代砂轮".into()]
+        }
+    );
+    assert_eq!(
+        one("tool  path / OP 1 , TOOL , T1\n"),
+        ClEvent::ToolPath {
+            name: "OP 1".into(),
+            words: vec!["TOOL".into(), "T1".into()]
+        }
+    );
+}
+
+#[test]
+fn tool_data_and_cutter() {
+    assert_eq!(
+        one("TLDATA/MILL,25.0000,0.0000,75.0000,0.0000,0.0000\n"),
+        ClEvent::ToolData {
+            kind: "MILL".into(),
+            values: vec![25.0, 0.0, 75.0, 0.0, 0.0]
+        }
+    );
+    assert_eq!(
+        one("CUTTER/6.,0,3.,0,0,0,51.\n"),
+        ClEvent::ToolData {
+            kind: "CUTTER".into(),
+            values: vec![6.0, 0.0, 3.0, 0.0, 0.0, 0.0, 51.0]
+        }
+    );
+    assert!(
+        error("TLDATA/MILL,2x\n")
+            .message
+            .contains("malformed number `2x`")
+    );
+}
+
+#[test]
+fn msys_full_short_and_cut() {
+    assert_eq!(
+        one("MSYS/1,2,3,1,0,0,0,1,0\n"),
+        ClEvent::MachineSystem {
+            origin: [1., 2., 3.],
+            x: Some([1., 0., 0.]),
+            y: Some([0., 1., 0.])
+        }
+    );
+    assert_eq!(
+        one("MSYS/1,2,3\n"),
+        ClEvent::MachineSystem {
+            origin: [1., 2., 3.],
+            x: None,
+            y: None
+        }
+    );
+    let (s, w) = read("MSYS/1,2,3,1,0,0,\n");
+    assert_eq!(
+        s[0].event,
+        ClEvent::MachineSystem {
+            origin: [1., 2., 3.],
+            x: Some([1., 0., 0.]),
+            y: None
+        }
+    );
+    assert_eq!(w.len(), 1);
+    assert!(
+        w[0].message
+            .starts_with("MSYS has 6 values, expected 3 or 9; ")
+    );
+    assert!(error("MSYS/1,2\n").message.contains("origin"));
+}
+
+#[test]
+fn comments() {
+    assert_eq!(
+        events("$$ centerline data\n  $$\nGOTO/1,2,3,0,0,1 $$ trailing\nPPRINT/ hello \n"),
+        vec![
+            ClEvent::Comment("centerline data".into()),
+            ClEvent::Comment(String::new()),
+            goto([1., 2., 3.], [0., 0., 1.], Motion::Feed),
+            ClEvent::Comment("hello".into()),
+        ]
+    );
+}
+
+#[test]
+fn tools_spindle_coolant() {
+    assert_eq!(
+        events(
+            "LOAD/TOOL,1\nSELECT/ tool , 5.\nSPINDL/12000,RPM,CLW\nSPINDL/RPM,500,CCLW\nSPINDL/OFF\nSPINDL/ON\nCOOLNT/FLOOD\nCOOLNT/mist\nCOOLNT/OFF\nCOOLNT\n"
+        ),
+        vec![
+            ClEvent::LoadTool { number: 1 },
+            ClEvent::SelectTool { number: 5 },
+            ClEvent::Spindle {
+                rpm: 12000.0,
+                dir: SpindleDir::Clockwise
+            },
+            ClEvent::Spindle {
+                rpm: 500.0,
+                dir: SpindleDir::CounterClockwise
+            },
+            ClEvent::SpindleOff,
+            ClEvent::Spindle {
+                rpm: 500.0,
+                dir: SpindleDir::CounterClockwise
+            },
+            ClEvent::Coolant {
+                on: true,
+                mode: "FLOOD".into()
+            },
+            ClEvent::Coolant {
+                on: true,
+                mode: "MIST".into()
+            },
+            ClEvent::Coolant {
+                on: false,
+                mode: "OFF".into()
+            },
+            ClEvent::Coolant {
+                on: true,
+                mode: "ON".into()
+            },
+        ]
+    );
+    assert!(error("LOAD/TOOL,1.5\n").message.contains("whole number"));
+    assert!(error("LOAD/TOOL,-1\n").message.contains("whole number"));
+    assert!(error("LOAD/1\n").message.contains("LOAD/TOOL,n"));
+    assert!(error("SPINDL/0,RPM\n").message.contains("positive"));
+    assert!(error("SPINDL/ON\n").message.contains("no earlier speed"));
+    assert!(error("SPINDL/200,SFM\n").message.contains("surface speed"));
+    let (s, w) = read("LOAD/TOOL,3,ADJUST,3\n");
+    assert_eq!(s[0].event, ClEvent::LoadTool { number: 3 });
+    assert_eq!(w[0].message, "`ADJUST,3` after the tool number ignored");
+}
+
+#[test]
+fn insert_partno_units_multax_pressure_end() {
+    assert_eq!(
+        events(
+            "INSERT/[HOLDER=C40-M06EM2] 6MM CRB 2FL, 19 LOC\nINSERT/ G05.1 Q1  \nPARTNO/1\nPARTNO  my part \nUNIT/MM\nUNITS/INCHES\nMULTAX/OFF\nMULTAX/ON\nPRESSURE/H1,3000\nPRESSURE/ 2.5\nEND-OF-PATH\nFINI\n"
+        ),
+        vec![
+            ClEvent::Insert("[HOLDER=C40-M06EM2] 6MM CRB 2FL, 19 LOC".into()),
+            ClEvent::Insert(" G05.1 Q1".into()),
+            ClEvent::PartNo("1".into()),
+            ClEvent::PartNo("my part".into()),
+            ClEvent::Units(Units::Mm),
+            ClEvent::Units(Units::Inch),
+            ClEvent::Multax(false),
+            ClEvent::Multax(true),
+            ClEvent::Pressure {
+                word: Some("H1".into()),
+                value: 3000.0
+            },
+            ClEvent::Pressure {
+                word: None,
+                value: 2.5
+            },
+            ClEvent::EndOfPath,
+            ClEvent::Fini,
+        ]
+    );
+    assert!(error("UNITS/FEET\n").message.contains("unknown units"));
+    assert!(error("PRESSURE/H1,-3\n").message.contains("negative"));
+    assert!(error("MULTAX/MAYBE\n").message.contains("MULTAX"));
+}
+
+#[test]
+fn silent_and_unsupported_statements() {
+    assert!(events("PAINT/PATH\nPAINT/COLOR,186\nTRNTYP/WORLD,0,0,0\nCSI_SET_FLUTE_LENGTH/19.\nCSYS/1.,0,0,0,0,1.,0,0,0,0,1.,0\nCUTCOM/OFF\nCYCLE/OFF\nRAPID\n\n   \n").is_empty());
+    for (cl, word) in [
+        ("CIRCLE/95.,44.249705,-3.,0,0,-1.\n", "CIRCLE"),
+        ("NURBS/1\n", "NURBS"),
+        ("CYCLE/DRILL,FEDTO,7.65\n", "CYCLE"),
+    ] {
+        let e = error(cl);
+        assert!(
+            e.message
+                .starts_with(&format!("{word} is not supported yet; ")),
+            "{}",
+            e.message
+        );
+        assert_eq!((e.line, e.column, e.width), (1, 1, word.len()));
+    }
+    let e = error("CSYS/0,0,1.,0,1.,0,0,0,0,1.,0,0\n");
+    assert!(e.message.contains("non-identity"), "{}", e.message);
+    assert!(error("CSYS/1,0,0\n").message.contains("expected 12"));
+    let (s, w) = read("CUTCOM/LEFT\n");
+    assert!(s.is_empty());
+    assert_eq!(
+        w[0].message,
+        "cutter compensation ignored: the GOTO points are used as tool positions"
+    );
+}
+
+#[test]
+fn unknown_statements_are_warnings() {
+    let (s, w) = read("FOO/1,2\nTLDDATA/MILL,1\nGOTO/1,2,3,0,0,1\n平板/1\n/x\nP1=POINT/1,2,3\n");
+    assert_eq!(s.len(), 1);
+    let got: Vec<_> = w
+        .iter()
+        .map(|d| (d.line, d.column, d.width, d.message.as_str()))
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            (1, 1, 3, "unknown statement `FOO` ignored"),
+            (
+                2,
+                1,
+                7,
+                "unknown statement `TLDDATA` (did you mean `TLDATA`?) ignored"
+            ),
+            (4, 1, 2, "unknown statement `平板` ignored"),
+            (5, 1, 1, "unknown statement `/` ignored"),
+            (6, 1, 2, "unknown statement `P1` ignored"),
+        ]
+    );
+    assert!(w.iter().all(|d| d.severity == Severity::Warning));
+}
+
+#[test]
+fn continuation_lines() {
+    let (s, w) = read(
+        "GOTO/1,2,$\n  3,0,0,1\nTOOL PATH/A$\nB,TOOL,T$  $$ comment\n$$ skipped comment\n,X\n",
+    );
+    assert!(w.is_empty());
+    assert_eq!(s[0].line, 1);
+    assert_eq!(s[0].event, goto([1., 2., 3.], [0., 0., 1.], Motion::Feed));
+    assert_eq!(s[1].line, 3);
+    assert_eq!(
+        s[1].event,
+        ClEvent::ToolPath {
+            name: "AB".into(),
+            words: vec!["TOOL".into(), "T".into(), "X".into()]
+        }
+    );
+    // Diagnostics point at the physical line holding the bad text.
+    let e = error("GOTO/1,2,$\n  3,0,x,1\n");
+    assert_eq!(
+        (e.line, e.column, e.source_line.as_str()),
+        (2, 7, "  3,0,x,1")
+    );
+    let e = error("GOTO/1,2,3,$\n");
+    assert_eq!((e.line, e.column), (1, 12));
+    assert!(e.message.contains("past the end of the file"));
+}
+
+#[test]
+fn crlf_bom_blank_lines() {
+    let (s, w) = read("\u{feff}RAPID\r\nGOTO/1,2,3,0,0,1\r\n\r\n\r\nGOTO/1,2,4 \r\nFOO\r\n");
+    assert_eq!(s.len(), 2);
+    assert_eq!(s[1].line, 5);
+    assert_eq!(s[0].event, goto([1., 2., 3.], [0., 0., 1.], Motion::Rapid));
+    assert_eq!((w[0].line, w[0].source_line.as_str()), (6, "FOO"));
+    // A BOM on line 1 is not part of the columns.
+    let e = error("\u{feff}GOTO/x,2,3\n");
+    assert_eq!((e.column, e.source_line.as_str()), (6, "GOTO/x,2,3"));
+}
+
+#[test]
+fn invalid_utf8_is_an_error_with_a_line() {
+    let mut r = ClReader::new(&b"GOTO/1,2,3,0,0,1\nTOOL PATH/ab\xff\xfe\n"[..], "t.cls");
+    assert!(r.next_statement().unwrap().is_some());
+    let e = r.next_statement().unwrap_err();
+    assert_eq!((e.line, e.column), (2, 13));
+    assert!(e.message.starts_with("invalid UTF-8 (byte 0xFF)"));
+    assert_eq!(r.next_statement().unwrap(), None);
+}
+
+#[test]
+fn reader_continues_after_an_error() {
+    let mut r = ClReader::new(
+        "RAPID\nGOTO/1,2,x,0,0,1\nGOTO/1,2,3,0,0,1\n".as_bytes(),
+        "t.cls",
+    );
+    assert!(r.next_statement().is_err());
+    // The failed GOTO had no effect: the RAPID still applies.
+    assert_eq!(
+        r.next_statement().unwrap().unwrap().event,
+        goto([1., 2., 3.], [0., 0., 1.], Motion::Rapid)
+    );
+    assert_eq!(r.next_statement().unwrap(), None);
+    assert_eq!(r.lines_read(), 3);
+}
+
+#[test]
+fn iterator_and_io_errors() {
+    struct Failing;
+    impl std::io::Read for Failing {
+        fn read(&mut self, _: &mut [u8]) -> std::io::Result<usize> {
+            Err(std::io::Error::other("disk on fire"))
+        }
+    }
+    let r = ClReader::new(std::io::BufReader::new(Failing), "t.cls");
+    let all: Vec<_> = r.collect();
+    assert_eq!(all.len(), 1);
+    let e = all[0].as_ref().unwrap_err();
+    assert_eq!(e.line, 1);
+    assert!(e.message.contains("disk on fire"));
+    let n = ClReader::new("GOTO/1,2,3,0,0,1\nGOTO/1,2,3\n".as_bytes(), "t.cls").count();
+    assert_eq!(n, 2);
+}

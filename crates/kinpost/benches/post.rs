@@ -1,0 +1,61 @@
+//! Posting speed: a generated 1,000,000-point 5-axis CL file on `mts1600`
+//! to `sinumerik`, closed-loop check included (issue target: ≥ 3 million CL
+//! points per second on one core). Figures go to BENCHMARKS.md.
+
+use std::fmt::Write as _;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use kinpost::{PostOptions, post};
+
+/// A 5-axis zig-zag over a gently curved surface: every point moves X, Y, Z,
+/// A and B.
+pub fn generate_cl(points: usize) -> String {
+    let mut cl = String::with_capacity(points * 64);
+    cl.push_str("TOOL PATH/BENCH,TOOL,WHEEL\nLOAD/TOOL,1\nFEDRAT/MMPM,2000\n");
+    for k in 0..points {
+        let t = k as f64 / points as f64;
+        let s = (k % 1000) as f64 / 1000.0;
+        let b = (-20.0 + 40.0 * s).to_radians();
+        let a = (10.0 * (std::f64::consts::TAU * t).sin()).to_radians();
+        let n = [b.sin(), -a.sin() * b.cos(), a.cos() * b.cos()];
+        writeln!(
+            cl,
+            "GOTO/{:.4},{:.4},{:.4},{:.7},{:.7},{:.7}",
+            -400.0 + 50.0 * s,
+            60.0 - 40.0 * t,
+            5.0 + 3.0 * (7.0 * s).sin(),
+            n[0],
+            n[1],
+            n[2]
+        )
+        .unwrap();
+    }
+    cl
+}
+
+fn bench(c: &mut Criterion) {
+    let points = 1_000_000;
+    let cl = generate_cl(points);
+    let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let mut group = c.benchmark_group("post");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(points as u64));
+    group.bench_function("mts1600_sinumerik_1M_points", |b| {
+        b.iter(|| {
+            let summary = post(
+                cl.as_bytes(),
+                &machine,
+                &dialect,
+                std::io::sink(),
+                &PostOptions::default(),
+            )
+            .unwrap();
+            assert_eq!(summary.cl_points, points as u64);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,107 @@
+//! The closed-loop check: every block, with its values exactly as written, is
+//! run back through the forward kinematics and compared with the CL pose it
+//! was made from.
+
+use kinpost_machine::{Machine, Pose};
+use nalgebra::Vector3;
+
+/// How far a block may put the tool from its CL pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerance {
+    /// Largest distance between the tool point of a block and its CL point, mm.
+    pub position_mm: f64,
+    /// Largest angle between the tool axis of a block and its CL axis, rad.
+    pub axis_rad: f64,
+}
+
+impl Tolerance {
+    /// The error that rounding to the output decimals can cause: half a unit
+    /// of the last decimal on every free linear axis, plus half a unit on
+    /// every free rotary axis times the machine's largest pivot distance
+    /// ([`Machine::largest_pivot_distance`]). `resolution(i)` is the value of
+    /// one unit in the last written decimal of axis `i` (0.001 for 3
+    /// decimals).
+    pub fn from_resolution(machine: &Machine, resolution: impl Fn(usize) -> f64) -> Tolerance {
+        let lever = machine.largest_pivot_distance();
+        let mut position = 0.0;
+        let mut axis = 0.0;
+        for (i, a) in machine.axes.iter().enumerate() {
+            if !a.is_free() {
+                continue;
+            }
+            let half = 0.5 * resolution(i);
+            if a.is_rotary() {
+                let rad = half.to_radians();
+                axis += rad;
+                position += rad * lever;
+            } else {
+                position += half;
+            }
+        }
+        // Slack for the arithmetic itself (1e-9 mm / rad).
+        Tolerance {
+            position_mm: position + 1e-9,
+            axis_rad: axis + 1e-9,
+        }
+    }
+}
+
+/// Position and tool-axis error of `got` against `want`.
+pub fn pose_error(want: &Pose, got: &Pose) -> (f64, f64) {
+    (
+        (want.point - got.point).norm(),
+        angle_between(&want.axis, &got.axis),
+    )
+}
+
+/// Angle between two unit vectors, accurate for small angles (atan2 of the
+/// cross and dot products).
+pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// Running maxima of the check.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CheckStats {
+    pub max_position_error_mm: f64,
+    pub max_axis_error_rad: f64,
+    /// CL line of the block with the largest position error.
+    pub worst_line: Option<usize>,
+}
+
+impl CheckStats {
+    /// Records one block; returns its errors.
+    pub fn record(&mut self, want: &Pose, got: &Pose, line: usize) -> (f64, f64) {
+        let (p, a) = pose_error(want, got);
+        if p > self.max_position_error_mm {
+            self.max_position_error_mm = p;
+            self.worst_line = Some(line);
+        }
+        self.max_axis_error_rad = self.max_axis_error_rad.max(a);
+        (p, a)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tolerance_of_mts1600_at_3_decimals() {
+        let m = kinpost_machine::builtin::load("mts1600").unwrap().unwrap();
+        let t = Tolerance::from_resolution(&m, |_| 0.001);
+        // 3 linear axes × 0.0005 mm + 2 free rotaries × 0.0005° × lever.
+        let lever = m.largest_pivot_distance();
+        let want = 3.0 * 0.0005 + 2.0 * 0.0005f64.to_radians() * lever + 1e-9;
+        assert!((t.position_mm - want).abs() < 1e-15);
+        assert!(lever > 79.0 && lever < 2100.0, "{lever}");
+        assert!((t.axis_rad - (2.0 * 0.0005f64.to_radians() + 1e-9)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn small_angles_are_accurate() {
+        let a = Vector3::z();
+        let b = Vector3::new(1e-10, 0.0, 1.0).normalize();
+        assert!((angle_between(&a, &b) - 1e-10).abs() < 1e-20);
+    }
+}

@@ -1,0 +1,425 @@
+//! The `kinpost` command: a thin layer over the library.
+//!
+//! Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error.
+
+use std::io::{self, BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, anyhow};
+use clap::{Parser, Subcommand};
+use kinpost::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use kinpost::nc::Dialect;
+use kinpost::output::{AtomicFile, write_atomically};
+use kinpost::{PostError, PostOptions};
+use nalgebra::Vector3;
+
+#[derive(Parser)]
+#[command(
+    name = "kinpost",
+    version,
+    about = "Multi-axis CNC post-processor: CL data to NC code through a machine's kinematic chain, checked in closed loop",
+    after_help = "Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Post a CL file (NX CLSF / APT) to an NC program.
+    Post(PostArgs),
+    /// List the built-in machines.
+    Machines,
+    /// Show or check machine files.
+    #[command(subcommand)]
+    Machine(MachineCommand),
+    /// List the built-in dialects.
+    Dialects,
+    /// Show a built-in dialect file.
+    #[command(subcommand)]
+    Dialect(DialectCommand),
+    /// Forward kinematics: tool point and axis in the part frame for axis values.
+    Fk {
+        /// Built-in machine name or machine file.
+        #[arg(long, short)]
+        machine: String,
+        /// Axis values as NAME=VALUE (mm, degrees); axes not given are 0.
+        #[arg(value_name = "AXIS=VALUE")]
+        values: Vec<String>,
+    },
+    /// Inverse kinematics: every solution for a tool point and axis.
+    Ik {
+        /// Built-in machine name or machine file.
+        #[arg(long, short)]
+        machine: String,
+        /// Tool point in the part frame: x,y,z (mm).
+        #[arg(long, allow_hyphen_values = true)]
+        point: String,
+        /// Tool axis in the part frame: i,j,k.
+        #[arg(long, allow_hyphen_values = true)]
+        axis: String,
+        /// Reference direction u,v,w (machines with three free rotary axes).
+        #[arg(long, allow_hyphen_values = true)]
+        reference: Option<String>,
+    },
+}
+
+#[derive(clap::Args)]
+struct PostArgs {
+    /// CL file, or - for standard input.
+    input: String,
+    /// Built-in machine name (see `kinpost machines`) or machine file (TOML).
+    #[arg(long, short)]
+    machine: String,
+    /// Built-in dialect name or dialect file; default: the machine's.
+    #[arg(long, short)]
+    dialect: Option<String>,
+    /// Output NC file; default: standard output.
+    #[arg(long, short)]
+    output: Option<PathBuf>,
+    /// Write the run summary as JSON to this file.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Closed-loop position tolerance in mm (default: derived from the
+    /// output decimals and the machine's largest pivot distance).
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Program name for the header (default: PARTNO, TOOL PATH name or file name).
+    #[arg(long)]
+    program: Option<String>,
+    /// Date for the header: a text, or `today`. Default: none, so that the
+    /// same input gives the same output bytes.
+    #[arg(long)]
+    date: Option<String>,
+    /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
+    #[arg(long, allow_hyphen_values = true)]
+    default_axis: Option<String>,
+    /// Print no summary on standard error.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum MachineCommand {
+    /// Print a built-in machine file.
+    Show { name: String },
+    /// Validate a machine file.
+    Check { file: PathBuf },
+}
+
+#[derive(Subcommand)]
+enum DialectCommand {
+    /// Print a built-in dialect file.
+    Show { name: String },
+}
+
+/// An error already reported to the user (diagnostics printed).
+#[derive(Debug)]
+struct Reported;
+
+impl std::fmt::Display for Reported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("reported")
+    }
+}
+
+impl std::error::Error for Reported {}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if e.downcast_ref::<Reported>().is_none() {
+                eprintln!("error: {e:#}");
+            }
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Post(args) => post(args),
+        Command::Machines => {
+            for name in builtin::names() {
+                let m = builtin::load(name).expect("listed").map_err(report)?;
+                println!("{name:<16} {}", m.description);
+            }
+            Ok(())
+        }
+        Command::Machine(MachineCommand::Show { name }) => {
+            let src = builtin::source(&name).ok_or_else(|| unknown_machine(&name))?;
+            print!("{src}");
+            Ok(())
+        }
+        Command::Machine(MachineCommand::Check { file }) => {
+            let m = load_machine(&file.to_string_lossy())?;
+            let free: Vec<&str> = m
+                .axes
+                .iter()
+                .filter(|a| a.is_free())
+                .map(|a| a.name.as_str())
+                .collect();
+            println!(
+                "{}: machine `{}` is valid: {} axes ({} free: {})",
+                file.display(),
+                m.name,
+                m.axes.len(),
+                free.len(),
+                free.join(" ")
+            );
+            Ok(())
+        }
+        Command::Dialects => {
+            for name in Dialect::builtin_names() {
+                let d = Dialect::builtin(name).expect("listed");
+                println!("{name:<12} .{:<5} {}", d.extension(), d.description());
+            }
+            Ok(())
+        }
+        Command::Dialect(DialectCommand::Show { name }) => {
+            let src = Dialect::builtin_source(&name).ok_or_else(|| {
+                anyhow!(
+                    "no built-in dialect `{name}` (built in: {})",
+                    Dialect::builtin_names().join(", ")
+                )
+            })?;
+            print!("{src}");
+            Ok(())
+        }
+        Command::Fk { machine, values } => fk(&machine, &values),
+        Command::Ik {
+            machine,
+            point,
+            axis,
+            reference,
+        } => ik(&machine, &point, &axis, reference.as_deref()),
+    }
+}
+
+/// Prints diagnostics and turns them into a [`Reported`] error.
+fn report(d: impl std::fmt::Display) -> anyhow::Error {
+    eprintln!("{d}");
+    anyhow::Error::new(Reported)
+}
+
+fn unknown_machine(name: &str) -> anyhow::Error {
+    anyhow!(
+        "no built-in machine `{name}` and no such file (built in: {})",
+        builtin::names().collect::<Vec<_>>().join(", ")
+    )
+}
+
+/// A built-in machine by name, or a machine file.
+fn load_machine(name: &str) -> Result<Machine> {
+    let path = Path::new(name);
+    if path.is_file() {
+        let src = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read machine file {name}"))?;
+        return machine_from_toml(&src, name).map_err(report);
+    }
+    match builtin::load(name) {
+        Some(m) => m.map_err(report),
+        None => Err(unknown_machine(name)),
+    }
+}
+
+/// A built-in dialect by name, or a dialect file.
+fn load_dialect(name: &str) -> Result<Dialect> {
+    let path = Path::new(name);
+    if path.is_file() {
+        let src = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read dialect file {name}"))?;
+        return Dialect::from_toml(&src, name).map_err(report);
+    }
+    Dialect::builtin(name).ok_or_else(|| {
+        anyhow!(
+            "no built-in dialect `{name}` and no such file (built in: {})",
+            Dialect::builtin_names().join(", ")
+        )
+    })
+}
+
+fn parse_vector(text: &str, what: &str) -> Result<[f64; 3]> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let values: Vec<f64> = parts
+        .iter()
+        .map(|p| p.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| anyhow!("{what} `{text}`: expected three numbers separated by commas"))?;
+    <[f64; 3]>::try_from(values)
+        .map_err(|_| anyhow!("{what} `{text}`: expected three numbers separated by commas"))
+}
+
+fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
+    let v = Vector3::from(parse_vector(text, what)?);
+    let n = v.norm();
+    if n < 1e-12 {
+        return Err(anyhow!("{what} `{text}` is a zero vector"));
+    }
+    Ok(v / n)
+}
+
+fn post(args: PostArgs) -> Result<()> {
+    let machine = load_machine(&args.machine)?;
+    let dialect_name = args
+        .dialect
+        .clone()
+        .or_else(|| machine.post.dialect.clone())
+        .unwrap_or_else(|| "csv".to_string());
+    let dialect = load_dialect(&dialect_name)?;
+    let options = PostOptions {
+        cl_file: args.input.clone(),
+        program_name: args.program.clone(),
+        date: match args.date.as_deref() {
+            Some("today") => today(),
+            Some(d) => d.to_string(),
+            None => String::new(),
+        },
+        tolerance_mm: args.tolerance,
+        default_axis: args
+            .default_axis
+            .as_deref()
+            .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
+            .transpose()?,
+    };
+    if let Some(t) = args.tolerance
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(anyhow!("--tolerance must be a positive number of mm"));
+    }
+    let input: Box<dyn BufRead> = if args.input == "-" {
+        Box::new(BufReader::with_capacity(1 << 16, io::stdin().lock()))
+    } else {
+        let f = std::fs::File::open(&args.input)
+            .with_context(|| format!("cannot open CL file {}", args.input))?;
+        Box::new(BufReader::with_capacity(1 << 16, f))
+    };
+
+    let result = match &args.output {
+        Some(path) => {
+            let mut file = AtomicFile::create(path)
+                .with_context(|| format!("cannot create {}", path.display()))?;
+            let summary = kinpost::post(input, &machine, &dialect, &mut file, &options);
+            if summary.is_ok() {
+                file.commit()
+                    .with_context(|| format!("cannot write {}", path.display()))?;
+            }
+            summary
+        }
+        None => {
+            // Held in memory so that a failed run prints no partial program.
+            let mut buffer = Vec::new();
+            let summary = kinpost::post(input, &machine, &dialect, &mut buffer, &options);
+            if summary.is_ok() {
+                let mut out = io::stdout().lock();
+                out.write_all(&buffer)?;
+                out.flush()?;
+            }
+            summary
+        }
+    };
+    let summary = match result {
+        Ok(s) => s,
+        Err(PostError::Input(d)) => return Err(report(d)),
+        Err(e) => return Err(e.into()),
+    };
+    for w in &summary.warnings {
+        eprintln!("{w}\n");
+    }
+    if let Some(json) = &args.json {
+        write_atomically(json, summary.to_json().as_bytes())
+            .with_context(|| format!("cannot write {}", json.display()))?;
+    }
+    if !args.quiet {
+        eprintln!("{}", summary.one_line());
+    }
+    Ok(())
+}
+
+fn fk(machine: &str, values: &[String]) -> Result<()> {
+    let m = load_machine(machine)?;
+    let mut q = m.home_joints();
+    for v in values {
+        let (name, value) = v
+            .split_once('=')
+            .ok_or_else(|| anyhow!("`{v}`: expected AXIS=VALUE, e.g. X=459"))?;
+        let i = m
+            .axis_index(name.trim())
+            .ok_or_else(|| anyhow!("machine `{}` has no axis `{name}`", m.name))?;
+        let value: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|x: &f64| x.is_finite())
+            .ok_or_else(|| anyhow!("`{v}`: `{value}` is not a number"))?;
+        if m.axes[i].fixed.is_some_and(|f| f != value) {
+            eprintln!(
+                "warning: axis {} is fixed at {} in this machine file; using {value}",
+                m.axes[i].name,
+                m.axes[i].fixed.unwrap_or(0.0)
+            );
+        }
+        if !m.axes[i].accepts(value) {
+            eprintln!("warning: {name}={value} is outside the axis limits");
+        }
+        q[i] = value;
+    }
+    let pose = Kinematics::new(&m).fk(&q);
+    let p = pose.point;
+    let a = pose.axis;
+    println!("point     {:.6} {:.6} {:.6}", p.x, p.y, p.z);
+    println!("axis      {:.9} {:.9} {:.9}", a.x, a.y, a.z);
+    if let Some(r) = pose.reference {
+        println!("reference {:.9} {:.9} {:.9}", r.x, r.y, r.z);
+    }
+    Ok(())
+}
+
+fn ik(machine: &str, point: &str, axis: &str, reference: Option<&str>) -> Result<()> {
+    let m = load_machine(machine)?;
+    let pose = Pose {
+        point: Vector3::from(parse_vector(point, "point")?),
+        axis: unit_vector(axis, "axis")?,
+        reference: reference.map(|r| unit_vector(r, "reference")).transpose()?,
+    };
+    let kin = Kinematics::new(&m);
+    let mut sols = Vec::new();
+    kin.ik_all_branches(&pose, None, &mut sols)
+        .map_err(|e| anyhow!("no solution: {e}"))?;
+    let names: Vec<String> = m.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
+    println!("branch {}  status", names.join(""));
+    for s in &sols {
+        let values: Vec<String> = (0..m.axes.len())
+            .map(|i| format!("{:>12.6}", s.joints[i]))
+            .collect();
+        let status = match s.violation {
+            None if s.singular => "ok (singular: a free angle kept at 0)".to_string(),
+            None => "ok".to_string(),
+            Some(v) => format!("outside travel: {}", m.axes[v.axis].name),
+        };
+        println!("{:>6} {}  {status}", s.branch, values.join(""));
+    }
+    Ok(())
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the civil-from-days algorithm
+/// (H. Hinnant, "chrono-Compatible Low-Level Date Algorithms").
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}

@@ -1,0 +1,898 @@
+//! Dialect files: parsing, validation and the resolved settings.
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::sync::Arc;
+
+use kinpost_diag::{Diagnostic, Diagnostics, Severity};
+use minijinja::Environment;
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
+use crate::template;
+use crate::writer::{MAX_LEAD, MAX_SUFFIX};
+use crate::{AxisSpec, Motion};
+
+/// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
+const MAX_PREFIX: usize = 24;
+
+const SINUMERIK: &str = include_str!("../dialects/sinumerik.toml");
+const CSV: &str = include_str!("../dialects/csv.toml");
+const BUILTINS: &[(&str, &str)] = &[("sinumerik", SINUMERIK), ("csv", CSV)];
+const BUILTIN_NAMES: &[&str] = &["sinumerik", "csv"];
+
+/// What kind of file a dialect writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum DialectKind {
+    /// An NC program: blocks of address words, templates, comments.
+    #[default]
+    Words,
+    /// A table of axis values: a header row, then one row per motion block
+    /// (`line`, `motion`, every machine axis in machine order, `feed`).
+    Csv,
+}
+
+/// The complete format of one word: prefix, number, suffix, modality.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WordFormat {
+    /// Text before the number (`X=`, `A=DC(`, `F`).
+    pub prefix: String,
+    /// Text after the number (`)` for `DC(...)`).
+    pub suffix: String,
+    /// The number.
+    pub number: NumberFormat,
+    /// A modal word is written only when its (written) value changes.
+    pub modal: bool,
+}
+
+/// The feed word.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeedFormat {
+    /// Prefix, number format and modality of the `F` word.
+    pub word: WordFormat,
+    /// Literal word written on rapid blocks instead of a feed word
+    /// (Heidenhain `FMAX`); empty for none.
+    pub rapid: String,
+    /// The feed values are inverse time (Fanuc/LinuxCNC `G93`): the caller
+    /// computes them; the writer formats them like any feed.
+    pub inverse_time: bool,
+}
+
+/// The motion (interpolation) words.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionWords {
+    /// Word for rapid blocks (`G0`, Heidenhain `L`); empty for none.
+    pub rapid: String,
+    /// Word for feed blocks (`G1`, Heidenhain `L`); empty for none.
+    pub feed: String,
+    /// Written only when the motion changes.
+    pub modal: bool,
+    /// The motion in force after the header (the header template sets it),
+    /// `None` when unknown: the first block then always has its motion word.
+    pub initial: Option<Motion>,
+    /// Further spellings of the rapid word accepted by the reader (`G00`).
+    pub rapid_aliases: Vec<String>,
+    /// Further spellings of the feed word accepted by the reader (`G01`).
+    pub feed_aliases: Vec<String>,
+}
+
+/// Layout of a block (a line).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockFormat {
+    /// Axis names written first, in this order; the other axes follow in
+    /// machine order. Names the machine does not have are ignored.
+    pub order: Vec<String>,
+    /// Whether axes the machine locks (`fixed`) are written.
+    pub write_fixed: bool,
+    /// Between words (`" "`; `""` for compact Fanuc style; `,` in csv).
+    pub separator: String,
+    /// End of every line (`"\n"`, `"\r\n"`).
+    pub line_end: String,
+    /// Literal words written after the axis words of every motion block
+    /// (Heidenhain `R0`); empty for none.
+    pub after_axes: String,
+}
+
+/// Block numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numbering {
+    /// Whether blocks get numbers at all.
+    pub enabled: bool,
+    /// Text before the number (`N`; empty for Heidenhain).
+    pub prefix: String,
+    /// First number.
+    pub start: u64,
+    /// Increment.
+    pub step: u64,
+    /// Minimum number of digits (zero padded); 0 for none.
+    pub digits: usize,
+    /// After this number, numbering starts again at `start` (Fanuc N99999).
+    pub wrap_after: Option<u64>,
+    /// Number the lines of the header and footer templates.
+    pub header: bool,
+    /// Number the lines of the tool change, spindle, coolant and pressure templates.
+    pub commands: bool,
+    /// Number comment lines (Heidenhain `5 * - text`).
+    pub comments: bool,
+}
+
+/// How comments are written.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CommentSyntax {
+    /// Comments are written at all.
+    pub enabled: bool,
+    /// Before the text (`; `, `(`, `* - `).
+    pub prefix: String,
+    /// After the text (`)`).
+    pub suffix: String,
+    /// Replacements applied to the text, e.g. `(` → `[`; line breaks always
+    /// become spaces.
+    pub replace: Vec<(String, String)>,
+}
+
+/// The templates a dialect may define.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TemplateKind {
+    /// Start of the program.
+    Header,
+    /// End of the program.
+    Footer,
+    /// Tool change (`tool_number`, `tool_name`).
+    ToolChange,
+    /// Spindle on (`speed`, `clockwise`, `direction`).
+    SpindleOn,
+    /// Spindle off.
+    SpindleOff,
+    /// Coolant on (`mode`).
+    CoolantOn,
+    /// Coolant off.
+    CoolantOff,
+    /// Process pressure (`pressure`, belt grinding H1).
+    Pressure,
+}
+
+impl TemplateKind {
+    /// All kinds, in file order.
+    pub const ALL: [TemplateKind; 8] = [
+        TemplateKind::Header,
+        TemplateKind::Footer,
+        TemplateKind::ToolChange,
+        TemplateKind::SpindleOn,
+        TemplateKind::SpindleOff,
+        TemplateKind::CoolantOn,
+        TemplateKind::CoolantOff,
+        TemplateKind::Pressure,
+    ];
+
+    /// The key in `[templates]`.
+    pub fn key(self) -> &'static str {
+        match self {
+            TemplateKind::Header => "header",
+            TemplateKind::Footer => "footer",
+            TemplateKind::ToolChange => "tool_change",
+            TemplateKind::SpindleOn => "spindle_on",
+            TemplateKind::SpindleOff => "spindle_off",
+            TemplateKind::CoolantOn => "coolant_on",
+            TemplateKind::CoolantOff => "coolant_off",
+            TemplateKind::Pressure => "pressure",
+        }
+    }
+}
+
+/// A parsed, validated NC dialect.
+#[derive(Clone)]
+pub struct Dialect {
+    pub(crate) name: String,
+    pub(crate) extension: String,
+    pub(crate) description: String,
+    pub(crate) kind: DialectKind,
+    pub(crate) block: BlockFormat,
+    linear: PartialWord,
+    rotary: PartialWord,
+    axis: BTreeMap<String, PartialWord>,
+    pub(crate) feed: FeedFormat,
+    pub(crate) motion: MotionWords,
+    pub(crate) numbering: Numbering,
+    pub(crate) comment: CommentSyntax,
+    templates: BTreeMap<TemplateKind, String>,
+    pub(crate) env: Arc<Environment<'static>>,
+}
+
+impl fmt::Debug for Dialect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Dialect")
+            .field("name", &self.name)
+            .field("extension", &self.extension)
+            .field("kind", &self.kind)
+            .field("block", &self.block)
+            .field("feed", &self.feed)
+            .field("motion", &self.motion)
+            .field("numbering", &self.numbering)
+            .field("comment", &self.comment)
+            .field("templates", &self.templates)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Dialect {
+    /// A built-in dialect by name (see [`Dialect::builtin_names`]).
+    pub fn builtin(name: &str) -> Option<Dialect> {
+        let source = Self::builtin_source(name)?;
+        // The built-in files are tested; a failure here is a bug in this crate.
+        Some(
+            Self::from_toml(source, &format!("<builtin>/{name}.toml"))
+                .unwrap_or_else(|e| panic!("built-in dialect `{name}` is broken:\n{e}")),
+        )
+    }
+
+    /// Names of the built-in dialects.
+    pub fn builtin_names() -> &'static [&'static str] {
+        BUILTIN_NAMES
+    }
+
+    /// The TOML text of a built-in dialect (for `kinpost dialect show`).
+    pub fn builtin_source(name: &str) -> Option<&'static str> {
+        BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
+    }
+
+    /// Parses and validates a dialect file. Every problem is reported as a
+    /// diagnostic naming `file_name`, line and column.
+    pub fn from_toml(source: &str, file_name: &str) -> Result<Dialect, Diagnostics> {
+        let raw: RawDialect = toml::from_str(source).map_err(|e| {
+            Diagnostics::from(Diagnostic::at_byte_span(
+                Severity::Error,
+                file_name,
+                source,
+                e.span().unwrap_or(0..0),
+                e.message().trim_end().to_string(),
+            ))
+        })?;
+        let mut errors = Vec::new();
+        let mut err = |span: std::ops::Range<usize>, msg: String| {
+            errors.push(Diagnostic::at_byte_span(
+                Severity::Error,
+                file_name,
+                source,
+                span,
+                msg,
+            ));
+        };
+
+        let kind = raw.kind;
+        if raw.name.get_ref().trim().is_empty() {
+            err(raw.name.span(), "`name` must not be empty".into());
+        }
+        if raw.extension.get_ref().contains(['.', '/', '\\']) {
+            err(
+                raw.extension.span(),
+                "`extension` is the bare extension, without a dot (e.g. `mpf`)".into(),
+            );
+        }
+
+        // Word formats.
+        let base = PartialWord::base(kind);
+        let check_word = |w: &RawWord, err: &mut dyn FnMut(std::ops::Range<usize>, String)| {
+            if let Some(p) = &w.prefix
+                && p.get_ref().len() > MAX_PREFIX
+            {
+                err(
+                    p.span(),
+                    format!("`prefix` may have at most {MAX_PREFIX} bytes"),
+                );
+            }
+            if let Some(p) = &w.suffix
+                && p.get_ref().len() > MAX_SUFFIX
+            {
+                err(
+                    p.span(),
+                    format!("`suffix` may have at most {MAX_SUFFIX} bytes"),
+                );
+            }
+            if let Some(d) = &w.decimals
+                && *d.get_ref() > MAX_DECIMALS
+            {
+                err(
+                    d.span(),
+                    format!("`decimals` must be between 0 and {MAX_DECIMALS}"),
+                );
+            }
+        };
+        check_word(&raw.linear, &mut err);
+        check_word(&raw.rotary, &mut err);
+        for w in raw.axis.values() {
+            check_word(w, &mut err);
+        }
+        let raw_feed_word = raw.feed.as_word();
+        check_word(&raw_feed_word, &mut err);
+
+        let linear = base.over(&PartialWord::from(&raw.linear));
+        let rotary = base.over(&PartialWord::from(&raw.rotary));
+        let axis: BTreeMap<String, PartialWord> = raw
+            .axis
+            .iter()
+            .map(|(k, w)| (k.clone(), PartialWord::from(w)))
+            .collect();
+        // Whole formats (modulo against decimals) once the fields are sane.
+        let mut whole = |w: &RawWord, resolved: &[WordFormat]| {
+            for r in resolved {
+                if r.number.decimals <= MAX_DECIMALS
+                    && let Err(msg) = r.number.validate()
+                {
+                    let span = w
+                        .modulo
+                        .as_ref()
+                        .map(|m| m.span())
+                        .or_else(|| w.decimals.as_ref().map(|d| d.span()))
+                        .unwrap_or(0..0);
+                    err(span, msg);
+                    break;
+                }
+            }
+        };
+        whole(&raw.linear, &[linear.resolve("X")]);
+        whole(&raw.rotary, &[rotary.resolve("A")]);
+        for (name, w) in &raw.axis {
+            let o = PartialWord::from(w);
+            whole(
+                w,
+                &[linear.over(&o).resolve(name), rotary.over(&o).resolve(name)],
+            );
+        }
+        let feed_word = PartialWord::feed_base()
+            .over(&PartialWord::from(&raw_feed_word))
+            .resolve("F");
+        whole(&raw_feed_word, std::slice::from_ref(&feed_word));
+
+        let numbering = Numbering {
+            enabled: raw.numbering.enabled,
+            prefix: raw.numbering.prefix,
+            start: raw.numbering.start,
+            step: *raw.numbering.step.get_ref(),
+            digits: raw.numbering.digits,
+            wrap_after: raw.numbering.wrap_after,
+            header: raw.numbering.header,
+            commands: raw.numbering.commands,
+            comments: raw.numbering.comments,
+        };
+        if numbering.step == 0 {
+            err(
+                raw.numbering.step.span(),
+                "`step` must be at least 1".into(),
+            );
+        }
+        let mut replace = Vec::new();
+        for (from, to) in raw.comment.replace {
+            if from.is_empty() {
+                err(0..0, "`comment.replace` has an empty key".into());
+            }
+            replace.push((from, to));
+        }
+
+        // Templates: compile once, errors point into the TOML file.
+        let mut env = template::environment();
+        let mut templates = BTreeMap::new();
+        for kind_t in TemplateKind::ALL {
+            let Some(t) = raw.templates.get(kind_t) else {
+                continue;
+            };
+            if let Err(e) = env.add_template_owned(kind_t.key(), t.get_ref().clone()) {
+                let span = template::error_span_in_toml(source, t.span(), t.get_ref(), &e);
+                err(
+                    span,
+                    format!(
+                        "template `{}`: {}",
+                        kind_t.key(),
+                        template::error_message(&e)
+                    ),
+                );
+            }
+            templates.insert(kind_t, t.get_ref().clone());
+        }
+
+        let motion = MotionWords {
+            rapid: raw.motion.rapid,
+            feed: raw.motion.feed,
+            modal: raw.motion.modal,
+            initial: match raw.motion.initial {
+                RawInitial::None => None,
+                RawInitial::Rapid => Some(Motion::Rapid),
+                RawInitial::Feed => Some(Motion::Feed),
+            },
+            rapid_aliases: raw.motion.rapid_aliases,
+            feed_aliases: raw.motion.feed_aliases,
+        };
+        let block = BlockFormat {
+            order: raw.block.order,
+            write_fixed: raw.block.write_fixed,
+            separator: raw
+                .block
+                .separator
+                .as_ref()
+                .map(|s| s.get_ref().clone())
+                .unwrap_or_else(|| match kind {
+                    DialectKind::Words => " ".into(),
+                    DialectKind::Csv => ",".into(),
+                }),
+            line_end: raw.block.line_end.get_ref().clone(),
+            after_axes: raw.block.after_axes,
+        };
+        if let Some(sep) = &raw.block.separator
+            && sep.get_ref().len() > MAX_LEAD - MAX_PREFIX
+        {
+            err(
+                sep.span(),
+                format!(
+                    "`separator` may have at most {} bytes",
+                    MAX_LEAD - MAX_PREFIX
+                ),
+            );
+        }
+        if !block.line_end.ends_with('\n') {
+            err(
+                raw.block.line_end.span(),
+                "`line_end` must end with a newline".into(),
+            );
+        }
+
+        if !errors.is_empty() {
+            return Err(Diagnostics(errors));
+        }
+        Ok(Dialect {
+            name: raw.name.into_inner(),
+            extension: raw.extension.into_inner(),
+            description: raw.description,
+            kind,
+            block,
+            linear,
+            rotary,
+            axis,
+            feed: FeedFormat {
+                word: feed_word,
+                rapid: raw.feed.rapid,
+                inverse_time: raw.feed.inverse_time,
+            },
+            motion,
+            numbering,
+            comment: CommentSyntax {
+                enabled: raw.comment.enabled,
+                prefix: raw.comment.prefix,
+                suffix: raw.comment.suffix,
+                replace,
+            },
+            templates,
+            env: Arc::new(env),
+        })
+    }
+
+    /// The dialect's name (`sinumerik`).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// File extension of programs, without the dot (`mpf`).
+    pub fn extension(&self) -> &str {
+        &self.extension
+    }
+
+    /// One-line description.
+    pub fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// NC words or CSV table.
+    pub fn kind(&self) -> DialectKind {
+        self.kind
+    }
+
+    /// Block layout.
+    pub fn block_format(&self) -> &BlockFormat {
+        &self.block
+    }
+
+    /// The feed word.
+    pub fn feed_format(&self) -> &FeedFormat {
+        &self.feed
+    }
+
+    /// Motion words.
+    pub fn motion_words(&self) -> &MotionWords {
+        &self.motion
+    }
+
+    /// Block numbering.
+    pub fn numbering(&self) -> &Numbering {
+        &self.numbering
+    }
+
+    /// Comment syntax.
+    pub fn comment_syntax(&self) -> &CommentSyntax {
+        &self.comment
+    }
+
+    /// The source of a template, if the dialect defines it.
+    pub fn template(&self, kind: TemplateKind) -> Option<&str> {
+        self.templates.get(&kind).map(String::as_str)
+    }
+
+    /// The word format of one machine axis: built-in default, then
+    /// `[linear]` or `[rotary]`, then `[axis.NAME]`.
+    pub fn word_format(&self, axis: &AxisSpec) -> WordFormat {
+        let kind_default = if axis.rotary {
+            &self.rotary
+        } else {
+            &self.linear
+        };
+        match self.axis.get(&axis.name) {
+            Some(o) => kind_default.over(o).resolve(&axis.name),
+            None => kind_default.resolve(&axis.name),
+        }
+    }
+
+    /// The value exactly as it will be written for this axis (rounded to the
+    /// axis decimals, ties to even; modulo applied), so the caller can run
+    /// it through forward kinematics for the closed-loop check. Values that
+    /// cannot be written (non-finite, too large) are returned unchanged.
+    pub fn quantize(&self, axis: &AxisSpec, value: f64) -> f64 {
+        self.word_format(axis).number.quantize(value)
+    }
+
+    /// Renders a template source (e.g. a machine file's header override) with
+    /// this dialect's template settings and filters.
+    pub fn render_template(
+        &self,
+        source: &str,
+        vars: &BTreeMap<String, minijinja::Value>,
+    ) -> Result<String, crate::NcError> {
+        template::render_str(&self.env, "template", source, vars)
+    }
+}
+
+/// A word format with every setting optional (one layer of defaults).
+#[derive(Debug, Clone, Default, PartialEq)]
+struct PartialWord {
+    prefix: Option<String>,
+    suffix: Option<String>,
+    decimals: Option<u8>,
+    trailing_zeros: Option<TrailingZeros>,
+    leading_zero: Option<bool>,
+    plus_sign: Option<bool>,
+    modulo: Option<f64>,
+    modal: Option<bool>,
+}
+
+impl PartialWord {
+    fn base(kind: DialectKind) -> PartialWord {
+        let (prefix, decimals) = match kind {
+            DialectKind::Words => ("{name}", 3),
+            DialectKind::Csv => ("", 6),
+        };
+        PartialWord {
+            prefix: Some(prefix.into()),
+            suffix: Some(String::new()),
+            decimals: Some(decimals),
+            trailing_zeros: Some(TrailingZeros::Keep),
+            leading_zero: Some(true),
+            plus_sign: Some(false),
+            modulo: None,
+            modal: Some(false),
+        }
+    }
+
+    fn feed_base() -> PartialWord {
+        PartialWord {
+            prefix: Some("F".into()),
+            trailing_zeros: Some(TrailingZeros::Trim),
+            modal: Some(true),
+            ..PartialWord::base(DialectKind::Words)
+        }
+    }
+
+    /// `other`'s settings where given, else ours.
+    fn over(&self, other: &PartialWord) -> PartialWord {
+        PartialWord {
+            prefix: other.prefix.clone().or_else(|| self.prefix.clone()),
+            suffix: other.suffix.clone().or_else(|| self.suffix.clone()),
+            decimals: other.decimals.or(self.decimals),
+            trailing_zeros: other.trailing_zeros.or(self.trailing_zeros),
+            leading_zero: other.leading_zero.or(self.leading_zero),
+            plus_sign: other.plus_sign.or(self.plus_sign),
+            modulo: other.modulo.or(self.modulo),
+            modal: other.modal.or(self.modal),
+        }
+    }
+
+    fn resolve(&self, name: &str) -> WordFormat {
+        WordFormat {
+            prefix: self
+                .prefix
+                .as_deref()
+                .unwrap_or("{name}")
+                .replace("{name}", name),
+            suffix: self.suffix.clone().unwrap_or_default(),
+            number: NumberFormat {
+                decimals: self.decimals.unwrap_or(3),
+                trailing_zeros: self.trailing_zeros.unwrap_or(TrailingZeros::Keep),
+                leading_zero: self.leading_zero.unwrap_or(true),
+                plus_sign: self.plus_sign.unwrap_or(false),
+                modulo: self.modulo,
+            },
+            modal: self.modal.unwrap_or(false),
+        }
+    }
+}
+
+impl From<&RawWord> for PartialWord {
+    fn from(w: &RawWord) -> Self {
+        PartialWord {
+            prefix: w.prefix.as_ref().map(|p| p.get_ref().clone()),
+            suffix: w.suffix.as_ref().map(|p| p.get_ref().clone()),
+            decimals: w.decimals.as_ref().map(|d| *d.get_ref()),
+            trailing_zeros: w.trailing_zeros,
+            leading_zero: w.leading_zero,
+            plus_sign: w.plus_sign,
+            modulo: w.modulo.as_ref().map(|m| *m.get_ref()),
+            modal: w.modal,
+        }
+    }
+}
+
+// ---------------------------------------------------------------- raw TOML
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDialect {
+    name: Spanned<String>,
+    extension: Spanned<String>,
+    #[serde(default)]
+    description: String,
+    #[serde(default)]
+    kind: DialectKind,
+    #[serde(default)]
+    block: RawBlock,
+    #[serde(default)]
+    linear: RawWord,
+    #[serde(default)]
+    rotary: RawWord,
+    #[serde(default)]
+    axis: BTreeMap<String, RawWord>,
+    #[serde(default)]
+    feed: RawFeed,
+    #[serde(default)]
+    motion: RawMotion,
+    #[serde(default)]
+    numbering: RawNumbering,
+    #[serde(default)]
+    comment: RawComment,
+    #[serde(default)]
+    templates: RawTemplates,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawWord {
+    prefix: Option<Spanned<String>>,
+    suffix: Option<Spanned<String>>,
+    decimals: Option<Spanned<u8>>,
+    trailing_zeros: Option<TrailingZeros>,
+    leading_zero: Option<bool>,
+    plus_sign: Option<bool>,
+    modulo: Option<Spanned<f64>>,
+    modal: Option<bool>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawFeed {
+    prefix: Option<Spanned<String>>,
+    suffix: Option<Spanned<String>>,
+    decimals: Option<Spanned<u8>>,
+    trailing_zeros: Option<TrailingZeros>,
+    leading_zero: Option<bool>,
+    plus_sign: Option<bool>,
+    modal: Option<bool>,
+    #[serde(default)]
+    rapid: String,
+    #[serde(default)]
+    inverse_time: bool,
+}
+
+impl RawFeed {
+    /// The number settings of the feed word as a word layer.
+    fn as_word(&self) -> RawWord {
+        RawWord {
+            prefix: self.prefix.clone(),
+            suffix: self.suffix.clone(),
+            decimals: self.decimals.clone(),
+            trailing_zeros: self.trailing_zeros,
+            leading_zero: self.leading_zero,
+            plus_sign: self.plus_sign,
+            modulo: None,
+            modal: self.modal,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBlock {
+    #[serde(default)]
+    order: Vec<String>,
+    #[serde(default)]
+    write_fixed: bool,
+    separator: Option<Spanned<String>>,
+    #[serde(default = "newline")]
+    line_end: Spanned<String>,
+    #[serde(default)]
+    after_axes: String,
+}
+
+impl Default for RawBlock {
+    fn default() -> Self {
+        RawBlock {
+            order: Vec::new(),
+            write_fixed: false,
+            separator: None,
+            line_end: newline(),
+            after_axes: String::new(),
+        }
+    }
+}
+
+fn newline() -> Spanned<String> {
+    Spanned::new(0..0, "\n".into())
+}
+
+#[derive(Deserialize, Default, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum RawInitial {
+    #[default]
+    None,
+    Rapid,
+    Feed,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMotion {
+    #[serde(default = "g0")]
+    rapid: String,
+    #[serde(default = "g1")]
+    feed: String,
+    #[serde(default = "yes")]
+    modal: bool,
+    #[serde(default)]
+    initial: RawInitial,
+    #[serde(default)]
+    rapid_aliases: Vec<String>,
+    #[serde(default)]
+    feed_aliases: Vec<String>,
+}
+
+impl Default for RawMotion {
+    fn default() -> Self {
+        RawMotion {
+            rapid: g0(),
+            feed: g1(),
+            modal: true,
+            initial: RawInitial::None,
+            rapid_aliases: Vec::new(),
+            feed_aliases: Vec::new(),
+        }
+    }
+}
+
+fn g0() -> String {
+    "G0".into()
+}
+fn g1() -> String {
+    "G1".into()
+}
+fn yes() -> bool {
+    true
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawNumbering {
+    #[serde(default)]
+    enabled: bool,
+    #[serde(default = "n_prefix")]
+    prefix: String,
+    #[serde(default = "ten")]
+    start: u64,
+    #[serde(default = "ten_spanned")]
+    step: Spanned<u64>,
+    #[serde(default)]
+    digits: usize,
+    wrap_after: Option<u64>,
+    #[serde(default)]
+    header: bool,
+    #[serde(default = "yes")]
+    commands: bool,
+    #[serde(default)]
+    comments: bool,
+}
+
+impl Default for RawNumbering {
+    fn default() -> Self {
+        RawNumbering {
+            enabled: false,
+            prefix: n_prefix(),
+            start: 10,
+            step: ten_spanned(),
+            digits: 0,
+            wrap_after: None,
+            header: false,
+            commands: true,
+            comments: false,
+        }
+    }
+}
+
+fn n_prefix() -> String {
+    "N".into()
+}
+fn ten() -> u64 {
+    10
+}
+fn ten_spanned() -> Spanned<u64> {
+    Spanned::new(0..0, 10)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawComment {
+    #[serde(default = "yes")]
+    enabled: bool,
+    #[serde(default = "semicolon")]
+    prefix: String,
+    #[serde(default)]
+    suffix: String,
+    #[serde(default)]
+    replace: BTreeMap<String, String>,
+}
+
+impl Default for RawComment {
+    fn default() -> Self {
+        RawComment {
+            enabled: true,
+            prefix: semicolon(),
+            suffix: String::new(),
+            replace: BTreeMap::new(),
+        }
+    }
+}
+
+fn semicolon() -> String {
+    "; ".into()
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawTemplates {
+    header: Option<Spanned<String>>,
+    footer: Option<Spanned<String>>,
+    tool_change: Option<Spanned<String>>,
+    spindle_on: Option<Spanned<String>>,
+    spindle_off: Option<Spanned<String>>,
+    coolant_on: Option<Spanned<String>>,
+    coolant_off: Option<Spanned<String>>,
+    pressure: Option<Spanned<String>>,
+}
+
+impl RawTemplates {
+    fn get(&self, kind: TemplateKind) -> Option<&Spanned<String>> {
+        match kind {
+            TemplateKind::Header => self.header.as_ref(),
+            TemplateKind::Footer => self.footer.as_ref(),
+            TemplateKind::ToolChange => self.tool_change.as_ref(),
+            TemplateKind::SpindleOn => self.spindle_on.as_ref(),
+            TemplateKind::SpindleOff => self.spindle_off.as_ref(),
+            TemplateKind::CoolantOn => self.coolant_on.as_ref(),
+            TemplateKind::CoolantOff => self.coolant_off.as_ref(),
+            TemplateKind::Pressure => self.pressure.as_ref(),
+        }
+    }
+}

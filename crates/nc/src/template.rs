@@ -1,0 +1,188 @@
+//! minijinja set-up shared by dialect templates and machine-file overrides.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use minijinja::syntax::SyntaxConfig;
+use minijinja::{Environment, UndefinedBehavior, Value};
+
+use crate::NcError;
+
+/// The environment every dialect uses: `trim_blocks` and `lstrip_blocks` on
+/// (block tags on their own lines leave no blank lines), undefined variables
+/// are errors, plus the `num` filter.
+pub(crate) fn environment() -> Environment<'static> {
+    let mut env = Environment::new();
+    if let Ok(syntax) = SyntaxConfig::builder()
+        .trim_blocks(true)
+        .lstrip_blocks(true)
+        .build()
+    {
+        env.set_syntax(syntax);
+    }
+    env.set_undefined_behavior(UndefinedBehavior::Strict);
+    env.set_debug(true);
+    env.add_filter("num", num);
+    env
+}
+
+/// `{{ value | num }}`, `{{ value | num(1) }}`: a number with at most that many
+/// decimals (default 3), trailing zeros and a bare point removed, no `-0`.
+fn num(value: f64, decimals: Option<u32>) -> String {
+    let d = decimals.unwrap_or(3).min(9) as usize;
+    let mut s = format!("{value:.d$}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    if s == "-0" {
+        s.remove(0);
+    }
+    s
+}
+
+/// Renders a template registered in `env`.
+pub(crate) fn render(
+    env: &Environment<'static>,
+    name: &str,
+    vars: &BTreeMap<String, Value>,
+) -> Result<String, NcError> {
+    let t = env.get_template(name).map_err(|e| to_error(name, &e))?;
+    t.render(Value::from(vars.clone()))
+        .map_err(|e| to_error(name, &e))
+}
+
+/// Renders a template given as text (e.g. a machine file override).
+pub(crate) fn render_str(
+    env: &Environment<'static>,
+    name: &str,
+    source: &str,
+    vars: &BTreeMap<String, Value>,
+) -> Result<String, NcError> {
+    env.render_named_str(name, source, Value::from(vars.clone()))
+        .map_err(|e| to_error(name, &e))
+}
+
+fn to_error(name: &str, e: &minijinja::Error) -> NcError {
+    NcError::Template {
+        template: name.to_string(),
+        line: e.line(),
+        range: e.range(),
+        message: error_message(e),
+    }
+}
+
+/// The error without minijinja's debug dump.
+pub(crate) fn error_message(e: &minijinja::Error) -> String {
+    match e.detail() {
+        Some(d) => format!("{}: {d}", e.kind()),
+        None => e.kind().to_string(),
+    }
+}
+
+/// A template syntax error: message and byte range in the template text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TemplateError {
+    /// What is wrong.
+    pub message: String,
+    /// Byte range in the template source, when known.
+    pub range: Option<Range<usize>>,
+    /// 1-based line in the template source, when known.
+    pub line: Option<usize>,
+}
+
+impl std::fmt::Display for TemplateError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for TemplateError {}
+
+/// Checks the syntax of a template (e.g. a machine file's header override)
+/// without rendering it, so a loader can report the error at its own span
+/// (see [`template_span_in_toml`]).
+pub fn check_template(source: &str) -> Result<(), TemplateError> {
+    let env = environment();
+    env.template_from_str(source)
+        .map(|_| ())
+        .map_err(|e| TemplateError {
+            message: error_message(&e),
+            range: e.range(),
+            line: e.line(),
+        })
+}
+
+/// Maps a byte range inside a template string to a byte range in the TOML
+/// file that holds it. `value_span` is the span of the TOML string value
+/// (with its quotes, as `toml::Spanned` gives it), `text` the decoded
+/// string. Exact when the string has no escape sequences (literal strings,
+/// or basic strings without backslashes), else the start of the string.
+pub fn template_span_in_toml(
+    toml_source: &str,
+    value_span: Range<usize>,
+    text: &str,
+    range: Option<Range<usize>>,
+) -> Range<usize> {
+    let fallback = value_span.start..value_span.start + 1;
+    let Some(raw) = toml_source.get(value_span.clone()) else {
+        return fallback;
+    };
+    let Some(range) = range else {
+        return fallback;
+    };
+    match raw.find(text) {
+        Some(at) if !text.is_empty() => {
+            let base = value_span.start + at;
+            let end = range
+                .end
+                .max(range.start + 1)
+                .min(text.len().max(range.start + 1));
+            base + range.start..base + end
+        }
+        _ => fallback,
+    }
+}
+
+pub(crate) fn error_span_in_toml(
+    toml_source: &str,
+    value_span: Range<usize>,
+    text: &str,
+    e: &minijinja::Error,
+) -> Range<usize> {
+    let range = e.range().or_else(|| {
+        // Only a line: point at its start.
+        e.line().and_then(|l| {
+            let start: usize = text
+                .split_inclusive('\n')
+                .take(l.saturating_sub(1))
+                .map(str::len)
+                .sum();
+            (start <= text.len()).then_some(start..start + 1)
+        })
+    });
+    template_span_in_toml(toml_source, value_span, text, range)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn num_filter() {
+        assert_eq!(num(3000.0, None), "3000");
+        assert_eq!(num(2.5, None), "2.5");
+        assert_eq!(num(-0.0001, None), "0");
+        assert_eq!(num(1.23456, Some(2)), "1.23");
+    }
+
+    #[test]
+    fn syntax_error_has_range() {
+        let e = check_template("G01\n{{ foo ").unwrap_err();
+        assert!(e.range.is_some(), "{e:?}");
+    }
+}

@@ -1,0 +1,69 @@
+use kinpost_nc::Dialect;
+
+fn err(src: &str) -> kinpost_nc::Diagnostic {
+    let e = Dialect::from_toml(src, "my.toml").unwrap_err();
+    assert_eq!(e.0.len(), 1, "{e}");
+    e.0[0].clone()
+}
+
+#[test]
+fn unknown_key_has_exact_line_and_column() {
+    let d = err("name = \"x\"\nextension = \"nc\"\n\n[linear]\ndecimals = 3\n  prefx = \"X\"\n");
+    assert_eq!(
+        (d.file.as_str(), d.line, d.column),
+        ("my.toml", 6, 3),
+        "{d}"
+    );
+    assert!(d.message.contains("prefx"), "{d}");
+    assert_eq!(d.source_line, "  prefx = \"X\"");
+}
+
+#[test]
+fn unknown_top_level_table() {
+    let d = err("name = \"x\"\nextension = \"nc\"\n[blok]\n");
+    assert_eq!((d.line, d.column), (3, 2), "{d}");
+}
+
+#[test]
+fn bad_values() {
+    let d = err("name = \"x\"\nextension = \"nc\"\n[rotary]\ntrailing_zeros = \"some\"\n");
+    assert_eq!((d.line, d.column), (4, 18), "{d}");
+    let d = err("name = \"x\"\nextension = \"nc\"\n[axis.A]\ndecimals = 12\n");
+    assert_eq!((d.line, d.column), (4, 12), "{d}");
+    assert!(d.message.contains("decimals"));
+    let d = err("name = \"x\"\nextension = \"nc\"\n[axis.A]\nmodulo = -360.0\n");
+    assert_eq!((d.line, d.column), (4, 10), "{d}");
+    let d = err("name = \"x\"\nextension = \".nc\"\n");
+    assert_eq!((d.line, d.column), (2, 13), "{d}");
+    let d = err("name = \"x\"\nextension = \"nc\"\n[linear]\ndecimals = \"3\"\n");
+    assert_eq!(d.line, 4, "{d}");
+    let d = err("extension = \"nc\"\n");
+    assert!(d.message.contains("name"), "{d}");
+    let d = err(
+        "name = \"x\"\nextension = \"nc\"\n[axis.A]\nprefix = \"AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA\"\n",
+    );
+    assert_eq!((d.line, d.column), (4, 10), "{d}");
+    let d = err("name = \"x\"\nextension = \"nc\"\n[axis.A]\ndecimals = 2\nmodulo = 0.001\n");
+    assert_eq!((d.line, d.column), (5, 10), "{d}");
+}
+
+#[test]
+fn template_syntax_error_points_into_the_file() {
+    let src = "name = \"x\"\nextension = \"nc\"\n[templates]\nheader = '''\n; {{ program_name }}\nG01 {% if x %}\n'''\n";
+    let d = err(src);
+    assert_eq!(d.line, 6, "{d}");
+    assert!(d.column >= 5, "{d}");
+    assert!(d.message.contains("header"), "{d}");
+    let src = "name = \"x\"\nextension = \"nc\"\n[templates]\nfooter = \"M30 {{ x \"\n";
+    let d = err(src);
+    assert_eq!(d.line, 4, "{d}");
+    assert!(d.column > 10, "{d}");
+}
+
+#[test]
+fn rendered_diagnostic() {
+    let e =
+        Dialect::from_toml("name = \"x\"\nextension = \"nc\"\nbogus = 1\n", "my.toml").unwrap_err();
+    let s = e.to_string();
+    assert!(s.contains("--> my.toml:3:1"), "{s}");
+}

@@ -1,0 +1,607 @@
+use std::collections::BTreeMap;
+
+use kinpost_nc::{
+    AxisSpec, Block, Dialect, Motion, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
+    check_template, read_program, read_program_full,
+};
+
+/// Machine axes of the MTS1600-500-6NC in chain order (DESIGN §2.1).
+fn mts_axes() -> Vec<AxisSpec> {
+    vec![
+        AxisSpec::linear("X"),
+        AxisSpec::rotary("A"),
+        AxisSpec::linear("Y"),
+        AxisSpec::linear("Z"),
+        AxisSpec::rotary("B"),
+        AxisSpec::rotary("C").fixed(),
+    ]
+}
+
+const SEED: &str = include_str!("../../../../shared/data/seed000/figure28b-verbatim.mpf");
+
+/// The motion blocks of seed 000 Figure 28(b), as (X, Y, Z, B, A).
+fn seed_blocks() -> Vec<(String, [f64; 5])> {
+    SEED.lines()
+        .filter(|l| l.starts_with("X="))
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .map(|w| {
+                    let n = w
+                        .trim_start_matches(|c: char| {
+                            c.is_ascii_alphabetic() || c == '=' || c == '('
+                        })
+                        .trim_end_matches(')');
+                    n.parse().unwrap()
+                })
+                .collect();
+            (l.to_string(), [v[0], v[1], v[2], v[3], v[4]])
+        })
+        .collect()
+}
+
+fn text(w: NcWriter<Vec<u8>>) -> String {
+    String::from_utf8(w.finish().unwrap()).unwrap()
+}
+
+#[test]
+fn golden_seed_000_feed_blocks() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let seed = seed_blocks();
+    assert_eq!(seed.len(), 11);
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    for (k, (_, [x, y, z, b, a])) in seed.iter().enumerate() {
+        // Perturb below the 4th decimal, with both signs (A slightly negative:
+        // the DC word must still read 0.000, not 360.000 or -0.000).
+        let e = if k % 2 == 0 { 3.7e-5 } else { -4.1e-5 };
+        let values = [x + e, a - 2.0e-5, y - e, z + e, b + e, 0.0];
+        w.block(&Block {
+            cl_line: Some(17 + k),
+            motion: Motion::Feed,
+            axes: &values,
+            feed: Some(250.0),
+        })
+        .unwrap();
+    }
+    assert_eq!(w.blocks_written(), 11);
+    let out = text(w);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], format!("{} F250", seed[0].0));
+    for (k, line) in lines.iter().enumerate().skip(1) {
+        assert_eq!(*line, seed[k].0);
+    }
+    assert_eq!(
+        lines[0],
+        "X=459.000 Y=8.807 Z361.368 B0.000 A=DC(0.000) F250"
+    );
+}
+
+#[test]
+fn sinumerik_rapid_then_feed_and_modal_feed() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
+    w.block(&Block {
+        cl_line: Some(10),
+        motion: Motion::Rapid,
+        axes: &p,
+        feed: None,
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: Some(12),
+        motion: Motion::Rapid,
+        axes: &p,
+        feed: None,
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: Some(14),
+        motion: Motion::Feed,
+        axes: &p,
+        feed: Some(250.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: Some(15),
+        motion: Motion::Feed,
+        axes: &p,
+        feed: Some(250.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: Some(16),
+        motion: Motion::Feed,
+        axes: &p,
+        feed: Some(312.5),
+    })
+    .unwrap();
+    assert_eq!(
+        text(w),
+        "G0 X=459.000 Y=8.500 Z380.000 B10.250 A=DC(270.000)\n\
+         X=459.000 Y=8.500 Z380.000 B10.250 A=DC(270.000)\n\
+         G1 X=459.000 Y=8.500 Z380.000 B10.250 A=DC(270.000) F250\n\
+         X=459.000 Y=8.500 Z380.000 B10.250 A=DC(270.000)\n\
+         X=459.000 Y=8.500 Z380.000 B10.250 A=DC(270.000) F312.5\n"
+    );
+}
+
+#[test]
+fn quantized_matches_dialect_quantize_and_printed_text() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let w = NcWriter::new(&dialect, &axes, Vec::new());
+    assert_eq!(w.quantized(1, -0.00002), 0.0);
+    assert_eq!(w.quantized(1, -90.0004), 270.0);
+    assert_eq!(w.quantized(1, -90.0006), 269.999);
+    assert_eq!(w.quantized(1, 719.9996), 0.0);
+    assert_eq!(w.quantized(2, 8.80694), 8.807);
+    assert_eq!(dialect.quantize(&axes[2], 8.80694), 8.807);
+    assert_eq!(dialect.quantize(&axes[1], -90.0), 270.0);
+}
+
+#[test]
+fn header_footer_templates_and_overrides() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let mut info = ProgramInfo {
+        program_name: "GRINDING PRESURE".into(),
+        date: "2024-05-01".into(),
+        machine: "MTS1600-500-6NC".into(),
+        tool: "BELT".into(),
+        tool_number: 1,
+        cl_file: "figure28a.cls".into(),
+        extra: BTreeMap::new(),
+    };
+    info.extra.insert("pressure".into(), "3000".into());
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    w.header(&info, None).unwrap();
+    w.footer(
+        &info,
+        Some("M30 ; {{ program_name }} H1={{ extra.pressure }} {{ pressure }}"),
+    )
+    .unwrap();
+    let out = text(w);
+    assert!(
+        out.starts_with("; PROGRAM NAME: GRINDING PRESURE\n"),
+        "{out}"
+    );
+    assert!(out.contains("; DATE: 2024-05-01\n"));
+    assert!(out.contains("; MACHINE: MTS1600-500-6NC\n"));
+    assert!(out.contains("(DIALECT sinumerik)\n"));
+    assert!(
+        out.ends_with("G01\nM30 ; GRINDING PRESURE H1=3000 3000\n"),
+        "{out}"
+    );
+    assert!(!out.contains("\n\n"));
+}
+
+#[test]
+fn seed_header_as_machine_override() {
+    // The header of Figure 28(b) as a machine file would give it.
+    let header: String = SEED
+        .lines()
+        .take_while(|l| !l.starts_with("X="))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let template = header
+        .replace("GRINDING PRESURE", "{{ program_name }}")
+        .replace("T1", "T{{ tool_number }}");
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let info = ProgramInfo {
+        program_name: "GRINDING PRESURE".into(),
+        tool_number: 1,
+        ..Default::default()
+    };
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    w.header(&info, Some(&template)).unwrap();
+    let mut f = true;
+    for (_, [x, y, z, b, a]) in seed_blocks() {
+        w.block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &[x, a, y, z, b, 0.0],
+            feed: if f { None } else { Some(250.0) },
+        })
+        .unwrap();
+        f = false;
+    }
+    let out = text(w);
+    let want: String = SEED.lines().map(|l| format!("{l}\n")).collect();
+    // Only the second block differs: it carries the F word.
+    let diff: Vec<(&str, &str)> = out
+        .lines()
+        .zip(want.lines())
+        .filter(|(a, b)| a != b)
+        .collect();
+    assert_eq!(
+        diff,
+        vec![(
+            "X=459.000 Y=9.126 Z359.765 B0.000 A=DC(0.000) F250",
+            "X=459.000 Y=9.126 Z359.765 B0.000 A=DC(0.000)"
+        )]
+    );
+    // The reader reads our output back: the header's `N150 B0 C0` and
+    // `N130 G01 B0 F5000` are motion too; 11 blocks from the body.
+    let blocks = read_program(&dialect, &axes, "seed.mpf", &out).unwrap();
+    let body: Vec<_> = blocks.iter().filter(|b| b.axes[0].is_some()).collect();
+    assert_eq!(body.len(), 11);
+    assert_eq!(
+        body[0].axes,
+        vec![
+            Some(459.0),
+            Some(0.0),
+            Some(8.807),
+            Some(361.368),
+            Some(0.0),
+            Some(0.0)
+        ]
+    );
+    assert_eq!(body[0].feed, Some(5000.0));
+    assert_eq!(body[1].feed, Some(250.0));
+    assert!(body.iter().all(|b| b.motion == Motion::Feed));
+}
+
+#[test]
+fn commands_tool_spindle_coolant_pressure() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    w.tool_change(3, "WHEEL").unwrap();
+    w.spindle(Spindle::Cw(3013.0)).unwrap();
+    w.spindle(Spindle::Ccw(3000.4)).unwrap();
+    w.coolant(Some("flood")).unwrap();
+    w.coolant(Some("mist")).unwrap();
+    w.coolant(None).unwrap();
+    w.pressure(3000.0).unwrap();
+    w.spindle(Spindle::Off).unwrap();
+    w.comment("posted by (kinpost)\nline two").unwrap();
+    w.insert("G642 U1030").unwrap();
+    assert_eq!(
+        text(w),
+        "T3\nM6\nS3013 M03\nS3000 M04\nM08\nM07\nM09\nH1=3000\nM05\n; posted by (kinpost) line two\nG642 U1030\n"
+    );
+    assert!(dialect.template(TemplateKind::Pressure).is_some());
+}
+
+#[test]
+fn template_render_errors_are_reported() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    let mut w = NcWriter::new(&dialect, &mts_axes(), Vec::new());
+    let e = w
+        .header(&ProgramInfo::default(), Some("{{ no_such_variable }}"))
+        .unwrap_err();
+    assert!(matches!(e, NcError::Template { .. }), "{e}");
+    assert!(e.to_string().contains("undefined"), "{e}");
+    let e = check_template("G01\n{% if x %}").unwrap_err();
+    assert!(e.range.is_some());
+    assert!(check_template("T{{ tool_number }}").is_ok());
+    let mut vars = BTreeMap::new();
+    vars.insert("x".to_string(), kinpost_nc::Value::from(2.5));
+    assert_eq!(
+        dialect.render_template("R{{ x | num }}", &vars).unwrap(),
+        "R2.5"
+    );
+}
+
+const HEIDENHAIN_LIKE: &str = r#"
+name = "heidenhain-test"
+extension = "h"
+description = "Heidenhain conversational, as a user file"
+
+[block]
+order = ["X", "Y", "Z", "B", "A"]
+after_axes = "R0"
+
+[linear]
+plus_sign = true
+modal = true
+
+[rotary]
+plus_sign = true
+modal = true
+
+[feed]
+decimals = 0
+rapid = "FMAX"
+
+[motion]
+rapid = "L"
+feed = "L"
+modal = false
+
+[numbering]
+enabled = true
+prefix = ""
+start = 0
+step = 1
+header = true
+comments = true
+
+[comment]
+prefix = "* - "
+replace = { ";" = "," }
+
+[templates]
+header = "BEGIN PGM {{ program_name }} MM"
+footer = "END PGM {{ program_name }} MM"
+"#;
+
+#[test]
+fn user_dialect_heidenhain_like() {
+    let d = Dialect::from_toml(HEIDENHAIN_LIKE, "heid.toml").unwrap();
+    assert_eq!((d.name(), d.extension()), ("heidenhain-test", "h"));
+    let axes = mts_axes();
+    let info = ProgramInfo {
+        program_name: "P1".into(),
+        ..Default::default()
+    };
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    w.header(&info, None).unwrap();
+    w.comment("approach; slowly").unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Rapid,
+        axes: &[1.0, 0.0, -2.0, 3.0, 0.0, 0.0],
+        feed: None,
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[1.0, 0.0, -2.5, 3.0, 0.0, 0.0],
+        feed: Some(250.0),
+    })
+    .unwrap();
+    // Nothing changed: no block at all.
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[1.0, 0.0, -2.5, 3.0, 0.0, 0.0],
+        feed: Some(250.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[1.0, 0.0, -2.5, 3.0004, 0.0, 0.0],
+        feed: Some(250.2),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[1.0, 0.0, -2.5, 3.5, 0.0, 0.0],
+        feed: Some(250.0),
+    })
+    .unwrap();
+    assert_eq!(w.blocks_written(), 3);
+    w.footer(&info, None).unwrap();
+    let out = text(w);
+    assert_eq!(
+        out,
+        "0 BEGIN PGM P1 MM\n\
+         1 * - approach, slowly\n\
+         2 L X+1.000 Y-2.000 Z+3.000 B+0.000 A+0.000 R0 FMAX\n\
+         3 L Y-2.500 R0 F250\n\
+         4 L Z+3.500 R0\n\
+         5 END PGM P1 MM\n"
+    );
+    let blocks = read_program(&d, &axes, "p.h", &out).unwrap();
+    assert_eq!(blocks.len(), 3);
+    assert_eq!(blocks[0].motion, Motion::Rapid);
+    assert_eq!(blocks[0].number, Some(2));
+    assert_eq!(blocks[1].motion, Motion::Feed);
+    assert_eq!(
+        blocks[2].axes,
+        vec![Some(1.0), Some(0.0), Some(-2.5), Some(3.5), Some(0.0), None]
+    );
+    assert_eq!(blocks[2].feed, Some(250.0));
+}
+
+#[test]
+fn n_numbering_and_parenthesis_comments() {
+    let src = r#"
+name = "linuxcnc-test"
+extension = "ngc"
+[block]
+write_fixed = true
+[linear]
+trailing_zeros = "trim"
+leading_zero = false
+[rotary]
+trailing_zeros = "point"
+[numbering]
+enabled = true
+start = 100
+step = 5
+digits = 4
+wrap_after = 110
+[comment]
+prefix = "("
+suffix = ")"
+replace = { "(" = "[", ")" = "]" }
+[templates]
+header = "%\n(PROGRAM {{ program_name }})"
+footer = "M2\n%"
+"#;
+    let d = Dialect::from_toml(src, "lcnc.toml").unwrap();
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::linear("Y"),
+        AxisSpec::rotary("C").fixed(),
+    ];
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let info = ProgramInfo {
+        program_name: "T".into(),
+        ..Default::default()
+    };
+    w.header(&info, None).unwrap();
+    w.comment("a (nested) note").unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Rapid,
+        axes: &[0.5, -0.25, 90.0],
+        feed: None,
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[10.0, -0.25, 90.0],
+        feed: Some(100.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[11.0, -0.25, 90.0],
+        feed: Some(100.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[12.0, -0.25, 90.0],
+        feed: Some(100.0),
+    })
+    .unwrap();
+    w.footer(&info, None).unwrap();
+    let out = text(w);
+    assert_eq!(
+        out,
+        "%\n(PROGRAM T)\n(a [nested] note)\n\
+         N0100 G0 X.5 Y-.25 C90.\n\
+         N0105 G1 X10 Y-.25 C90. F100\n\
+         N0110 X11 Y-.25 C90.\n\
+         N0100 X12 Y-.25 C90.\n\
+         M2\n%\n"
+    );
+    let read = read_program_full(&d, &axes, "t.ngc", &out).unwrap();
+    assert_eq!(read.blocks.len(), 4);
+    assert_eq!(
+        read.blocks[0].axes,
+        vec![Some(0.5), Some(-0.25), Some(90.0)]
+    );
+    assert_eq!(read.blocks[0].motion, Motion::Rapid);
+    assert_eq!(read.blocks[3].number, Some(100));
+    assert_eq!(read.blocks[3].feed, Some(100.0));
+    assert_eq!(read.other_lines, vec![1, 8, 9]);
+}
+
+#[test]
+fn csv_rows() {
+    let d = Dialect::builtin("csv").unwrap();
+    assert_eq!(d.extension(), "csv");
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    w.header(&ProgramInfo::default(), None).unwrap();
+    w.comment("dropped").unwrap();
+    w.insert("dropped").unwrap();
+    w.tool_change(1, "T").unwrap();
+    w.block(&Block {
+        cl_line: Some(10),
+        motion: Motion::Rapid,
+        axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
+        feed: None,
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
+        feed: Some(250.0),
+    })
+    .unwrap();
+    w.block(&Block {
+        cl_line: Some(17),
+        motion: Motion::Feed,
+        axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
+        feed: Some(250.0),
+    })
+    .unwrap();
+    w.footer(&ProgramInfo::default(), None).unwrap();
+    let out = text(w);
+    assert_eq!(
+        out,
+        "line,motion,X,A,Y,Z,B,C,feed\n\
+         10,rapid,459.000000,-90.000000,8.806940,361.368000,0.000000,0.000000,\n\
+         ,feed,459.000000,-90.000000,8.806940,361.368000,0.000000,0.000000,250.000000\n\
+         17,feed,459.000000,-90.000000,8.806940,361.368000,0.000000,0.000000,250.000000\n"
+    );
+    let blocks = read_program(&d, &axes, "p.csv", &out).unwrap();
+    assert_eq!(blocks.len(), 3);
+    assert_eq!(blocks[0].cl_line, Some(10));
+    assert_eq!(blocks[1].cl_line, None);
+    assert_eq!(blocks[1].feed, Some(250.0));
+    assert_eq!(blocks[0].feed, None);
+    assert_eq!(blocks[2].axes[2], Some(8.80694));
+}
+
+#[test]
+fn csv_reader_errors_name_line_and_column() {
+    let d = Dialect::builtin("csv").unwrap();
+    let axes = [AxisSpec::linear("X"), AxisSpec::linear("Y")];
+    let e = read_program(&d, &axes, "p.csv", "line,motion,X,Y,feed\n1,feed,1.0,x2,\n").unwrap_err();
+    assert_eq!((e.file.as_str(), e.line, e.column), ("p.csv", 2, 12));
+    let e = read_program(&d, &axes, "p.csv", "line,motion,X,Q,feed\n").unwrap_err();
+    assert_eq!((e.line, e.column), (1, 15));
+    let e = read_program(&d, &axes, "p.csv", "line,motion,X,Y,feed\n1,fed,1,2,\n").unwrap_err();
+    assert_eq!((e.line, e.column), (2, 3));
+}
+
+#[test]
+fn empty_csv_has_header_row() {
+    let d = Dialect::builtin("csv").unwrap();
+    let w = NcWriter::new(&d, &[AxisSpec::linear("X")], Vec::new());
+    assert_eq!(text(w), "line,motion,X,feed\n");
+}
+
+#[test]
+fn bad_values_are_errors() {
+    let d = Dialect::builtin("sinumerik").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let e = w
+        .block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0],
+            feed: None,
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("X"), "{e}");
+    assert!(
+        w.block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &[1e300, 0.0, 0.0, 0.0, 0.0, 0.0],
+            feed: None
+        })
+        .is_err()
+    );
+    assert!(
+        w.block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &[0.0],
+            feed: None
+        })
+        .is_err()
+    );
+    assert_eq!(w.blocks_written(), 0);
+    assert_eq!(text(w), "");
+}
+
+#[test]
+fn builtins_parse_and_list() {
+    for name in Dialect::builtin_names() {
+        let d = Dialect::builtin(name).unwrap();
+        assert_eq!(d.name(), *name);
+        assert!(Dialect::builtin_source(name).unwrap().contains("name ="));
+    }
+    assert!(Dialect::builtin("nope").is_none());
+}

@@ -1,0 +1,44 @@
+//! Fuzz target: any bytes fed to the CL reader, with and without a default
+//! tool axis, must never panic or loop, and every diagnostic must point into
+//! the input. Run with `cargo +nightly fuzz run cl_reader` from the
+//! repository root.
+
+#![no_main]
+
+use kinpost_cl::{ClEvent, ClReader};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let lines = data.split(|&b| b == b'\n').count();
+    for default_axis in [false, true] {
+        let mut reader = ClReader::new(data, "fuzz.cls");
+        if default_axis {
+            reader = reader.with_default_axis([0.0, 0.0, 1.0]);
+        }
+        // Every call consumes at least one line.
+        let mut calls = 0;
+        loop {
+            calls += 1;
+            assert!(calls <= lines + 1, "the reader does not advance");
+            let result = reader.next_statement();
+            for w in reader.take_warnings() {
+                assert!(w.line >= 1 && w.line <= lines && w.column >= 1);
+            }
+            match result {
+                Ok(None) => break,
+                Ok(Some(statement)) => {
+                    assert!(statement.line >= 1 && statement.line <= lines);
+                    if let ClEvent::Goto { point, axis, .. } = statement.event {
+                        assert!(point.iter().all(|v| v.is_finite()));
+                        let n: f64 = axis.iter().map(|v| v * v).sum();
+                        assert!((n - 1.0).abs() < 1e-12);
+                    }
+                }
+                Err(e) => {
+                    assert!(e.line >= 1 && e.line <= lines && e.column >= 1);
+                    let _ = e.to_string();
+                }
+            }
+        }
+    }
+});
