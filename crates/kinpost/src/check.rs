@@ -94,7 +94,11 @@ mod tests {
         let lever = m.largest_pivot_distance();
         let want = 3.0 * 0.0005 + 2.0 * 0.0005f64.to_radians() * lever + 1e-9;
         assert!((t.position_mm - want).abs() < 1e-15);
-        assert!(lever > 79.0 && lever < 2100.0, "{lever}");
+        // The A line (the X axis) is farthest from the home contact point
+        // (43, 79.2, −350); the travel box is 1750.5 × 501 × 501.3 mm.
+        let want_lever = (79.2f64.powi(2) + 350.0f64.powi(2)).sqrt()
+            + (1750.5f64.powi(2) + 501.0f64.powi(2) + 501.3f64.powi(2)).sqrt();
+        assert!((lever - want_lever).abs() < 1e-9, "{lever} vs {want_lever}");
         assert!((t.axis_rad - (2.0 * 0.0005f64.to_radians() + 1e-9)).abs() < 1e-15);
     }
 

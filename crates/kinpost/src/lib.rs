@@ -11,7 +11,7 @@
 //! use kinpost::{post, PostOptions};
 //! let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
 //! let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
-//! let cl = "GOTO/-416,70.5,16.53,0,0,1\nFEDRAT/MMPM,250\nGOTO/-416,70.3931,11.3684\n";
+//! let cl = "RAPID\nGOTO/-416,70.5,16.53,0,0,1\nFEDRAT/MMPM,250\nGOTO/-416,70.3931,11.3684\n";
 //! let mut nc = Vec::new();
 //! let options = PostOptions { cl_file: "flat.cls".into(), ..Default::default() };
 //! let summary = post(cl.as_bytes(), &machine, &dialect, &mut nc, &options).unwrap();

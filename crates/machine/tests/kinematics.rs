@@ -96,12 +96,13 @@ fn fk_of_ik_is_the_pose_for_every_branch_and_ik_of_fk_contains_q() {
                 let mut fast = Vec::new();
                 kin.ik(&pose, Some(&q), &mut fast).unwrap();
                 prop_assert!(fast.iter().all(|f| sols.contains(f)));
-                prop_assert!(fast.iter().any(|s| {
+                let has_q = fast.iter().any(|s| {
                     s.joints[..q.len()]
                         .iter()
                         .zip(&q)
                         .all(|(a, b)| (a - b).abs() < 1e-7)
-                }));
+                });
+                prop_assert!(has_q, "{}: fast ik lost q", m.name);
                 if sols.iter().any(|s| s.branch == 1) {
                     two_branches.set(two_branches.get() + 1);
                 }
