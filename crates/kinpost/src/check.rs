@@ -67,18 +67,36 @@ pub struct CheckStats {
     pub max_axis_error_rad: f64,
     /// CL line of the block with the largest position error.
     pub worst_line: Option<usize>,
+    /// sin of `max_axis_error_rad`, to skip the `atan2` of smaller errors.
+    sin_max_axis: f64,
 }
 
 impl CheckStats {
-    /// Records one block; returns its errors.
-    pub fn record(&mut self, want: &Pose, got: &Pose, line: usize) -> (f64, f64) {
-        let (p, a) = pose_error(want, got);
-        if p > self.max_position_error_mm {
-            self.max_position_error_mm = p;
+    /// Records one block; returns whether it is within `tolerance`. Only
+    /// errors that may be new maxima or failures are measured exactly (one
+    /// `sqrt`/`atan2` saved per block on the hot path).
+    pub fn record(&mut self, want: &Pose, got: &Pose, line: usize, tolerance: &Tolerance) -> bool {
+        let d2 = (want.point - got.point).norm_squared();
+        let max = self.max_position_error_mm;
+        if d2 > max * max {
+            self.max_position_error_mm = d2.sqrt();
             self.worst_line = Some(line);
         }
-        self.max_axis_error_rad = self.max_axis_error_rad.max(a);
-        (p, a)
+        let sin = want.axis.cross(&got.axis).norm();
+        let cos = want.axis.dot(&got.axis);
+        if cos <= 0.0 || sin > self.sin_max_axis {
+            let a = sin.atan2(cos);
+            if a > self.max_axis_error_rad {
+                self.max_axis_error_rad = a;
+                self.sin_max_axis = if a < std::f64::consts::FRAC_PI_2 {
+                    a.sin()
+                } else {
+                    1.0
+                };
+            }
+        }
+        self.max_position_error_mm <= tolerance.position_mm
+            && self.max_axis_error_rad <= tolerance.axis_rad
     }
 }
 
@@ -100,6 +118,27 @@ mod tests {
             + (1750.5f64.powi(2) + 501.0f64.powi(2) + 501.3f64.powi(2)).sqrt();
         assert!((lever - want_lever).abs() < 1e-9, "{lever} vs {want_lever}");
         assert!((t.axis_rad - (2.0 * 0.0005f64.to_radians() + 1e-9)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn stats_keep_exact_maxima() {
+        let pose = |x: f64, ax: f64| Pose {
+            point: Vector3::new(x, 0.0, 0.0),
+            axis: Vector3::new(ax.sin(), 0.0, ax.cos()),
+            reference: None,
+        };
+        let tol = Tolerance {
+            position_mm: 0.5,
+            axis_rad: 0.25,
+        };
+        let mut s = CheckStats::default();
+        assert!(s.record(&pose(0.0, 0.0), &pose(0.3, 0.2), 7, &tol));
+        assert!(s.record(&pose(0.0, 0.0), &pose(0.1, 0.1), 8, &tol));
+        assert!((s.max_position_error_mm - 0.3).abs() < 1e-15);
+        assert!((s.max_axis_error_rad - 0.2).abs() < 1e-15);
+        assert_eq!(s.worst_line, Some(7));
+        assert!(!s.record(&pose(0.0, 0.0), &pose(0.0, 2.5), 9, &tol));
+        assert!((s.max_axis_error_rad - 2.5).abs() < 1e-12);
     }
 
     #[test]

@@ -15,7 +15,7 @@ use kinpost_nc::{AxisSpec, Block, Dialect, NcError, NcWriter, ProgramInfo, Spind
 use kinpost_plan::{NearestPlanner, Planner, Rejection};
 use nalgebra::Vector3;
 
-use crate::check::{CheckStats, Tolerance};
+use crate::check::{CheckStats, Tolerance, pose_error};
 use crate::summary::Summary;
 
 /// Settings of one post run.
@@ -339,8 +339,8 @@ impl<W: Write> Job<'_, W> {
             self.written[i] = self.writer.quantized(i, chosen.joints[i]);
         }
         let reached = self.kin.fk(&self.written[..n]);
-        let (p, a) = self.stats.record(pose, &reached, line);
-        if p > self.tolerance.position_mm || a > self.tolerance.axis_rad {
+        if !self.stats.record(pose, &reached, line, &self.tolerance) {
+            let (p, a) = pose_error(pose, &reached);
             return Err(at(format!(
                 "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
                  from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",

@@ -22,7 +22,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{FREE_EPS, rotation, sp1, sp2};
+use crate::subproblems::{Angle, FREE_EPS, rotation, sp1_cs, sp2};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -93,7 +93,14 @@ struct Link {
     index: usize,
     /// Position among the free linear axes (the column of the linear solve).
     free_lin: Option<usize>,
+    /// Position among the free rotary axes (effective-chain order).
+    slot: Option<usize>,
+    /// Rotation of a rotary axis locked by `fixed`.
+    fixed_rot: Matrix3<f64>,
 }
+
+/// Rotation matrices of the free rotary axes, by slot.
+type Rots = [Matrix3<f64>; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
@@ -117,8 +124,9 @@ pub struct Kinematics {
     between: Vec<Matrix3<f64>>,
     /// Free linear axes, machine-file indices.
     free_lin: Vec<usize>,
-    /// Rotation of every rotary axis locked by `fixed` (identity elsewhere).
-    fixed_rots: [Matrix3<f64>; MAX_AXES],
+    /// Axis index and own direction of each free rotary slot.
+    slot_axis: Vec<usize>,
+    slot_dir: Vec<Vector3<f64>>,
 }
 
 #[inline]
@@ -143,7 +151,7 @@ impl Kinematics {
         let mut is_fixed = [false; MAX_AXES];
         let mut limits = [None; MAX_AXES];
         let mut rotary = [false; MAX_AXES];
-        let (mut tool_chain, mut work_chain) = (Vec::new(), Vec::new());
+        let (mut tool_chain, mut work_chain): (Vec<Link>, Vec<Link>) = (Vec::new(), Vec::new());
         for (i, a) in machine.axes.iter().enumerate() {
             fixed[i] = a.fixed.unwrap_or(0.0);
             is_fixed[i] = a.fixed.is_some();
@@ -161,6 +169,8 @@ impl Kinematics {
                 point: a.point,
                 index: i,
                 free_lin,
+                slot: None,
+                fixed_rot: Matrix3::identity(),
             };
             match a.side {
                 Side::Tool => tool_chain.push(link),
@@ -193,10 +203,16 @@ impl Kinematics {
             }
         }
         let free_lin = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
-        let mut fixed_rots = [Matrix3::identity(); MAX_AXES];
-        for (i, a) in machine.axes.iter().enumerate() {
-            if let (true, Some(v)) = (a.is_rotary(), a.fixed) {
-                fixed_rots[i] = rotation(&a.direction, rad(v));
+        // Slots of the free rotary axes and cached rotations of fixed ones.
+        let slot_axis: Vec<usize> = free_rot.iter().map(|&(i, _)| i).collect();
+        let slot_dir = slot_axis
+            .iter()
+            .map(|&i| machine.axes[i].direction)
+            .collect();
+        for l in tool_chain.iter_mut().chain(work_chain.iter_mut()) {
+            l.slot = free_rot.iter().position(|&(i, _)| i == l.index);
+            if l.kind == AxisKind::Rotary && is_fixed[l.index] {
+                l.fixed_rot = rotation(&l.dir, rad(fixed[l.index]));
             }
         }
         Kinematics {
@@ -215,7 +231,8 @@ impl Kinematics {
             free_rot,
             between,
             free_lin,
-            fixed_rots,
+            slot_axis,
+            slot_dir,
         }
     }
 
@@ -227,7 +244,11 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
-        let e = self.eval(q, &self.rotations(q));
+        let mut rots = [Matrix3::identity(); 3];
+        for (k, &i) in self.slot_axis.iter().enumerate() {
+            rots[k] = rotation(&self.slot_dir[k], rad(q[i]));
+        }
+        let e = self.eval(q, &rots);
         Pose {
             point: e.point,
             axis: e.axis,
@@ -235,22 +256,19 @@ impl Kinematics {
         }
     }
 
-    /// Rotation matrix of every rotary axis at `q` (fixed axes from the cache).
+    /// The rotation of link `l` (cached for fixed axes).
     #[inline]
-    fn rotations(&self, q: &[f64]) -> [Matrix3<f64>; MAX_AXES] {
-        let mut rots = self.fixed_rots;
-        for l in self.tool_chain.iter().chain(&self.work_chain) {
-            if l.kind == AxisKind::Rotary && !self.is_fixed[l.index] {
-                rots[l.index] = rotation(&l.dir, rad(q[l.index]));
-            }
+    fn rot<'a>(l: &'a Link, rots: &'a Rots) -> &'a Matrix3<f64> {
+        match l.slot {
+            Some(k) => &rots[k],
+            None => &l.fixed_rot,
         }
-        rots
     }
 
     /// One pass over both chains: the tool pose in the part frame at `q`, and
     /// the column of each free linear axis (the pose is affine in them).
     #[inline]
-    fn eval(&self, q: &[f64], rots: &[Matrix3<f64>; MAX_AXES]) -> Eval {
+    fn eval(&self, q: &[f64], rots: &Rots) -> Eval {
         // Tool chain, base outwards: T = G_t1 ⋯ G_tm, G x = g (x − p) + p.
         let mut r = Matrix3::identity();
         let mut t = Vector3::zeros();
@@ -265,7 +283,7 @@ impl Kinematics {
                     t += d * q[l.index];
                 }
                 AxisKind::Rotary => {
-                    let g = &rots[l.index];
+                    let g = Self::rot(l, rots);
                     t += r * (l.point - g * l.point);
                     r *= g;
                 }
@@ -286,7 +304,7 @@ impl Kinematics {
                     st += l.dir * q[l.index];
                 }
                 AxisKind::Rotary => {
-                    let g = &rots[l.index];
+                    let g = Self::rot(l, rots);
                     sr = g * sr;
                     st = g * st + (l.point - g * l.point);
                 }
@@ -345,7 +363,11 @@ impl Kinematics {
         out.clear();
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
         let target = self.rw0 * pose.axis;
-        let mut orientations: [(Joints, bool); 2] = [(self.fixed, false); 2];
+        let mut orientations = [Orientation {
+            joints: self.fixed,
+            singular: false,
+            angles: [ZERO_ANGLE; 3],
+        }; 2];
         let count;
         match self.free_rot.len() {
             0 => {
@@ -361,12 +383,12 @@ impl Kinematics {
                 if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
                     return Err(IkError::OrientationUnreachable);
                 }
-                let (q, singular) = match sp1(&w, &u, &v) {
-                    Some(t) => (t.to_degrees(), false),
-                    None => (hint_of(i), true),
-                };
-                orientations[0].0[i] = q;
-                orientations[0].1 = singular;
+                let o = &mut orientations[0];
+                let angle = sp1_cs(&w, &u, &v).unwrap_or_else(|| {
+                    o.singular = true;
+                    degrees(hint_of(i))
+                });
+                o.set(0, i, angle);
                 count = 1;
             }
             nfree => {
@@ -396,48 +418,40 @@ impl Kinematics {
                     return Err(IkError::OrientationUnreachable);
                 }
                 for (k, s) in sols[..n].iter().enumerate() {
-                    let mut j = self.fixed;
-                    let mut singular = false;
-                    let mut pick = |theta: Option<f64>, i: usize| match theta {
-                        Some(t) => t.to_degrees(),
-                        None => {
-                            singular = true;
-                            hint_of(i)
+                    let o = &mut orientations[k];
+                    let (a1, a2) = match (s.theta1, s.theta2) {
+                        (Some(a1), Some(a2)) => (a1, a2),
+                        // One angle is free (the tool axis lies on a rotary
+                        // axis): keep the hinted value and solve the other
+                        // one for it so that the tool axis is exact.
+                        (None, a2) => {
+                            o.singular = true;
+                            let a1 = degrees(hint_of(i1));
+                            let v = a1.rotation(&w1).transpose() * q;
+                            let a2 = sp1_cs(&w2e, &p, &v).or(a2).unwrap_or(degrees(hint_of(i2)));
+                            (a1, a2)
+                        }
+                        (Some(a1), None) => {
+                            o.singular = true;
+                            let a2 = degrees(hint_of(i2));
+                            let u = a2.rotation(&w2e) * p;
+                            (sp1_cs(&w1, &u, &q).unwrap_or(a1), a2)
                         }
                     };
-                    j[i1] = pick(s.theta1, i1);
-                    j[i2] = pick(s.theta2, i2);
-                    if s.theta1.is_none() || s.theta2.is_none() {
-                        // One angle was free: solve the other one for the
-                        // chosen value so that the tool axis is exact.
-                        let r1 = rotation(&w1, rad(j[i1]));
-                        let r2 = rotation(&w2e, rad(j[i2]));
-                        if s.theta1.is_none()
-                            && let Some(t) = sp1(&w2e, &p, &(r1.transpose() * q))
-                        {
-                            j[i2] = t.to_degrees();
-                        } else if s.theta2.is_none()
-                            && let Some(t) = sp1(&w1, &(r2 * p), &q)
-                        {
-                            j[i1] = t.to_degrees();
-                        }
-                    }
+                    o.set(0, i1, a1);
+                    o.set(1, i2, a2);
                     if let Some(target_rot) = full {
                         let (i3, w3) = self.free_rot[2];
-                        let r12 = c[0]
-                            * rotation(&w1, rad(j[i1]))
-                            * c[1]
-                            * rotation(&w2, rad(j[i2]))
-                            * c[2];
+                        let r12 = c[0] * a1.rotation(&w1) * c[1] * a2.rotation(&w2) * c[2];
                         let f3 = r12.transpose() * target_rot * c[3].transpose();
                         // Any vector off the axis shows the angle of F3.
                         let x = any_perpendicular(&w3);
-                        j[i3] = match sp1(&w3, &x, &(f3 * x)) {
-                            Some(t) => t.to_degrees(),
-                            None => hint_of(i3),
-                        };
+                        let a3 = sp1_cs(&w3, &x, &(f3 * x)).unwrap_or_else(|| {
+                            o.singular = true;
+                            degrees(hint_of(i3))
+                        });
+                        o.set(2, i3, a3);
                     }
-                    orientations[k] = (j, singular);
                 }
                 count = n;
             }
@@ -454,14 +468,18 @@ impl Kinematics {
             if !pass && !all_branches && out.iter().any(Solution::is_valid) {
                 break;
             }
-            for (k, (angles, singular)) in orientations[..count].iter().enumerate() {
-                if fits(angles) != pass {
+            for (k, o) in orientations[..count].iter().enumerate() {
+                if fits(&o.joints) != pass {
                     continue;
                 }
-                let Some(joints) = self.solve_linear(angles, &pose.point) else {
+                let mut rots = [Matrix3::identity(); 3];
+                for (slot, a) in o.angles[..self.free_rot.len()].iter().enumerate() {
+                    rots[slot] = a.rotation(&self.slot_dir[slot]);
+                }
+                let Some(joints) = self.solve_linear(&o.joints, &rots, &pose.point) else {
                     continue;
                 };
-                self.push_equivalents(joints, k as u8, *singular, hint, out);
+                self.push_equivalents(joints, k as u8, o.singular, hint, out);
             }
         }
         if out.is_empty() {
@@ -472,12 +490,12 @@ impl Kinematics {
 
     /// With every rotary angle set in `joints`, solves the free linear axes so
     /// that the tool point lands on `target` (part frame).
-    fn solve_linear(&self, joints: &Joints, target: &Vector3<f64>) -> Option<Joints> {
+    fn solve_linear(&self, joints: &Joints, rots: &Rots, target: &Vector3<f64>) -> Option<Joints> {
         let mut q = *joints;
         for &i in &self.free_lin {
             q[i] = 0.0;
         }
-        let e = self.eval(&q, &self.rotations(&q));
+        let e = self.eval(&q, rots);
         let rhs = target - e.point;
         let c = &e.cols;
         let m = self.free_lin.len();
@@ -585,12 +603,11 @@ impl Kinematics {
             None => {
                 // Unlimited: the turn nearest the hint (continuous output).
                 let h = hint.map_or(0.0, |h| h[i]);
-                joints[i] = principal + 360.0 * ((h - principal) / 360.0).round();
+                joints[i] = principal + 360.0 * turns_nearest((h - principal) / 360.0) as f64;
                 self.expand(k + 1, joints, branch, singular, hint, out);
             }
             Some([lo, hi]) => {
-                let first = ((lo - 1e-9 - principal) / 360.0).ceil() as i64;
-                let last = ((hi + 1e-9 - principal) / 360.0).floor() as i64;
+                let (first, last) = turn_range(lo, hi, principal);
                 for turn in first..=last {
                     joints[i] = principal + 360.0 * turn as f64;
                     self.expand(k + 1, joints, branch, singular, hint, out);
@@ -611,16 +628,78 @@ fn has_equivalent(limits: Option<[f64; 2]>, principal: f64) -> bool {
     match limits {
         None => true,
         Some([lo, hi]) => {
-            ((lo - 1e-9 - principal) / 360.0).ceil() <= ((hi + 1e-9 - principal) / 360.0).floor()
+            let (first, last) = turn_range(lo, hi, principal);
+            first <= last
         }
     }
+}
+
+// Rounding by integer conversion: `floor`, `ceil`, `round` and `fmod` are
+// library calls on baseline x86-64 and showed up in the posting profile.
+// Angles here are far below 2^53 turns.
+
+/// ⌊x⌋ as an integer.
+#[inline]
+fn floor_i(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}
+
+/// The nearest integer to x (halves away from zero or not: callers do not care).
+#[inline]
+fn turns_nearest(x: f64) -> i64 {
+    floor_i(x + 0.5)
+}
+
+/// The whole turns k with lo ≤ principal + 360k ≤ hi (1e-9° slack).
+#[inline]
+fn turn_range(lo: f64, hi: f64, principal: f64) -> (i64, i64) {
+    (
+        -floor_i(-(lo - 1e-9 - principal) / 360.0),
+        floor_i((hi + 1e-9 - principal) / 360.0),
+    )
 }
 
 /// Angle in degrees wrapped to (−180, 180].
 #[inline]
 pub fn wrap180(deg: f64) -> f64 {
-    let w = deg.rem_euclid(360.0);
-    if w > 180.0 { w - 360.0 } else { w }
+    let w = deg - 360.0 * turns_nearest(deg / 360.0) as f64;
+    if w <= -180.0 {
+        w + 360.0
+    } else if w > 180.0 {
+        w - 360.0
+    } else {
+        w
+    }
+}
+
+/// The solved orientation of one branch.
+#[derive(Clone, Copy)]
+struct Orientation {
+    joints: Joints,
+    singular: bool,
+    /// Angles of the free rotary slots.
+    angles: [Angle; 3],
+}
+
+impl Orientation {
+    fn set(&mut self, slot: usize, axis: usize, angle: Angle) {
+        self.joints[axis] = angle.rad.to_degrees();
+        self.angles[slot] = angle;
+    }
+}
+
+const ZERO_ANGLE: Angle = Angle {
+    rad: 0.0,
+    cos: 1.0,
+    sin: 0.0,
+};
+
+/// An angle given in degrees.
+fn degrees(deg: f64) -> Angle {
+    let rad = deg.to_radians();
+    let (sin, cos) = rad.sin_cos();
+    Angle { rad, cos, sin }
 }
 
 /// Orthonormal frame (columns a, b', a×b') from a direction and a second,
@@ -639,4 +718,41 @@ fn any_perpendicular(w: &Vector3<f64>) -> Vector3<f64> {
     let p = seed - w * w.dot(&seed);
     debug_assert!(p.norm() > FREE_EPS);
     p.normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_helpers_match_the_library() {
+        for x in [
+            -721.5,
+            -360.0,
+            -180.0,
+            -179.999,
+            -0.5,
+            -1e-12,
+            0.0,
+            1e-12,
+            0.49,
+            180.0,
+            359.9,
+            540.0,
+            1e6 + 0.25,
+        ] {
+            assert_eq!(floor_i(x), x.floor() as i64, "{x}");
+            let w = wrap180(x);
+            assert!(w > -180.0 && w <= 180.0, "{x} -> {w}");
+            assert!(
+                ((x - w) / 360.0 - ((x - w) / 360.0).round()).abs() < 1e-12,
+                "{x} -> {w}"
+            );
+        }
+        assert_eq!(wrap180(-180.0), 180.0);
+        assert_eq!(turn_range(-360.0, 360.0, 10.0), (-1, 0));
+        assert_eq!(turn_range(-45.2, 45.2, 10.0), (0, 0));
+        assert_eq!(turn_range(-45.2, 45.2, 50.0), (0, -1));
+        assert_eq!(turn_range(0.0, 720.0, -90.0), (1, 2));
+    }
 }

@@ -30,26 +30,76 @@ pub fn rotation(w: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     )
 }
 
-/// Subproblem 1: the angle `θ` with `rot(w, θ)·u = v`, assuming `w·u = w·v`
-/// and `|u| = |v|`. `None` when `u` (or `v`) lies on the axis: every angle
-/// is a solution (a singular configuration).
+/// Rotation matrix about unit `w` by the angle whose cosine and sine are
+/// `c` and `s` (no trigonometry: for angles that come out of [`sp1_cs`]).
 #[inline]
-pub fn sp1(w: &Vector3<f64>, u: &Vector3<f64>, v: &Vector3<f64>) -> Option<f64> {
+pub fn rotation_cs(w: &Vector3<f64>, c: f64, s: f64) -> Matrix3<f64> {
+    let v = 1.0 - c;
+    let (x, y, z) = (w.x, w.y, w.z);
+    Matrix3::new(
+        c + x * x * v,
+        x * y * v - z * s,
+        x * z * v + y * s,
+        y * x * v + z * s,
+        c + y * y * v,
+        y * z * v - x * s,
+        z * x * v - y * s,
+        z * y * v + x * s,
+        c + z * z * v,
+    )
+}
+
+/// An angle with its cosine and sine, as subproblem 1 finds them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Angle {
+    /// Radians, in (−π, π].
+    pub rad: f64,
+    pub cos: f64,
+    pub sin: f64,
+}
+
+impl Angle {
+    /// The rotation about unit `w` by this angle.
+    #[inline]
+    pub fn rotation(&self, w: &Vector3<f64>) -> Matrix3<f64> {
+        rotation_cs(w, self.cos, self.sin)
+    }
+}
+
+/// Subproblem 1 with the cosine and sine of the solution (see [`sp1`]).
+#[inline]
+pub fn sp1_cs(w: &Vector3<f64>, u: &Vector3<f64>, v: &Vector3<f64>) -> Option<Angle> {
     let up = u - w * w.dot(u);
     let vp = v - w * w.dot(v);
     if up.norm_squared() < FREE_EPS * FREE_EPS || vp.norm_squared() < FREE_EPS * FREE_EPS {
         return None;
     }
-    Some(f64::atan2(w.dot(&up.cross(&vp)), up.dot(&vp)))
+    let y = w.dot(&up.cross(&vp));
+    let x = up.dot(&vp);
+    // Both are products of unit-length-scale vectors: no overflow to fear.
+    let r = (x * x + y * y).sqrt();
+    Some(Angle {
+        rad: f64::atan2(y, x),
+        cos: x / r,
+        sin: y / r,
+    })
+}
+
+/// Subproblem 1: the angle `θ` with `rot(w, θ)·u = v`, assuming `w·u = w·v`
+/// and `|u| = |v|`. `None` when `u` (or `v`) lies on the axis: every angle
+/// is a solution (a singular configuration).
+#[inline]
+pub fn sp1(w: &Vector3<f64>, u: &Vector3<f64>, v: &Vector3<f64>) -> Option<f64> {
+    sp1_cs(w, u, v).map(|a| a.rad)
 }
 
 /// One solution of subproblem 2.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sp2Solution {
     /// Angle about the first axis; `None` if free (singular).
-    pub theta1: Option<f64>,
+    pub theta1: Option<Angle>,
     /// Angle about the second axis; `None` if free (singular).
-    pub theta2: Option<f64>,
+    pub theta2: Option<Angle>,
 }
 
 /// Subproblem 2: angles with `rot(w1, θ1)·rot(w2, θ2)·p = q` for unit vectors
@@ -85,8 +135,8 @@ pub fn sp2(
     let solve = |g: f64| {
         let z = w1 * a + w2 * b + cross * g;
         Sp2Solution {
-            theta1: sp1(w1, &z, q),
-            theta2: sp1(w2, p, &z),
+            theta1: sp1_cs(w1, &z, q),
+            theta2: sp1_cs(w2, p, &z),
         }
     };
     if g == 0.0 {
@@ -134,7 +184,9 @@ mod tests {
             prop_assert!(n >= 1);
             let mut found = false;
             for s in &sols[..n] {
-                let (a, b) = (s.theta1.unwrap(), s.theta2.unwrap());
+                let (a, b) = (s.theta1.unwrap().rad, s.theta2.unwrap().rad);
+                let m = s.theta1.unwrap().rotation(&w1) * s.theta2.unwrap().rotation(&w2) * p;
+                prop_assert!((m - q).norm() < 1e-9, "cos/sin rotation {m} vs {q}");
                 let got = rotation(&w1, a) * rotation(&w2, b) * p;
                 prop_assert!((got - q).norm() < 1e-9, "{got} vs {q}");
                 let d = |x: f64, y: f64| (x - y + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
