@@ -2,7 +2,7 @@
 //! run back through the forward kinematics and compared with the CL pose it
 //! was made from.
 
-use kinpost_machine::{Machine, Pose};
+use kinpost_machine::{Kinematics, Machine, Pose};
 use nalgebra::Vector3;
 
 /// How far a block may put the tool from its CL pose.
@@ -23,6 +23,42 @@ impl Tolerance {
     /// decimals).
     pub fn from_resolution(machine: &Machine, resolution: impl Fn(usize) -> f64) -> Tolerance {
         let lever = machine.largest_pivot_distance();
+        Self::with_levers(machine, resolution, |_| lever)
+    }
+
+    /// The rounding error bound of one block at joint values `q`, with the
+    /// actual lever of every rotary axis (how far the tool point moves per
+    /// radian of that axis, by central differences through `kin`). Used where
+    /// a block lies beyond the machine-wide bound, e.g. on a machine without
+    /// travel limits whose linear axes run far out; 1.5 times the first-order
+    /// bound covers the second-order terms of half a unit.
+    pub fn at_block(
+        machine: &Machine,
+        kin: &Kinematics,
+        q: &[f64],
+        resolution: impl Fn(usize) -> f64,
+    ) -> Tolerance {
+        let mut probe = q.to_vec();
+        let h = 1e-3; // degrees
+        let t = Self::with_levers(machine, resolution, |i| {
+            probe[i] = q[i] + h;
+            let plus = kin.fk(&probe).point;
+            probe[i] = q[i] - h;
+            let minus = kin.fk(&probe).point;
+            probe[i] = q[i];
+            (plus - minus).norm() / (2.0 * h).to_radians()
+        });
+        Tolerance {
+            position_mm: 1.5 * t.position_mm,
+            axis_rad: t.axis_rad,
+        }
+    }
+
+    fn with_levers(
+        machine: &Machine,
+        resolution: impl Fn(usize) -> f64,
+        mut lever: impl FnMut(usize) -> f64,
+    ) -> Tolerance {
         let mut position = 0.0;
         let mut axis = 0.0;
         for (i, a) in machine.axes.iter().enumerate() {
@@ -33,7 +69,7 @@ impl Tolerance {
             if a.is_rotary() {
                 let rad = half.to_radians();
                 axis += rad;
-                position += rad * lever;
+                position += rad * lever(i);
             } else {
                 position += half;
             }

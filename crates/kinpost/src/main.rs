@@ -272,7 +272,11 @@ fn post(args: PostArgs) -> Result<()> {
         .unwrap_or_else(|| "csv".to_string());
     let dialect = load_dialect(&dialect_name)?;
     let options = PostOptions {
-        cl_file: args.input.clone(),
+        cl_file: if args.input == "-" {
+            "<stdin>".to_string()
+        } else {
+            args.input.clone()
+        },
         program_name: args.program.clone(),
         date: match args.date.as_deref() {
             Some("today") => today(),

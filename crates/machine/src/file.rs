@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 use nalgebra::{Matrix3, Vector3};
-use serde::Deserialize;
+use serde::{Deserialize, Deserializer};
 use toml::Spanned;
 
 use crate::model::{Axis, AxisKind, MAX_AXES, Machine, PostSettings, Side, Tool};
@@ -15,10 +15,15 @@ use crate::model::{Axis, AxisKind, MAX_AXES, Machine, PostSettings, Side, Tool};
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;
 
+/// Widest travel of a rotary axis, degrees. Every 360° equivalent inside the
+/// limits is an inverse-kinematics solution, so the travel must stay small; an
+/// axis that turns without end has no `limits`.
+const MAX_ROTARY_TRAVEL: f64 = 3600.0;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawMachine {
-    name: Spanned<String>,
+    name: Option<Spanned<String>>,
     #[serde(default)]
     description: String,
     #[serde(default)]
@@ -26,7 +31,7 @@ struct RawMachine {
     #[serde(default)]
     axis: Vec<RawAxis>,
     workpiece: Option<RawWorkpiece>,
-    tool: Spanned<RawTool>,
+    tool: Option<Spanned<RawTool>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -57,28 +62,42 @@ struct RawAxis {
     name: Spanned<String>,
     kind: RawKind,
     side: RawSide,
-    direction: Spanned<[f64; 3]>,
-    point: Option<Spanned<[f64; 3]>>,
-    limits: Option<Spanned<[f64; 2]>>,
+    direction: Spanned<Nums<3>>,
+    point: Option<Spanned<Nums<3>>>,
+    limits: Option<Spanned<Nums<2>>>,
     fixed: Option<Spanned<f64>>,
     /// Limits are machine coordinates: machine = NC + offset (DESIGN.md §2).
-    machine_offset: Option<f64>,
+    machine_offset: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawWorkpiece {
-    origin: [f64; 3],
-    x: Spanned<[f64; 3]>,
-    z: Spanned<[f64; 3]>,
+    origin: Spanned<Nums<3>>,
+    x: Spanned<Nums<3>>,
+    z: Spanned<Nums<3>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawTool {
-    point: [f64; 3],
-    axis: Spanned<[f64; 3]>,
-    reference: Option<Spanned<[f64; 3]>>,
+    point: Spanned<Nums<3>>,
+    axis: Spanned<Nums<3>>,
+    reference: Option<Spanned<Nums<3>>>,
+}
+
+/// Exactly `N` numbers (serde's own arrays accept longer lists).
+#[derive(Clone, Copy)]
+struct Nums<const N: usize>([f64; N]);
+
+impl<'de, const N: usize> Deserialize<'de> for Nums<N> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        <[f64; N]>::try_from(v.as_slice()).map(Nums).map_err(|_| {
+            let expected = format!("an array of length {N}");
+            serde::de::Error::invalid_length(v.len(), &expected.as_str())
+        })
+    }
 }
 
 /// Collects the mistakes of one file.
@@ -99,54 +118,183 @@ impl Checker<'_> {
         ));
     }
 
-    /// A unit vector, or an error at `v`'s span.
-    fn unit(&mut self, v: &Spanned<[f64; 3]>, what: &str) -> Vector3<f64> {
-        let raw = Vector3::from(*v.get_ref());
+    /// A unit vector, or an error at `v`'s span. `None` when `v` has no
+    /// direction at all (zero or not finite); a vector of another length is
+    /// reported and normalised.
+    fn unit(&mut self, v: &Spanned<Nums<3>>, what: &str) -> Option<Vector3<f64>> {
+        let raw = Vector3::from(v.get_ref().0);
+        if raw.iter().any(|x| !x.is_finite()) {
+            self.error(v.span(), format!("{what} must be three finite numbers"));
+            return None;
+        }
         let n = raw.norm();
         if !n.is_finite() || n < 1e-12 {
             self.error(v.span(), format!("{what} must be a non-zero unit vector"));
-            return Vector3::z();
+            return None;
         }
         if (n - 1.0).abs() > UNIT_TOLERANCE {
             let u = raw / n;
             self.error(
                 v.span(),
                 format!(
-                    "{what} is not a unit vector (length {n:.9}); did you mean [{:.9}, {:.9}, {:.9}]?",
-                    u.x, u.y, u.z
+                    "{what} is not a unit vector (length {}); did you mean [{}, {}, {}]?",
+                    short(n, 9),
+                    short(u.x, 9),
+                    short(u.y, 9),
+                    short(u.z, 9)
                 ),
             );
         }
-        raw / n
+        Some(raw / n)
     }
+
+    /// A point, or an error at `v`'s span when a coordinate is not finite.
+    fn point(&mut self, v: &Spanned<Nums<3>>, what: &str) -> Vector3<f64> {
+        let p = Vector3::from(v.get_ref().0);
+        if p.iter().any(|x| !x.is_finite()) {
+            self.error(
+                v.span(),
+                format!("{what} must be three finite numbers (mm)"),
+            );
+            return Vector3::zeros();
+        }
+        p
+    }
+
+    /// The 1-based line of a byte offset.
+    fn line_of(&self, offset: usize) -> usize {
+        self.source
+            .get(..offset)
+            .map_or(0, |s| s.matches('\n').count())
+            + 1
+    }
+}
+
+/// A number with at most `decimals` decimals and no trailing zeros.
+fn short(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.decimals$}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+/// The diagnostic of a TOML syntax or type error, in words for machine-file
+/// authors rather than for Rust programmers.
+fn toml_error(e: &toml::de::Error, file: &str, source: &str, syntax: bool) -> Diagnostic {
+    let span = e.span().unwrap_or(0..0);
+    let mut message = e.message().trim_end().to_string();
+    for (from, to) in [
+        ("unknown field", "unknown key"),
+        ("missing field", "missing key"),
+        ("expected f64", "expected a number"),
+        ("unknown variant", "unknown value"),
+    ] {
+        message = message.replace(from, to);
+    }
+    if let Some(rest) = message.strip_prefix("invalid length ")
+        && let Some((found, wanted)) = rest.split_once(", expected an array of length ")
+    {
+        message = format!("expected {wanted} numbers, found {found}");
+    }
+    let boundary = |mut i: usize| {
+        i = i.min(source.len());
+        while !source.is_char_boundary(i) {
+            i -= 1;
+        }
+        i
+    };
+    let start = boundary(span.start);
+    let line_start = source[..start].rfind('\n').map_or(0, |i| i + 1);
+    let before = &source[line_start..start];
+    let token: String = source[start..]
+        .chars()
+        .take_while(|c| !matches!(c, ',' | ']' | '\n') && !c.is_whitespace())
+        .collect();
+    if message == "duplicate key" && !token.is_empty() {
+        message = format!("`{token}` is defined twice");
+        if token == "axis" {
+            message.push_str(" (write every axis as `[[axis]]`, with two brackets)");
+        }
+    }
+    // `[0, 0 100]`: the parser reads `0 100` as one bare word.
+    let end = boundary(span.end.max(start));
+    let words: Vec<&str> = source[start..end]
+        .lines()
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .collect();
+    if syntax
+        && before.matches('[').count() > before.matches(']').count()
+        && words.len() >= 2
+        && words.iter().all(|w| w.parse::<f64>().is_ok())
+    {
+        message = format!(
+            "missing comma between `{}` and `{}` in this array",
+            words[0], words[1]
+        );
+    }
+    // A syntax error at the start of a line is often an array or string left
+    // open on an earlier line: the parser only notices on the next key.
+    if syntax && before.trim().is_empty() && line_start > 0 {
+        let before: Vec<&str> = source[..line_start - 1].lines().collect();
+        let earlier = before
+            .iter()
+            .enumerate()
+            .rev()
+            .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+        if let Some((i, l)) = earlier
+            && l.matches('[').count() > l.matches(']').count()
+        {
+            message = format!(
+                "{message} (is the array on line {} missing its closing `]`?)",
+                i + 1
+            );
+        }
+    }
+    Diagnostic::at_byte_span(Severity::Error, file, source, span, message)
 }
 
 /// Reads a machine file. `file` is the name used in diagnostics.
 pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostics> {
-    let raw: RawMachine = toml::from_str(source).map_err(|e| {
-        let span = e.span().unwrap_or(0..0);
-        Diagnostics::from(Diagnostic::at_byte_span(
-            Severity::Error,
-            file,
-            source,
-            span,
-            e.message().trim_end().to_string(),
-        ))
-    })?;
+    // Syntax first, then the keys and types of the machine file.
+    if let Err(e) = source.parse::<toml::Table>() {
+        return Err(toml_error(&e, file, source, true).into());
+    }
+    let raw: RawMachine = toml::from_str(source)
+        .map_err(|e| Diagnostics::from(toml_error(&e, file, source, false)))?;
     let mut c = Checker {
         file,
         source,
         errors: Vec::new(),
     };
 
-    let name = raw.name.get_ref().trim().to_string();
-    if name.is_empty() {
-        c.error(raw.name.span(), "machine name must not be empty");
-    }
+    let name = match &raw.name {
+        Some(n) => {
+            let name = n.get_ref().trim().to_string();
+            if name.is_empty() {
+                c.error(n.span(), "machine name must not be empty");
+            }
+            name
+        }
+        None => {
+            c.error(
+                0..0,
+                "the machine file has no `name` (e.g. `name = \"my-mill\"` at the top)",
+            );
+            String::new()
+        }
+    };
 
     let mut axes = Vec::with_capacity(raw.axis.len());
+    let mut direction_ok = Vec::with_capacity(raw.axis.len());
     for a in &raw.axis {
-        axes.push(check_axis(&mut c, a, &raw.axis));
+        let (axis, ok) = check_axis(&mut c, a, &raw.axis);
+        axes.push(axis);
+        direction_ok.push(ok);
     }
     if axes.len() > MAX_AXES {
         c.error(
@@ -154,37 +302,63 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
             format!("a machine has at most {MAX_AXES} axes"),
         );
     }
-    check_axis_counts(&mut c, &raw.axis, &axes);
+    check_axis_counts(&mut c, &raw.axis, &axes, &direction_ok);
 
     let (workpiece_rotation, workpiece_origin) = match &raw.workpiece {
         None => (Matrix3::identity(), Vector3::zeros()),
         Some(w) => {
+            let origin = c.point(&w.origin, "workpiece origin");
             let x = c.unit(&w.x, "workpiece x");
             let z = c.unit(&w.z, "workpiece z");
-            if x.dot(&z).abs() > UNIT_TOLERANCE {
-                c.error(w.z.span(), "workpiece x and z must be perpendicular");
-            }
+            let (x, z) = match (x, z) {
+                (Some(x), Some(z)) => {
+                    if x.dot(&z).abs() > UNIT_TOLERANCE {
+                        c.error(
+                            w.z.span(),
+                            format!(
+                                "workpiece x and z must be perpendicular (they are {}° apart)",
+                                short(x.angle(&z).to_degrees(), 3)
+                            ),
+                        );
+                    }
+                    (x, z)
+                }
+                _ => (Vector3::x(), Vector3::z()),
+            };
             let y = z.cross(&x);
-            (Matrix3::from_columns(&[x, y, z]), Vector3::from(w.origin))
+            (Matrix3::from_columns(&[x, y, z]), origin)
         }
     };
 
-    let t = raw.tool.get_ref();
+    let Some(tool) = &raw.tool else {
+        c.error(
+            0..0,
+            "the machine file has no [tool] table (the tool `point` and `axis` at home)",
+        );
+        return Err(Diagnostics(c.errors));
+    };
+    let t = tool.get_ref();
+    let tool_point = c.point(&t.point, "tool point");
     let tool_axis = c.unit(&t.axis, "tool axis");
     let reference = t.reference.as_ref().map(|r| {
         let u = c.unit(r, "tool reference");
-        if u.dot(&tool_axis).abs() > UNIT_TOLERANCE {
+        if let (Some(u), Some(a)) = (u, tool_axis)
+            && u.dot(&a).abs() > UNIT_TOLERANCE
+        {
             c.error(
                 r.span(),
-                "tool reference must be perpendicular to the tool axis",
+                format!(
+                    "tool reference must be perpendicular to the tool axis (they are {}° apart)",
+                    short(u.angle(&a).to_degrees(), 3)
+                ),
             );
         }
-        u
+        u.unwrap_or_else(Vector3::x)
     });
     let free_rotary = axes.iter().filter(|a| a.is_rotary() && a.is_free()).count();
     if free_rotary == 3 && reference.is_none() {
         c.error(
-            raw.tool.span(),
+            tool.span(),
             "three free rotary axes need a tool `reference` direction (or lock one with `fixed`)",
         );
     }
@@ -199,8 +373,8 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         workpiece_rotation,
         workpiece_origin,
         tool: Tool {
-            point: Vector3::from(t.point),
-            axis: tool_axis,
+            point: tool_point,
+            axis: tool_axis.unwrap_or_else(Vector3::z),
             reference,
         },
         post: PostSettings {
@@ -211,7 +385,8 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
     })
 }
 
-fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> Axis {
+/// Checks one axis; also says whether its direction is usable.
+fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
     let name = a.name.get_ref().trim().to_string();
     if name.is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric()) {
         c.error(
@@ -224,15 +399,25 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> Axis {
         .position(|b| b.name.get_ref().trim().eq_ignore_ascii_case(&name))
         .expect("the axis itself is in the list");
     if !std::ptr::eq(&all[first], a) {
-        c.error(a.name.span(), format!("duplicate axis name `{name}`"));
+        let other = &all[first].name;
+        let line = c.line_of(other.span().start);
+        c.error(
+            a.name.span(),
+            format!(
+                "duplicate axis name `{name}`: axis `{}` on line {line} has the same name (names are not case-sensitive)",
+                other.get_ref().trim()
+            ),
+        );
     }
     let direction = c.unit(&a.direction, "axis direction");
+    let direction_ok = direction.is_some();
+    let direction = direction.unwrap_or_else(Vector3::z);
     let kind = match a.kind {
         RawKind::Linear => AxisKind::Linear,
         RawKind::Rotary => AxisKind::Rotary,
     };
     let point = match (kind, &a.point) {
-        (AxisKind::Rotary, Some(p)) => Vector3::from(*p.get_ref()),
+        (AxisKind::Rotary, Some(p)) => c.point(p, "axis point"),
         (AxisKind::Rotary, None) => {
             c.error(
                 a.name.span(),
@@ -249,22 +434,46 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> Axis {
         }
         (AxisKind::Linear, None) => Vector3::zeros(),
     };
-    let offset = a.machine_offset.unwrap_or(0.0);
+    let offset = match &a.machine_offset {
+        Some(o) if !o.get_ref().is_finite() => {
+            c.error(o.span(), "machine_offset must be a finite number");
+            0.0
+        }
+        Some(o) => *o.get_ref(),
+        None => 0.0,
+    };
+    let mut limits_ok = true;
     let limits = a.limits.as_ref().map(|l| {
-        let [lo, hi] = *l.get_ref();
-        if !(lo.is_finite() && hi.is_finite()) {
+        let [lo, hi] = l.get_ref().0;
+        let (nc_lo, nc_hi) = (lo - offset, hi - offset);
+        limits_ok = false;
+        if !(lo.is_finite() && hi.is_finite() && nc_lo.is_finite() && nc_hi.is_finite()) {
             c.error(l.span(), "limits must be finite numbers");
         } else if lo > hi {
             c.error(
                 l.span(),
                 format!("limits are reversed: minimum {lo} is greater than maximum {hi}"),
             );
+        } else if kind == AxisKind::Rotary && nc_hi - nc_lo > MAX_ROTARY_TRAVEL {
+            c.error(
+                l.span(),
+                format!(
+                    "rotary limits span {}°, more than {} turns; leave `limits` out for an axis that turns without end",
+                    short(nc_hi - nc_lo, 3),
+                    MAX_ROTARY_TRAVEL / 360.0
+                ),
+            );
+        } else {
+            limits_ok = true;
         }
-        [lo - offset, hi - offset]
+        [nc_lo, nc_hi]
     });
     let fixed = a.fixed.as_ref().map(|f| {
         let v = *f.get_ref();
-        if let Some([lo, hi]) = limits
+        if !v.is_finite() {
+            c.error(f.span(), "fixed value must be a finite number");
+        } else if let Some([lo, hi]) = limits
+            && limits_ok
             && (v < lo || v > hi)
         {
             c.error(
@@ -274,7 +483,7 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> Axis {
         }
         v
     });
-    Axis {
+    let axis = Axis {
         name,
         kind,
         side: match a.side {
@@ -285,10 +494,11 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> Axis {
         point,
         limits,
         fixed,
-    }
+    };
+    (axis, direction_ok)
 }
 
-fn check_axis_counts(c: &mut Checker, raw: &[RawAxis], axes: &[Axis]) {
+fn check_axis_counts(c: &mut Checker, raw: &[RawAxis], axes: &[Axis], direction_ok: &[bool]) {
     for (kind, word) in [(AxisKind::Linear, "linear"), (AxisKind::Rotary, "rotary")] {
         let free: Vec<usize> = (0..axes.len())
             .filter(|&i| axes[i].kind == kind && axes[i].is_free())
@@ -300,21 +510,42 @@ fn check_axis_counts(c: &mut Checker, raw: &[RawAxis], axes: &[Axis]) {
             );
         }
     }
-    // Free linear axes must span their space at home (no two parallel).
+    // Directions already reported as unusable are left out of the geometry
+    // checks below, which would only repeat that mistake.
+    if direction_ok.iter().any(|ok| !ok) {
+        return;
+    }
+    // Free linear axes must span their space at home: report the first one
+    // whose direction the earlier ones already give.
     let lin: Vec<usize> = (0..axes.len())
         .filter(|&i| !axes[i].is_rotary() && axes[i].is_free())
         .collect();
-    let dirs: Vec<Vector3<f64>> = lin.iter().map(|&i| axes[i].direction).collect();
-    let independent = match dirs.len() {
-        2 => dirs[0].cross(&dirs[1]).norm() > 1e-6,
-        3 => Matrix3::from_columns(&dirs).determinant().abs() > 1e-6,
-        _ => true,
-    };
-    if !independent && let Some(&last) = lin.last() {
-        c.error(
-            raw[last].direction.span(),
-            "the free linear axes are not independent (two are parallel or all three coplanar)",
-        );
+    let independent = "the free linear axes must move in three independent directions";
+    for k in 1..lin.len().min(3) {
+        let (i, d) = (lin[k], axes[lin[k]].direction);
+        let message = if let Some(&j) = lin[..k]
+            .iter()
+            .find(|&&j| axes[j].direction.cross(&d).norm() <= 1e-6)
+        {
+            format!(
+                "linear axis `{}` is parallel to linear axis `{}`: {independent}",
+                axes[i].name, axes[j].name
+            )
+        } else if k == 2
+            && Matrix3::from_columns(&[axes[lin[0]].direction, axes[lin[1]].direction, d])
+                .determinant()
+                .abs()
+                <= 1e-6
+        {
+            format!(
+                "linear axis `{}` lies in the plane of linear axes `{}` and `{}`: {independent}",
+                axes[i].name, axes[lin[0]].name, axes[lin[1]].name
+            )
+        } else {
+            continue;
+        };
+        c.error(raw[i].direction.span(), message);
+        break;
     }
     let rot: Vec<usize> = (0..axes.len())
         .filter(|&i| axes[i].is_rotary() && axes[i].is_free())
@@ -323,7 +554,10 @@ fn check_axis_counts(c: &mut Checker, raw: &[RawAxis], axes: &[Axis]) {
         if axes[w[0]].direction.cross(&axes[w[1]].direction).norm() < 1e-6 {
             c.error(
                 raw[w[1]].direction.span(),
-                "two consecutive free rotary axes are parallel: they cannot orient the tool",
+                format!(
+                    "free rotary axes `{}` and `{}` are parallel: together they turn about one direction only and cannot orient the tool",
+                    axes[w[0]].name, axes[w[1]].name
+                ),
             );
         }
     }
@@ -386,7 +620,7 @@ axis = [0, 0, 1]
             "kind = \"linear\"\nside = \"tool\"\ndirection = [0, 1, 0]\nspeed = 3",
         );
         let e = err(&src);
-        assert!(e.contains("unknown field `speed`"), "{e}");
+        assert!(e.contains("unknown key `speed`"), "{e}");
         assert!(e.contains("m.toml:13:1"), "{e}");
     }
 

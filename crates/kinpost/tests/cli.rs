@@ -1,0 +1,443 @@
+//! The `kinpost` command end to end: the built binary run on the examples,
+//! checking exit codes, standard output and error, and the files it writes.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use kinpost::machine::machine_from_toml;
+
+/// The repository root.
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn example(name: &str) -> PathBuf {
+    root().join("examples").join(name)
+}
+
+fn kinpost(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_kinpost"));
+    c.args(args).current_dir(root());
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    kinpost(args).output().expect("run kinpost")
+}
+
+/// Runs with `input` on standard input.
+fn run_with_stdin(args: &[&str], input: &[u8]) -> Output {
+    let mut child = kinpost(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run kinpost");
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[track_caller]
+fn assert_exit(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+}
+
+/// The names of the files in `dir`.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A CL file asking for B = 60° (the tool axis tilted 60° about Y), outside
+/// the ±45.2° of mts1600, on line 3.
+const OUT_OF_TRAVEL: &str = "$$ B travel test\nRAPID\nGOTO/0,0,0,0.8660254,0,0.5\n";
+
+const FIGURE_28_BLOCK: &str = "X=459.000 Y=8.807 Z361.368 B0.000 A=DC(0.000)";
+
+#[test]
+fn post_flat_part() {
+    let o = run(&["post", "examples/flat-part.cls", "--machine", "mts1600"]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    assert!(out.contains(FIGURE_28_BLOCK), "{out}");
+    let err = stderr(&o);
+    // The two defects of the CL file: TLDDATA and the cut-short MSYS.
+    assert!(
+        err.contains("warning: unknown statement `TLDDATA`"),
+        "{err}"
+    );
+    assert!(err.contains("flat-part.cls:2:1"), "{err}");
+    assert!(err.contains("warning: MSYS"), "{err}");
+    assert!(err.contains("flat-part.cls:3:"), "{err}");
+    assert!(err.contains("14 CL points, 14 blocks"), "{err}");
+}
+
+#[test]
+fn same_input_same_output() {
+    let a = run(&["post", "examples/flat-part.cls", "-m", "mts1600", "-q"]);
+    let b = run(&["post", "examples/flat-part.cls", "-m", "mts1600", "-q"]);
+    assert_exit(&a, 0);
+    assert_eq!(a.stdout, b.stdout);
+}
+
+#[test]
+fn post_to_file_with_json_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.mpf");
+    let json = dir.path().join("s.json");
+    let o = run(&[
+        "post",
+        example("flat-part.cls").to_str().unwrap(),
+        "--machine",
+        "mts1600",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 0);
+    // The program goes to the file, not to standard output.
+    assert!(stdout(&o).is_empty(), "{}", stdout(&o));
+    let program = std::fs::read_to_string(&out).unwrap();
+    assert!(program.contains(FIGURE_28_BLOCK), "{program}");
+    assert!(program.contains("M30"), "{program}");
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(summary["cl_points"], 14);
+    assert_eq!(summary["blocks"], 14);
+    let warnings = summary["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 2, "{summary}");
+    for w in warnings {
+        assert!(w["line"].as_u64().is_some(), "{w}");
+        assert!(w["message"].as_str().is_some_and(|m| !m.is_empty()), "{w}");
+    }
+    assert_eq!(warnings[0]["line"], 2);
+    assert_eq!(warnings[1]["line"], 3);
+    let position = summary["max_position_error_mm"].as_f64().unwrap();
+    assert!((0.0..0.01).contains(&position), "{summary}");
+    assert!(summary["max_axis_error_rad"].as_f64().unwrap() >= 0.0);
+    assert!(summary["seconds"].as_f64().unwrap() >= 0.0);
+
+    // Only the two files: no temporary file left behind.
+    assert_eq!(listing(dir.path()), ["out.mpf", "s.json"]);
+}
+
+#[test]
+fn post_from_stdin() {
+    let cl = std::fs::read(example("flat-part.cls")).unwrap();
+    let o = run_with_stdin(&["post", "-", "--machine", "mts1600"], &cl);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains(FIGURE_28_BLOCK), "{}", stdout(&o));
+    // Same program as from the file, apart from the CL name in the header.
+    let from_file = run(&["post", "examples/flat-part.cls", "-m", "mts1600", "-q"]);
+    let body = |s: &str| -> Vec<String> {
+        s.lines()
+            .filter(|l| !l.contains("CL:"))
+            .map(str::to_string)
+            .collect()
+    };
+    assert_eq!(body(&stdout(&o)), body(&stdout(&from_file)));
+    assert!(stderr(&o).contains(":2:1"), "{}", stderr(&o));
+}
+
+#[test]
+fn point_outside_travel_fails_and_names_line_and_axis() {
+    let o = run_with_stdin(&["post", "-", "-m", "mts1600"], OUT_OF_TRAVEL.as_bytes());
+    assert_exit(&o, 1);
+    assert!(
+        stdout(&o).is_empty(),
+        "a failed run prints no partial program"
+    );
+    let err = stderr(&o);
+    assert!(err.contains("error:"), "{err}");
+    assert!(err.contains(":3:1"), "{err}");
+    assert!(err.contains("GOTO/0,0,0,0.8660254,0,0.5"), "{err}");
+    assert!(err.contains("B would be 60"), "{err}");
+}
+
+#[test]
+fn failed_run_leaves_the_existing_output_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let cl = dir.path().join("tilted.cls");
+    std::fs::write(&cl, OUT_OF_TRAVEL).unwrap();
+    let out = dir.path().join("existing.mpf");
+    std::fs::write(&out, "; a good program\n").unwrap();
+    let json = dir.path().join("s.json");
+    let o = run(&[
+        "post",
+        cl.to_str().unwrap(),
+        "-m",
+        "mts1600",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 1);
+    let err = stderr(&o);
+    assert!(err.contains("tilted.cls:3:1"), "{err}");
+    assert!(err.contains('B'), "{err}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "; a good program\n");
+    // No temporary file, no JSON summary of the failed run.
+    assert_eq!(listing(dir.path()), ["existing.mpf", "tilted.cls"]);
+}
+
+#[test]
+fn bad_cl_syntax_is_located() {
+    let dir = tempfile::tempdir().unwrap();
+    let cl = dir.path().join("syntax.cls");
+    std::fs::write(&cl, "RAPID\nGOTO/1,2,3x,0,0,1\n").unwrap();
+    let o = run(&["post", cl.to_str().unwrap(), "-m", "mts1600"]);
+    assert_exit(&o, 1);
+    let err = stderr(&o);
+    assert!(err.contains("error:"), "{err}");
+    assert!(err.contains("syntax.cls:2:10"), "{err}");
+    assert!(err.contains("GOTO/1,2,3x,0,0,1"), "{err}");
+}
+
+#[test]
+fn missing_cl_file() {
+    let o = run(&["post", "no-such-file.cls", "-m", "mts1600"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("no-such-file.cls"), "{}", stderr(&o));
+}
+
+#[test]
+fn unknown_machine() {
+    let o = run(&[
+        "post",
+        "examples/flat-part.cls",
+        "--machine",
+        "no-such-mill",
+    ]);
+    assert_exit(&o, 1);
+    let err = stderr(&o);
+    assert!(err.contains("no built-in machine `no-such-mill`"), "{err}");
+    assert!(err.contains("mts1600"), "{err}");
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    for args in [
+        &[][..],
+        &["post"][..],
+        &["post", "examples/flat-part.cls"][..],
+        &[
+            "post",
+            "examples/flat-part.cls",
+            "-m",
+            "mts1600",
+            "--frobnicate",
+        ][..],
+        &["no-such-command"][..],
+    ] {
+        let o = run(args);
+        assert_exit(&o, 2);
+        assert!(stdout(&o).is_empty(), "{args:?}");
+        assert!(!stderr(&o).is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn bad_tolerance_is_bad_input() {
+    let o = run(&[
+        "post",
+        "examples/flat-part.cls",
+        "-m",
+        "mts1600",
+        "--tolerance",
+        "0",
+    ]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("--tolerance"), "{}", stderr(&o));
+    // A negative number reads as an option: a usage error.
+    let o = run(&[
+        "post",
+        "examples/flat-part.cls",
+        "-m",
+        "mts1600",
+        "--tolerance",
+        "-1",
+    ]);
+    assert_exit(&o, 2);
+}
+
+#[test]
+fn machines_and_machine_show() {
+    let o = run(&["machines"]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("mts1600"), "{}", stdout(&o));
+
+    let o = run(&["machine", "show", "mts1600"]);
+    assert_exit(&o, 0);
+    let m = machine_from_toml(&stdout(&o), "shown.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.name, "mts1600");
+
+    let o = run(&["machine", "show", "no-such-mill"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("no-such-mill"), "{}", stderr(&o));
+}
+
+#[test]
+fn machine_check() {
+    let good = root().join("crates/machine/machines/mts1600.toml");
+    let o = run(&["machine", "check", good.to_str().unwrap()]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("is valid"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("5 free: X A Y Z B"), "{}", stdout(&o));
+
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string(&good)
+        .unwrap()
+        .replace("limits = [-45.2, 45.2]", "limits = [45.2, -45.2]");
+    std::fs::write(&bad, &text).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l == "limits = [45.2, -45.2]")
+        .unwrap()
+        + 1;
+    let o = run(&["machine", "check", bad.to_str().unwrap()]);
+    assert_exit(&o, 1);
+    let err = stderr(&o);
+    assert!(err.contains("error: limits are reversed"), "{err}");
+    assert!(err.contains(&format!("bad.toml:{line}:10")), "{err}");
+    assert!(err.contains("limits = [45.2, -45.2]"), "{err}");
+    assert!(stdout(&o).is_empty());
+}
+
+#[test]
+fn dialects_and_dialect_show() {
+    let o = run(&["dialects"]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    assert!(out.contains("sinumerik"), "{out}");
+    assert!(out.contains("csv"), "{out}");
+
+    let o = run(&["dialect", "show", "sinumerik"]);
+    assert_exit(&o, 0);
+    assert!(
+        stdout(&o).contains("name = \"sinumerik\""),
+        "{}",
+        stdout(&o)
+    );
+
+    let o = run(&["dialect", "show", "no-such-dialect"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("no-such-dialect"), "{}", stderr(&o));
+}
+
+/// The three numbers after `label` on its line of `out`.
+fn triple(out: &str, label: &str) -> [f64; 3] {
+    let line = out
+        .lines()
+        .find(|l| l.split_whitespace().next() == Some(label))
+        .unwrap_or_else(|| panic!("no `{label}` line in\n{out}"));
+    let v: Vec<f64> = line
+        .split_whitespace()
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    v.try_into().unwrap()
+}
+
+#[test]
+fn forward_kinematics() {
+    let o = run(&[
+        "fk",
+        "--machine",
+        "mts1600",
+        "X=459",
+        "Y=8.807",
+        "Z=361.368",
+    ]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    let p = triple(&out, "point");
+    for (got, want) in p.iter().zip([-416.0, 70.393, 11.368]) {
+        assert!((got - want).abs() < 1e-3, "{out}");
+    }
+    let a = triple(&out, "axis");
+    for (got, want) in a.iter().zip([0.0, 0.0, 1.0]) {
+        assert!((got - want).abs() < 1e-9, "{out}");
+    }
+
+    let o = run(&["fk", "--machine", "mts1600", "Q=1"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("no axis `Q`"), "{}", stderr(&o));
+
+    let o = run(&["fk", "--machine", "mts1600", "X459"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("AXIS=VALUE"), "{}", stderr(&o));
+}
+
+#[test]
+fn inverse_kinematics() {
+    let o = run(&[
+        "ik",
+        "--machine",
+        "mts1600",
+        "--point",
+        "-416,70.3931,11.3684",
+        "--axis",
+        "0,0,1",
+    ]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    assert!(out.lines().next().unwrap().contains("branch"), "{out}");
+    assert!(
+        out.lines()
+            .any(|l| l.contains("459.000000") && l.trim_end().ends_with("ok")),
+        "{out}"
+    );
+
+    let o = run(&["ik", "-m", "mts1600", "--point", "1,2", "--axis", "0,0,1"]);
+    assert_exit(&o, 1);
+    assert!(
+        stderr(&o).contains("expected three numbers"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn csv_dialect() {
+    let o = run(&[
+        "post",
+        "examples/flat-part.cls",
+        "-m",
+        "mts1600",
+        "--dialect",
+        "csv",
+        "-q",
+    ]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    let mut lines = out.lines();
+    assert_eq!(lines.next(), Some("line,motion,X,A,Y,Z,B,C,feed"));
+    // One row per block, every row with all nine columns.
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 14, "{out}");
+    assert!(rows.iter().all(|r| r.split(',').count() == 9), "{out}");
+    assert!(rows[2].starts_with("15,feed,459.000000,"), "{out}");
+}
