@@ -124,6 +124,12 @@ pub struct Kinematics {
     between: Vec<Matrix3<f64>>,
     /// Free linear axes, machine-file indices.
     free_lin: Vec<usize>,
+    /// Constant inputs of subproblem 2 (two or more free rotary axes): the
+    /// second axis as seen by the first, `C1·w2`, the home vector it turns,
+    /// `C1·C2·a0` (two free axes) or `C1·C2·w3` (three), and `C0ᵀ`.
+    sp2_w2: Vector3<f64>,
+    sp2_p: Vector3<f64>,
+    c0t: Matrix3<f64>,
     /// Axis index and own direction of each free rotary slot.
     slot_axis: Vec<usize>,
     slot_dir: Vec<Vector3<f64>>,
@@ -172,6 +178,11 @@ impl Kinematics {
                 slot: None,
                 fixed_rot: Matrix3::identity(),
             };
+            // An axis locked at zero is the identity motion: leave it out of
+            // the chains (the C axis of the 5-axis mts1600).
+            if a.fixed == Some(0.0) {
+                continue;
+            }
             match a.side {
                 Side::Tool => tool_chain.push(link),
                 Side::Workpiece => work_chain.push(link),
@@ -215,8 +226,23 @@ impl Kinematics {
                 l.fixed_rot = rotation(&l.dir, rad(fixed[l.index]));
             }
         }
+        let (sp2_w2, sp2_p) = match free_rot.len() {
+            2 => (
+                between[1] * free_rot[1].1,
+                between[1] * between[2] * machine.tool.axis,
+            ),
+            3 => (
+                between[1] * free_rot[1].1,
+                between[1] * between[2] * free_rot[2].1,
+            ),
+            _ => (Vector3::zeros(), Vector3::zeros()),
+        };
+        let c0t = between[0].transpose();
         Kinematics {
             n,
+            sp2_w2,
+            sp2_p,
+            c0t,
             tool_chain,
             work_chain,
             rw0: machine.workpiece_rotation,
@@ -395,7 +421,7 @@ impl Kinematics {
                 let (i1, w1) = self.free_rot[0];
                 let (i2, w2) = self.free_rot[1];
                 let c = &self.between;
-                let w2e = c[1] * w2;
+                let w2e = self.sp2_w2;
                 // With a third free axis, the vector it leaves unchanged (its
                 // own direction) must be carried to where the full target
                 // rotation puts it; otherwise the tool axis.
@@ -407,11 +433,10 @@ impl Kinematics {
                     let r0 = self.r0.ok_or(IkError::NeedsReference)?;
                     let target_rot =
                         frame(&target, &(self.rw0 * reference)) * frame(&self.a0, &r0).transpose();
-                    let p = c[1] * c[2] * w3;
-                    let q = c[0].transpose() * target_rot * c[3].transpose() * w3;
-                    (p, q, Some(target_rot))
+                    let q = self.c0t * target_rot * c[3].transpose() * w3;
+                    (self.sp2_p, q, Some(target_rot))
                 } else {
-                    (c[1] * c[2] * self.a0, c[0].transpose() * target, None)
+                    (self.sp2_p, self.c0t * target, None)
                 };
                 let (sols, n) = sp2(&w1, &w2e, &p, &q, 1e-10);
                 if n == 0 {
