@@ -126,9 +126,183 @@ pub(crate) fn scan_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
     v.is_finite().then_some((v, i))
 }
 
+const ONES: u64 = 0x0101_0101_0101_0101;
+const LOW_BITS: u64 = 0x7F7F_7F7F_7F7F_7F7F;
+const HIGH_BITS: u64 = 0x8080_8080_8080_8080;
+
+/// The eight bytes at `b[i..]`, little-endian (the first in the low byte).
+#[inline(always)]
+pub(crate) fn word_at(b: &[u8], i: usize) -> Option<u64> {
+    Some(u64::from_le_bytes(*b.get(i..)?.first_chunk::<8>()?))
+}
+
+/// `word` with each ASCII digit turned into its value, and the high bit of
+/// each byte that is not a digit (exactly: no carries between bytes).
+#[inline(always)]
+fn digit_values(word: u64) -> (u64, u64) {
+    let v = word ^ (ONES * u64::from(b'0'));
+    // A byte is a digit iff it becomes 0..=9: then adding 0x76 to its low
+    // seven bits leaves the high bit clear.
+    let not_digit = (((v & LOW_BITS) + ONES * 0x76) | v) & HIGH_BITS;
+    (v, not_digit)
+}
+
+/// The number written by the digit values in `d`, most significant in the
+/// lowest byte; leading digits may be zero bytes (the classic SWAR
+/// conversion of eight digits).
+#[inline(always)]
+fn eight_digits(d: u64) -> u64 {
+    let d = (d & 0x0F0F_0F0F_0F0F_0F0F).wrapping_mul(2561) >> 8;
+    let d = (d & 0x00FF_00FF_00FF_00FF).wrapping_mul(6_553_601) >> 16;
+    (d & 0x0000_FFFF_0000_FFFF).wrapping_mul(42_949_672_960_001) >> 32
+}
+
+/// [`scan_number`] for the shape CL files are made of: `[-+]?d*[.d*]` with
+/// at most 7 digits before the point and at most 8 digits in all, read a
+/// word at a time. Returns the value and the index just after the digits;
+/// the caller must check that the byte there is a separator, neither a digit
+/// (more digits), nor `.`, `e` or `E`: then the result is what
+/// [`scan_number`] gives. `None` for any other shape, or if `b` has fewer
+/// than 9 bytes after the sign (pad the buffer).
+#[inline(always)]
+pub(crate) fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
+    let sign = *b.get(start)?;
+    let negative = sign == b'-';
+    let s = start + usize::from(negative || sign == b'+');
+    let word = word_at(b, s)?;
+    let next = word_at(b, s + 1)?;
+    let (_, stop) = digit_values(word);
+    if stop == 0 {
+        return None; // eight digits or more before the point
+    }
+    // The digits before the point (0..=7), then the point, if any.
+    let whole = (stop.trailing_zeros() / 8) as usize;
+    let point = (word >> (8 * whole)) as u8 == b'.';
+    // The whole digits, then those after the point moved down over it.
+    let low = (1u64 << (8 * whole)) - 1;
+    let digits = if point {
+        (word & low) | (next & !low)
+    } else {
+        word
+    };
+    let (values, stop) = digit_values(digits);
+    // `trailing_zeros` is 64 if all eight are digits.
+    let n = (stop.trailing_zeros() / 8) as usize;
+    let n = if point { n } else { whole };
+    if n == 0 {
+        return None;
+    }
+    // The n digits up to the top byte (the most significant at byte 8 - n),
+    // what follows them shifted out.
+    let mantissa = eight_digits(values << (64 - 8 * n));
+    // At most 8 digits: the mantissa is exact, and so is the power of ten
+    // (Clinger's fast path; `scan_number` computes the very same quotient).
+    // Through i64, which converts in one instruction, unlike u64.
+    let v = (mantissa as i64) as f64 / POW10[n - whole];
+    // `-v` without a branch on the sign (`v` is positive or +0).
+    let v = f64::from_bits(v.to_bits() | (u64::from(negative) << 63));
+    Some((v, s + n + usize::from(point)))
+}
+
 #[cfg(test)]
 mod tests {
-    use super::parse_number;
+    use super::{parse_number, scan_number, scan_plain_number};
+
+    #[test]
+    fn plain_numbers_match_the_general_scanner() {
+        let mut texts: Vec<String> = [
+            "0",
+            "-0",
+            "+0",
+            "-0.0",
+            "25.",
+            ".5",
+            "-.5",
+            "+.5",
+            "-3.",
+            "1234567.1",
+            "1.1234567",
+            ".12345678",
+            "0000000.0",
+            "9999999.9",
+            "99999999",
+            "-391.2345",
+            "0.9922222",
+            "-0.0123456",
+            ".",
+            "-",
+            "+",
+            "",
+            "1e5",
+            "1.5E3",
+            "1.5e",
+            "5.e2",
+            "12345678",
+            "1.12345678",
+            "1.2.3",
+            "1,2",
+            "-+1",
+            "--1",
+            "1 ",
+            " 1",
+            "a",
+            "1a",
+            "0x10",
+            "7.",
+            "..5",
+            "1..",
+            "-.",
+            "+.",
+            "1-2",
+            "1.-2",
+            "\u{e9}1",
+            "1.\u{e9}",
+            "12345678.1",
+        ]
+        .iter()
+        .map(|t| t.to_string())
+        .collect();
+        for k in 0..5000u64 {
+            let x = k.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            let whole = x % 100_000_000 / 10u64.pow((x >> 40) as u32 % 9);
+            let decimals = ((x >> 48) % 9) as usize;
+            let fraction = (x >> 20) % 10u64.pow(decimals as u32);
+            let sign = ["", "-", "+"][(x >> 60) as usize % 3];
+            texts.push(match (x >> 56) % 4 {
+                0 => format!("{sign}{whole}"),
+                1 => format!("{sign}{whole}."),
+                2 if decimals > 0 => format!("{sign}.{fraction:0decimals$}"),
+                _ => format!("{sign}{whole}.{fraction:0decimals$}"),
+            });
+        }
+        for text in &texts {
+            for after in [",", "\n", "\r\n", ",1.5,2\n", " ", "e5", ".5", "5", ""] {
+                let b = format!("{text}{after}\0\0\0\0\0\0\0\0\0");
+                let Some((v, end)) = scan_plain_number(b.as_bytes(), 0) else {
+                    continue;
+                };
+                if matches!(b.as_bytes()[end], b'0'..=b'9' | b'.' | b'e' | b'E') {
+                    continue; // the caller falls back
+                }
+                let (w, e) = scan_number(b.as_bytes(), 0).expect(text);
+                assert_eq!((v.to_bits(), end), (w.to_bits(), e), "{text:?}{after:?}");
+            }
+            // Every plain number up to 7 + 8 digits (8 in all) is taken.
+            let sign = usize::from(text.starts_with(['-', '+']));
+            let parts: Vec<&str> = text[sign..].split('.').collect();
+            let digits: usize = parts.iter().map(|p| p.len()).sum();
+            let plain = parts.len() <= 2
+                && parts.iter().all(|p| p.bytes().all(|c| c.is_ascii_digit()))
+                && parts[0].len() < 8
+                && (1..=8).contains(&digits);
+            let b = format!("{text},\0\0\0\0\0\0\0\0\0");
+            assert_eq!(
+                scan_plain_number(b.as_bytes(), 0).is_some_and(|(_, end)| end == text.len()),
+                plain,
+                "{text:?}"
+            );
+        }
+    }
 
     #[test]
     fn apt_forms() {

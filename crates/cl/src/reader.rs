@@ -4,7 +4,7 @@ use std::io::BufRead;
 
 use kinpost_diag::{Diagnostic, Severity};
 
-use crate::number::{parse_number, scan_number};
+use crate::number::{parse_number, scan_number, scan_plain_number};
 use crate::words::suggest;
 use crate::{ClEvent, FeedUnit, Motion, SpindleDir, Statement, Units, Vec3};
 
@@ -61,8 +61,17 @@ pub struct ClReader<R> {
     file: String,
     /// Physical lines of the current statement, back to back.
     raw: Vec<u8>,
-    /// The logical statement: continuation lines joined, comments removed.
+    /// The logical statement: continuation lines joined, comments removed;
+    /// unused (empty) when `text_in_raw` is set.
     text: String,
+    /// `Some(len)` if the logical statement is `raw[..len]` (a plain line,
+    /// read by the fast path, which is ASCII): then it is not copied to
+    /// `text`. See [`text_bytes`](Self::text_bytes).
+    text_in_raw: Option<usize>,
+    /// The values of a plain `GOTO` line read by the fast path, and their
+    /// number (0 if the statement was not read so).
+    plain_goto_values: [f64; 9],
+    plain_goto_count: usize,
     segments: Vec<Segment>,
     /// Comma-separated fields of the current statement's arguments.
     fields: Vec<Span>,
@@ -87,6 +96,9 @@ impl<R: BufRead> ClReader<R> {
             file: file_name.into(),
             raw: Vec::with_capacity(256),
             text: String::with_capacity(256),
+            text_in_raw: None,
+            plain_goto_values: [0.0; 9],
+            plain_goto_count: 0,
             segments: Vec::with_capacity(4),
             fields: Vec::with_capacity(16),
             line: 0,
@@ -151,7 +163,7 @@ impl<R: BufRead> ClReader<R> {
         message: impl Into<String>,
     ) -> Diagnostic {
         let end = self.segments.last().map_or(0, |s| s.text_end);
-        let start = skip_blanks(self.text.as_bytes(), 0).min(end);
+        let start = skip_blanks(self.text_bytes(), 0).min(end);
         self.diag(severity, (start, end), message)
     }
 
@@ -174,6 +186,15 @@ impl<R: BufRead> ClReader<R> {
                         event: ClEvent::Comment(text),
                     }));
                 }
+                Read::Statement if self.plain_goto_count != 0 => {
+                    // The bulk of a CL file, read by `plain_goto`: the event
+                    // is built right in the result.
+                    let count = std::mem::take(&mut self.plain_goto_count);
+                    let args = (5, self.text_in_raw.unwrap_or(0));
+                    let event = self.goto_with(args, self.plain_goto_values, count)?;
+                    let line = self.line;
+                    return Ok(Some(Statement { line, event }));
+                }
                 Read::Statement => {
                     if let Some(event) = self.interpret()? {
                         let line = self.segments[0].line;
@@ -186,12 +207,79 @@ impl<R: BufRead> ClReader<R> {
 
     // ----- lines -----
 
+    /// The logical statement text.
+    #[inline(always)]
+    fn text_bytes(&self) -> &[u8] {
+        match self.text_in_raw {
+            Some(len) => &self.raw[..len],
+            None => self.text.as_bytes(),
+        }
+    }
+
+    /// The logical statement text as a `str` (for the slower paths: it is
+    /// validated again when it is a line of `raw`).
+    fn text(&self) -> &str {
+        match self.text_in_raw {
+            Some(len) => std::str::from_utf8(&self.raw[..len]).expect("statement text is UTF-8"),
+            None => &self.text,
+        }
+    }
+
     /// Reads physical lines until a logical statement is complete.
     #[inline(always)]
     fn read_statement(&mut self) -> Result<Read, Diagnostic> {
         self.raw.clear();
         self.text.clear();
         self.segments.clear();
+        self.text_in_raw = None;
+        self.plain_goto_count = 0;
+        // Fast path: a whole line in the input buffer that is ASCII without
+        // `$` (no comment, no continuation, no UTF-8 to check) is a statement
+        // on its own. Anything else takes the general path below, which
+        // handles it exactly as before.
+        match self.input.fill_buf() {
+            Ok(buf) => {
+                if let Some((count, end)) = plain_goto(buf, &mut self.plain_goto_values) {
+                    let n = end + usize::from(buf[end] == b'\r');
+                    self.raw.extend_from_slice(&buf[..end]);
+                    self.input.consume(n + 1);
+                    self.line += 1;
+                    self.segments.push(Segment {
+                        line: self.line,
+                        raw_start: 0,
+                        raw_end: end,
+                        text_start: 0,
+                        text_end: end,
+                    });
+                    self.text_in_raw = Some(end);
+                    self.plain_goto_count = count;
+                    return Ok(Read::Statement);
+                }
+                if let Some(n) = plain_line(buf) {
+                    let line = &buf[..n];
+                    let mut end = n;
+                    if end > 0 && line[end - 1] == b'\r' {
+                        end -= 1;
+                    }
+                    let text_end = trim_end_ascii(&line[..end]);
+                    self.raw.extend_from_slice(line);
+                    self.input.consume(n + 1);
+                    self.line += 1;
+                    self.segments.push(Segment {
+                        line: self.line,
+                        raw_start: 0,
+                        raw_end: end,
+                        text_start: 0,
+                        text_end,
+                    });
+                    self.text_in_raw = Some(text_end);
+                    return Ok(Read::Statement);
+                }
+            }
+            // `read_until` below retries.
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(self.read_error(e)),
+        }
         loop {
             let mut start = self.raw.len();
             match self.input.read_until(b'\n', &mut self.raw) {
@@ -208,17 +296,7 @@ impl<R: BufRead> ClReader<R> {
                     ));
                 }
                 Ok(_) => {}
-                Err(e) => {
-                    self.finished = true;
-                    return Err(Diagnostic::error(
-                        &self.file,
-                        self.line + 1,
-                        0,
-                        0,
-                        "",
-                        format!("cannot read the file: {e}"),
-                    ));
-                }
+                Err(e) => return Err(self.read_error(e)),
             }
             self.line += 1;
             let mut end = self.raw.len();
@@ -269,6 +347,20 @@ impl<R: BufRead> ClReader<R> {
                 return Ok(Read::Statement);
             }
         }
+    }
+
+    /// The error for a failed read; the reader then reports end of input.
+    #[cold]
+    fn read_error(&mut self, e: std::io::Error) -> Diagnostic {
+        self.finished = true;
+        Diagnostic::error(
+            &self.file,
+            self.line + 1,
+            0,
+            0,
+            "",
+            format!("cannot read the file: {e}"),
+        )
     }
 
     fn invalid_utf8(&self, start: usize, end: usize, e: std::str::Utf8Error) -> Diagnostic {
@@ -327,7 +419,7 @@ impl<R: BufRead> ClReader<R> {
     /// Interprets the logical statement in `text`.
     #[inline(always)]
     fn interpret(&mut self) -> Result<Option<ClEvent>, Diagnostic> {
-        let b = self.text.as_bytes();
+        let b = self.text_bytes();
         let start = skip_blanks(b, 0);
         if start == b.len() {
             return Ok(None);
@@ -389,7 +481,7 @@ impl<R: BufRead> ClReader<R> {
                 | b"MULTAX"
         );
         if needs_slash && !slash && has_args {
-            let name = self.text[word.0..word.1].to_ascii_uppercase();
+            let name = self.text()[word.0..word.1].to_ascii_uppercase();
             return Err(self.error((after, after + 1), format!("expected `/` after `{name}`")));
         }
         match key {
@@ -411,14 +503,14 @@ impl<R: BufRead> ClReader<R> {
             b"SPINDL" => self.spindle(args).map(Some),
             b"COOLNT" => self.coolant(args).map(Some),
             b"INSERT" => Ok(Some(ClEvent::Insert(
-                self.text[args.0..].trim_end().to_string(),
+                self.text()[args.0..].trim_end().to_string(),
             ))),
             b"PPRINT" => Ok(Some(ClEvent::Comment(
-                self.text[args.0..].trim().to_string(),
+                self.text()[args.0..].trim().to_string(),
             ))),
             b"END-OF-PATH" => Ok(Some(ClEvent::EndOfPath)),
             b"PARTNO" => Ok(Some(ClEvent::PartNo(
-                self.text[args.0..].trim().to_string(),
+                self.text()[args.0..].trim().to_string(),
             ))),
             b"UNITS" | b"UNIT" => self.units_statement(word, args).map(Some),
             b"MULTAX" => self.multax(args).map(Some),
@@ -466,7 +558,7 @@ impl<R: BufRead> ClReader<R> {
         let mut word = word;
         if word.0 == word.1 {
             // Not a word at all: show the token up to a blank or a slash.
-            let b = self.text.as_bytes();
+            let b = self.text_bytes();
             let mut end = word.0;
             while end < b.len() && !b[end].is_ascii_whitespace() && b[end] != b'/' {
                 end += 1;
@@ -474,15 +566,15 @@ impl<R: BufRead> ClReader<R> {
             if end == word.0 {
                 end += 1;
             }
-            word.1 = floor_char_boundary(&self.text, end.min(b.len()));
+            word.1 = floor_char_boundary(self.text(), end.min(b.len()));
             if word.1 == word.0 {
-                word.1 = self.text[word.0..]
+                word.1 = self.text()[word.0..]
                     .chars()
                     .next()
                     .map_or(word.0, |c| word.0 + c.len_utf8());
             }
         }
-        let text = &self.text[word.0..word.1];
+        let text = &self.text()[word.0..word.1];
         let message = match suggest(text) {
             Some(known) => format!("unknown statement `{text}` (did you mean `{known}`?) ignored"),
             None => format!("unknown statement `{text}` ignored"),
@@ -495,7 +587,7 @@ impl<R: BufRead> ClReader<R> {
     /// takes the slow path, which finds the field and reports it.
     #[inline(always)]
     fn goto_values(&self, args: Span, v: &mut [f64; 9]) -> Option<usize> {
-        let b = &self.text.as_bytes()[..args.1];
+        let b = &self.text_bytes()[..args.1];
         let mut i = skip_blanks(b, args.0);
         if i == b.len() {
             return Some(0);
@@ -535,6 +627,12 @@ impl<R: BufRead> ClReader<R> {
                 self.fields.len()
             }
         };
+        self.goto_with(args, v, count)
+    }
+
+    /// A `GOTO` with `count` values (the first 9 in `v`).
+    #[inline(always)]
+    fn goto_with(&mut self, args: Span, v: [f64; 9], count: usize) -> Result<ClEvent, Diagnostic> {
         if !matches!(count, 3 | 6 | 9) {
             self.split(args);
             let extra = match count {
@@ -741,7 +839,7 @@ impl<R: BufRead> ClReader<R> {
         }
         if self.fields.len() > 2 {
             let rest = (self.fields[2].0, args.1);
-            let text = self.text[rest.0..rest.1].trim().to_string();
+            let text = self.text()[rest.0..rest.1].trim().to_string();
             self.warn(rest, format!("`{text}` after the tool number ignored"));
         }
         Ok(n as u32)
@@ -901,7 +999,11 @@ impl<R: BufRead> ClReader<R> {
     /// zero-width span at its comma (or at the end).
     fn split(&mut self, args: Span) {
         self.fields.clear();
-        let b = self.text.as_bytes();
+        // `self.text_bytes()`, borrowing only `raw` and `text`.
+        let b = match self.text_in_raw {
+            Some(len) => &self.raw[..len],
+            None => self.text.as_bytes(),
+        };
         let (mut s, end) = args;
         if skip_blanks(b, s) >= end {
             return;
@@ -928,7 +1030,11 @@ impl<R: BufRead> ClReader<R> {
     }
 
     fn field(&self, f: Span) -> &str {
-        &self.text[f.0..f.1]
+        match self.text_in_raw {
+            // A field of an ASCII line.
+            Some(_) => std::str::from_utf8(&self.raw[f.0..f.1]).expect("statement text is UTF-8"),
+            None => &self.text[f.0..f.1],
+        }
     }
 
     /// Whether field `f` is `keyword` (case-insensitive).
@@ -938,7 +1044,7 @@ impl<R: BufRead> ClReader<R> {
 
     /// Whether field `f` is a word rather than a number.
     fn is_word(&self, f: Span) -> bool {
-        self.text.as_bytes()[f.0..f.1]
+        self.text_bytes()[f.0..f.1]
             .first()
             .is_some_and(|c| c.is_ascii_alphabetic())
     }
@@ -1000,6 +1106,89 @@ fn make(
     }
 }
 
+const ONES: u64 = 0x0101_0101_0101_0101;
+const HIGH_BITS: u64 = 0x8080_8080_8080_8080;
+
+/// The high bit of each zero byte of `v`, and maybe of bytes above a zero
+/// byte (so the lowest one is exact).
+#[inline(always)]
+fn zero_bytes(v: u64) -> u64 {
+    v.wrapping_sub(ONES) & !v & HIGH_BITS
+}
+
+/// The length of the first line of `buf` if `buf` holds its `\n` and it is
+/// plain: ASCII without `$`. One pass, eight bytes at a time.
+#[inline(always)]
+fn plain_line(buf: &[u8]) -> Option<usize> {
+    let mut i = 0;
+    loop {
+        let word = match buf.get(i..).and_then(|b| b.first_chunk::<8>()) {
+            Some(word) => u64::from_le_bytes(*word),
+            None => {
+                let rest = buf.get(i..)?;
+                if rest.is_empty() {
+                    return None;
+                }
+                // Zero bytes are neither `\n` nor `$` nor non-ASCII.
+                let mut word = [0; 8];
+                word[..rest.len()].copy_from_slice(rest);
+                u64::from_le_bytes(word)
+            }
+        };
+        let newline = zero_bytes(word ^ (ONES * u64::from(b'\n')));
+        let special = zero_bytes(word ^ (ONES * u64::from(b'$'))) | (word & HIGH_BITS);
+        if newline != 0 {
+            // The bits below the line end's byte.
+            let before = (newline & newline.wrapping_neg()) - 1;
+            return (special & before == 0).then_some(i + (newline.trailing_zeros() / 8) as usize);
+        }
+        if special != 0 {
+            return None;
+        }
+        i += 8;
+    }
+}
+
+/// The length of `line` without trailing whitespace, as `str::trim_end`
+/// has it for ASCII (which, unlike `u8::is_ascii_whitespace`, includes the
+/// vertical tab).
+#[inline(always)]
+fn trim_end_ascii(line: &[u8]) -> usize {
+    let mut end = line.len();
+    while end > 0 && matches!(line[end - 1], b'\t'..=b'\r' | b' ') {
+        end -= 1;
+    }
+    end
+}
+
+/// A plain `GOTO` line at the start of `buf`, the common case: `GOTO/`,
+/// then numbers [`scan_plain_number`] takes, separated by commas, then the
+/// line end (`\n` or `\r\n`), nothing else (no blanks). Returns the number
+/// of values (at most 9, in `v`) and the length of the line without its
+/// `\r\n` or `\n`; `None` for anything else.
+///
+/// As the numbers are read, the line is checked on the way: it is ASCII
+/// without `$` (the bytes taken are digits, signs, points and commas).
+#[inline(always)]
+fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<(usize, usize)> {
+    if !buf.starts_with(b"GOTO/") {
+        return None;
+    }
+    let mut i = 5;
+    let mut count = 0;
+    loop {
+        let (x, end) = scan_plain_number(buf, i)?;
+        *v.get_mut(count)? = x;
+        count += 1;
+        match *buf.get(end)? {
+            b',' => i = end + 1,
+            b'\n' => return Some((count, end)),
+            b'\r' if buf.get(end + 1) == Some(&b'\n') => return Some((count, end)),
+            _ => return None,
+        }
+    }
+}
+
 fn is_word_byte(c: u8) -> bool {
     c.is_ascii_alphanumeric() || c == b'_' || c == b'-'
 }
@@ -1026,8 +1215,16 @@ fn floor_char_boundary(s: &str, i: usize) -> usize {
 
 /// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
 fn normalize(v: Vec3) -> Option<Vec3> {
-    if v[0] * v[0] + v[1] * v[1] + v[2] * v[2] == 1.0 {
+    let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if n2 == 1.0 {
         return Some(v); // already unit length, e.g. 0,0,1
+    }
+    // The usual case: no overflow or underflow in the squares (also false
+    // for NaN and infinity); one square root, three correctly rounded
+    // divisions.
+    if n2 > 1e-200 && n2 < 1e200 {
+        let n = n2.sqrt();
+        return Some([v[0] / n, v[1] / n, v[2] / n]);
     }
     // Scale first so that huge or tiny components neither overflow nor vanish.
     let m = v[0].abs().max(v[1].abs()).max(v[2].abs());

@@ -498,3 +498,114 @@ fn iterator_and_io_errors() {
     let n = ClReader::new("GOTO/1,2,3,0,0,1\nGOTO/1,2,3\n".as_bytes(), "t.cls").count();
     assert_eq!(n, 2);
 }
+
+#[test]
+fn statement_diagnostic_names_the_last_statement() {
+    // Plain lines (fast path), CRLF, blanks and comments (general path), a
+    // continued statement, and lines split across the input buffer.
+    let cl = "GOTO/-391.2345,57.1234,7.1234,0.1234567,-0.0123456,0.9922222\n\
+              GOTO/1,2,3\r\n  GOTO / 4,5,6 $$ note\nGOTO/7,8,$\n9\nGOTO/1.5,2.5,3.5";
+    let expected = [
+        (
+            1,
+            "GOTO/-391.2345,57.1234,7.1234,0.1234567,-0.0123456,0.9922222",
+            1,
+            60,
+        ),
+        (2, "GOTO/1,2,3", 1, 10),
+        (3, "  GOTO / 4,5,6 $$ note", 3, 12),
+        (4, "GOTO/7,8,$", 1, 9),
+        (6, "GOTO/1.5,2.5,3.5", 1, 16),
+    ];
+    for capacity in [8192, 7, 1] {
+        let input = std::io::BufReader::with_capacity(capacity, cl.as_bytes());
+        let mut r = ClReader::new(input, "t.cls").with_default_axis([0.0, 0.0, 1.0]);
+        for &(line, source, column, width) in &expected {
+            let s = r.next_statement().unwrap().unwrap();
+            assert!(matches!(s.event, ClEvent::Goto { .. }));
+            assert_eq!(s.line, line);
+            let d = r.statement_diagnostic(Severity::Error, "x");
+            assert_eq!(d.severity, Severity::Error);
+            assert_eq!(
+                (
+                    d.line,
+                    d.column,
+                    d.width,
+                    d.source_line.as_str(),
+                    d.message.as_str()
+                ),
+                (line, column, width, source, "x"),
+                "capacity {capacity}"
+            );
+        }
+        assert_eq!(r.next_statement().unwrap(), None);
+    }
+}
+
+/// Everything the reader returns, as text.
+fn transcript(input: impl std::io::BufRead) -> Vec<String> {
+    let mut r = ClReader::new(input, "t.cls");
+    let mut out = Vec::new();
+    for _ in 0..100 {
+        let item = r.next_statement();
+        let end = matches!(item, Ok(None));
+        match item {
+            Ok(Some(s)) => {
+                out.push(format!("{s:?}"));
+                let d = r.statement_diagnostic(Severity::Warning, "here");
+                out.push(format!("{d:?}"));
+            }
+            other => out.push(format!("{other:?}")),
+        }
+        out.extend(r.take_warnings().iter().map(|w| format!("{w:?}")));
+        if end {
+            break;
+        }
+    }
+    out
+}
+
+#[test]
+fn fast_paths_agree_with_the_general_path() {
+    // A one-byte buffer never holds a whole line: everything then takes the
+    // general path.
+    let texts = [
+        "GOTO/-391.2345,57.1234,7.1234,0.1234567,-0.0123456,0.9922222\nGOTO/1,2,3\n",
+        "GOTO/1,2,3,0,0,1\r\nGOTO/1,2,3\r\nGOTO/4,5,6 \nGOTO/4,5,6\t\x0b\nGOTO/1,2,3,0,0,0\n",
+        "GOTO/1,2,3,0,0,1,1,0,0\nGOTO/1,2,3,0,0,1,0,0,1\nGOTO/1,2,3,0,0,1,0,0,1,5\n",
+        "GOTO/1,2\nGOTO/\nGOTO\nGOTO/1,,2\nGOTO/1,2,3,\nGOTO/,1,2,3\nGOTO/1e3,2,3,0,0,1\n",
+        "GOTO/12345678.5,2,3,0,0,1\nGOTO/1.123456789,2,3\nGOTO/.5,-.5,+.5\nGOTO/5.,-0,+0.0\n",
+        "GOTO/1.2.3,4,5\nGOTO/1-2,3,4\nGOTO/1 ,2,3\nGOTO/1,2,3$\n,0,0,1\nGOTO/1,2,3 $$ c\n",
+        "goto/1,2,3,0,0,1\nGOTO/1,2,3,0,0,1\rGOTO/1,2,3\n\u{feff}GOTO/1,2,3\nGOTO/1,2,x\n",
+        "\u{feff}GOTO/1,2,3,0,0,1\nRAPID\nGOTO/1,2,3\nFEDRAT/MMPM,250\nFOO/1\nGOTO/é,1,2\n",
+        "GOTO/1,2,3,0,0,1\nGOTO/4,5,6",
+        "GOTO/1,2,3,0,0,1\nGOTO/4,5,6\r",
+        "GOTO/1,2,3,0,0,1,0,1,0,7\nGOTO/1e999,2,3,0,0,1\nGOTO/0.00000001,2,3,0,0,1\n",
+    ];
+    for text in texts {
+        let general = transcript(std::io::BufReader::with_capacity(1, text.as_bytes()));
+        assert_eq!(transcript(text.as_bytes()), general, "{text:?}");
+        let small = std::io::BufReader::with_capacity(13, text.as_bytes());
+        assert_eq!(transcript(small), general, "{text:?}");
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(1000))]
+
+    /// Random CL-ish text reads the same through the fast paths as through
+    /// the general path.
+    #[test]
+    fn fast_paths_agree_on_random_text(
+        pieces in proptest::collection::vec(0usize..25, 0..60),
+    ) {
+        const PIECES: &[&str] = &[
+            "GOTO/", "GOTO/-391.2345,57.1234,7.1234,0.1234567,-0.0123456,0.9922222\n",
+            ",", "\n", "\r\n", "\r", " ", "$", "$$", "-", "+", ".", "1", "0", "9", "12345678",
+            "e", "é", "\u{feff}", "RAPID\n", "x", "\t", "0.1234567", "-416.0000", "\0",
+        ];
+        let text: String = pieces.iter().map(|&k| PIECES[k]).collect();
+        let general = transcript(std::io::BufReader::with_capacity(1, text.as_bytes()));
+        proptest::prop_assert_eq!(transcript(text.as_bytes()), general);
+    }
+}
