@@ -15,19 +15,7 @@ pub const FREE_EPS: f64 = 1e-12;
 #[inline]
 pub fn rotation(w: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     let (s, c) = theta.sin_cos();
-    let v = 1.0 - c;
-    let (x, y, z) = (w.x, w.y, w.z);
-    Matrix3::new(
-        c + x * x * v,
-        x * y * v - z * s,
-        x * z * v + y * s,
-        y * x * v + z * s,
-        c + y * y * v,
-        y * z * v - x * s,
-        z * x * v - y * s,
-        z * y * v + x * s,
-        c + z * z * v,
-    )
+    rotation_cs(w, c, s)
 }
 
 /// Rotation matrix about unit `w` by the angle whose cosine and sine are
