@@ -64,25 +64,42 @@ impl From<Diagnostic> for PostError {
     }
 }
 
-/// State of the program being written.
-struct Job<'a, W: Write> {
-    machine: &'a Machine,
+/// An NC output met before the first CL point decides how the machine is
+/// driven (which axes the program writes); written once it is known.
+enum Pending {
+    Comment(String),
+    ToolChange(u32, String),
+    Spindle(Spindle),
+    Coolant(Option<String>),
+    Insert(String),
+}
+
+/// The machine as this program drives it, fixed by the first CL point: with
+/// reference directions, axes marked `free_with_reference` are free.
+struct Setup<W: Write> {
+    machine: Machine,
+    six_axis: bool,
     kin: Kinematics,
     planner: NearestPlanner,
     writer: NcWriter<W>,
-    info: ProgramInfo,
-    header_written: bool,
-    /// Comments met before the header, written right after it.
-    early_comments: Vec<String>,
-    solutions: Vec<Solution>,
-    written: [f64; kinpost_machine::MAX_AXES],
+    /// One unit of the last written decimal, per axis.
+    resolution: Vec<f64>,
     /// The tolerance in force; grows to a block's own rounding bound where
     /// that is larger (see `within_block_bound`).
     tolerance: Tolerance,
-    /// Set by `--tolerance`: never relaxed.
-    tolerance_given: bool,
-    /// One unit of the last written decimal, per axis.
-    resolution: Vec<f64>,
+}
+
+/// State of the program being written.
+struct Job<'a, W: Write> {
+    machine: &'a Machine,
+    dialect: &'a Dialect,
+    options: &'a PostOptions,
+    out: Option<W>,
+    setup: Option<Setup<W>>,
+    pending: Vec<Pending>,
+    info: ProgramInfo,
+    solutions: Vec<Solution>,
+    written: [f64; kinpost_machine::MAX_AXES],
     stats: CheckStats,
     feed: Option<f64>,
     /// Scale from CL units to mm.
@@ -106,27 +123,6 @@ pub fn post<R: BufRead, W: Write>(
     if let Some(axis) = options.default_axis {
         reader = reader.with_default_axis(axis);
     }
-    let axes: Vec<AxisSpec> = machine
-        .axes
-        .iter()
-        .map(|a| AxisSpec {
-            name: a.name.clone(),
-            rotary: a.is_rotary(),
-            fixed: a.fixed.is_some(),
-        })
-        .collect();
-    let writer = NcWriter::new(dialect, &axes, out);
-    let resolution: Vec<f64> = axes
-        .iter()
-        .map(|a| 10f64.powi(-i32::from(dialect.word_format(a).number.decimals)))
-        .collect();
-    let tolerance = {
-        let derived = Tolerance::from_resolution(machine, |i| resolution[i]);
-        Tolerance {
-            position_mm: options.tolerance_mm.unwrap_or(derived.position_mm),
-            ..derived
-        }
-    };
     let stem = std::path::Path::new(&options.cl_file)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -134,9 +130,11 @@ pub fn post<R: BufRead, W: Write>(
         .unwrap_or_else(|| "PROGRAM".to_string());
     let mut job = Job {
         machine,
-        kin: Kinematics::new(machine),
-        planner: NearestPlanner::new(machine),
-        writer,
+        dialect,
+        options,
+        out: Some(out),
+        setup: None,
+        pending: Vec::new(),
         info: ProgramInfo {
             program_name: options.program_name.clone().unwrap_or(stem),
             date: options.date.clone(),
@@ -146,13 +144,8 @@ pub fn post<R: BufRead, W: Write>(
             cl_file: options.cl_file.clone(),
             ..ProgramInfo::default()
         },
-        header_written: false,
-        early_comments: Vec::new(),
         solutions: Vec::with_capacity(16),
         written: [0.0; kinpost_machine::MAX_AXES],
-        tolerance,
-        tolerance_given: options.tolerance_mm.is_some(),
-        resolution,
         stats: CheckStats::default(),
         feed: None,
         scale: 1.0,
@@ -160,6 +153,7 @@ pub fn post<R: BufRead, W: Write>(
         blocks: 0,
     };
     let mut named = options.program_name.is_some();
+    let mut tool_loaded = false;
     let mut warnings = Vec::new();
 
     while let Some(statement) = reader.next_statement()? {
@@ -171,7 +165,6 @@ pub fn post<R: BufRead, W: Write>(
                 reference,
                 motion,
             } => {
-                job.start()?;
                 let s = job.scale;
                 let pose = Pose {
                     point: Vector3::new(point[0] * s, point[1] * s, point[2] * s),
@@ -215,39 +208,27 @@ pub fn post<R: BufRead, W: Write>(
                     job.info.tool = tool.clone();
                 }
                 job.break_segment();
-                job.comment(&format!("TOOL PATH: {name}"))?;
+                job.emit(Pending::Comment(format!("TOOL PATH: {name}")))?;
             }
-            ClEvent::Comment(text) => job.comment(text.trim())?,
+            ClEvent::Comment(text) => job.emit(Pending::Comment(text.trim().to_string()))?,
             ClEvent::LoadTool { number } => {
                 job.break_segment();
-                if job.header_written {
-                    let tool = job.info.tool.clone();
-                    job.writer.tool_change(number, &tool)?;
-                } else {
+                // The header loads the first tool (it knows `tool_number`).
+                if !tool_loaded && job.setup.is_none() {
                     job.info.tool_number = number;
-                    job.start()?;
+                } else {
+                    job.emit(Pending::ToolChange(number, job.info.tool.clone()))?;
                 }
+                tool_loaded = true;
             }
             ClEvent::SelectTool { .. } => {}
-            ClEvent::Spindle { rpm, dir } => {
-                job.start()?;
-                job.writer.spindle(match dir {
-                    SpindleDir::Clockwise => Spindle::Cw(rpm),
-                    SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
-                })?;
-            }
-            ClEvent::SpindleOff => {
-                job.start()?;
-                job.writer.spindle(Spindle::Off)?;
-            }
-            ClEvent::Coolant { on, mode } => {
-                job.start()?;
-                job.writer.coolant(on.then_some(mode.as_str()))?;
-            }
-            ClEvent::Insert(text) => {
-                job.start()?;
-                job.writer.insert(&text)?;
-            }
+            ClEvent::Spindle { rpm, dir } => job.emit(Pending::Spindle(match dir {
+                SpindleDir::Clockwise => Spindle::Cw(rpm),
+                SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
+            }))?,
+            ClEvent::SpindleOff => job.emit(Pending::Spindle(Spindle::Off))?,
+            ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
+            ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,
             ClEvent::EndOfPath => job.break_segment(),
             ClEvent::Pressure { .. } => warnings.push(reader.statement_diagnostic(
                 Severity::Warning,
@@ -257,12 +238,12 @@ pub fn post<R: BufRead, W: Write>(
             ClEvent::Fini => break,
         }
     }
-    job.start()?;
-    let info = job.info.clone();
-    job.writer
-        .footer(&info, machine.post.footer.as_deref())
-        .map_err(|e| PostError::Template(e.to_string()))?;
-    job.writer.finish()?;
+    let mut setup = job.open(false)?;
+    setup
+        .writer
+        .footer(&job.info, machine.post.footer.as_deref())?;
+    let tolerance = setup.tolerance;
+    setup.writer.finish()?;
 
     warnings.extend(reader.take_warnings());
     warnings.sort_by_key(|w| (w.line, w.column));
@@ -272,58 +253,75 @@ pub fn post<R: BufRead, W: Write>(
         warnings,
         max_position_error_mm: job.stats.max_position_error_mm,
         max_axis_error_rad: job.stats.max_axis_error_rad,
-        tolerance_mm: job.tolerance.position_mm,
-        tolerance_rad: job.tolerance.axis_rad,
+        tolerance_mm: tolerance.position_mm,
+        tolerance_rad: tolerance.axis_rad,
         seconds: started.elapsed().as_secs_f64(),
     })
 }
 
 impl<W: Write> Job<'_, W> {
-    /// Writes the header before the first NC output.
-    fn start(&mut self) -> Result<(), PostError> {
-        if self.header_written {
-            return Ok(());
+    /// Sets the machine up for the program (once) and writes the header and
+    /// whatever waited for it; hands the setup out of the job (put it back
+    /// with `self.setup = Some(..)` to keep using the job).
+    fn open(&mut self, six_axis: bool) -> Result<Setup<W>, PostError> {
+        if self.setup.is_none() {
+            let machine = if six_axis {
+                self.machine.with_reference_axes_free()
+            } else {
+                self.machine.clone()
+            };
+            let axes: Vec<AxisSpec> = machine
+                .axes
+                .iter()
+                .map(|a| AxisSpec {
+                    name: a.name.clone(),
+                    rotary: a.is_rotary(),
+                    fixed: a.fixed.is_some(),
+                })
+                .collect();
+            let resolution: Vec<f64> = axes
+                .iter()
+                .map(|a| 10f64.powi(-i32::from(self.dialect.word_format(a).number.decimals)))
+                .collect();
+            let derived = Tolerance::from_resolution(&machine, |i| resolution[i]);
+            let tolerance = Tolerance {
+                position_mm: self.options.tolerance_mm.unwrap_or(derived.position_mm),
+                ..derived
+            };
+            let out = self.out.take().expect("the output is taken once, here");
+            let mut writer = NcWriter::new(self.dialect, &axes, out);
+            writer.header(&self.info, self.machine.post.header.as_deref())?;
+            for p in std::mem::take(&mut self.pending) {
+                write_pending(&mut writer, p)?;
+            }
+            self.setup = Some(Setup {
+                kin: Kinematics::new(&machine),
+                planner: NearestPlanner::new(&machine),
+                machine,
+                six_axis,
+                writer,
+                resolution,
+                tolerance,
+            });
         }
-        self.header_written = true;
-        self.writer
-            .header(&self.info, self.machine.post.header.as_deref())?;
-        for c in std::mem::take(&mut self.early_comments) {
-            self.writer.comment(&c)?;
-        }
-        Ok(())
+        Ok(self.setup.take().expect("set up above"))
     }
 
-    fn comment(&mut self, text: &str) -> Result<(), PostError> {
-        if self.header_written {
-            self.writer.comment(text)?;
-        } else {
-            self.early_comments.push(text.to_string());
+    /// Writes an NC output now, or once the program is set up.
+    fn emit(&mut self, p: Pending) -> Result<(), PostError> {
+        match &mut self.setup {
+            Some(s) => write_pending(&mut s.writer, p),
+            None => {
+                self.pending.push(p);
+                Ok(())
+            }
         }
-        Ok(())
-    }
-
-    /// With the derived tolerance, a block beyond the machine-wide bound is
-    /// still right if its error is what rounding causes at its own levers;
-    /// the summary then reports the larger tolerance.
-    fn within_block_bound(&mut self, want: &Pose, got: &Pose, n: usize) -> bool {
-        if self.tolerance_given {
-            return false;
-        }
-        let resolution = &self.resolution;
-        let block = Tolerance::at_block(self.machine, &self.kin, &self.written[..n], |i| {
-            resolution[i]
-        });
-        let (p, a) = pose_error(want, got);
-        if p > block.position_mm || a > block.axis_rad {
-            return false;
-        }
-        self.tolerance.position_mm = self.tolerance.position_mm.max(p);
-        self.tolerance.axis_rad = self.tolerance.axis_rad.max(a);
-        true
     }
 
     fn break_segment(&mut self) {
-        self.planner.break_segment();
+        if let Some(s) = &mut self.setup {
+            s.planner.break_segment();
+        }
     }
 
     /// One CL point: solve, choose, round, check, write.
@@ -335,24 +333,56 @@ impl<W: Write> Job<'_, W> {
         reader: &ClReader<R>,
     ) -> Result<(), PostError> {
         self.cl_points += 1;
-        if motion == Motion::Rapid {
-            self.planner.break_segment();
-        }
-        let hint = self.planner.current().copied();
-        let n = self.machine.axes.len();
         let at = |message: String| -> PostError {
             reader.statement_diagnostic(Severity::Error, message).into()
         };
-        if let Err(e) = self
+        let unlocks = self.machine.unlocks_with_reference();
+        let six_axis = pose.reference.is_some() && unlocks;
+        let mut setup = self.open(six_axis)?;
+        let result = self.drive(&mut setup, pose, motion, line, six_axis, unlocks, &at);
+        self.setup = Some(setup);
+        result
+    }
+
+    /// The work of [`Job::motion`] once the machine is set up.
+    #[allow(clippy::too_many_arguments)]
+    fn drive(
+        &mut self,
+        s: &mut Setup<W>,
+        pose: &Pose,
+        motion: Motion,
+        line: usize,
+        six_axis: bool,
+        unlocks: bool,
+        at: &dyn Fn(String) -> PostError,
+    ) -> Result<(), PostError> {
+        let tolerance_given = self.options.tolerance_mm.is_some();
+        if unlocks && s.six_axis != six_axis {
+            return Err(at(if s.six_axis {
+                "this CL point has no reference direction, but the program began with them \
+                 (6-axis output): give every GOTO nine values, or none"
+                    .to_string()
+            } else {
+                "this CL point has a reference direction, but the program began without \
+                 (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
+                    .to_string()
+            }));
+        }
+        if motion == Motion::Rapid {
+            s.planner.break_segment();
+        }
+        let hint = s.planner.current().copied();
+        let n = s.machine.axes.len();
+        if let Err(e) = s
             .kin
             .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut self.solutions)
         {
             return Err(at(format!("{e}: {}", describe(pose))));
         }
-        let chosen = match self.planner.choose(&self.solutions) {
+        let chosen = match s.planner.choose(&self.solutions) {
             Ok(i) => self.solutions[i],
             Err(Rejection::OutsideLimits(v)) => {
-                let a = &self.machine.axes[v.axis];
+                let a = &s.machine.axes[v.axis];
                 let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
                 return Err(at(format!(
                     "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
@@ -366,18 +396,18 @@ impl<W: Write> Job<'_, W> {
             }
         };
         for i in 0..n {
-            self.written[i] = self.writer.quantized(i, chosen.joints[i]);
+            self.written[i] = s.writer.quantized(i, chosen.joints[i]);
         }
-        let reached = self.kin.fk(&self.written[..n]);
-        if !self.stats.record(pose, &reached, line, &self.tolerance)
-            && !self.within_block_bound(pose, &reached, n)
+        let reached = s.kin.fk(&self.written[..n]);
+        if !self.stats.record(pose, &reached, line, &s.tolerance)
+            && !within_block_bound(s, tolerance_given, pose, &reached, &self.written[..n])
         {
             let (p, a) = pose_error(pose, &reached);
             return Err(at(format!(
                 "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
                  from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
-                self.tolerance.position_mm,
-                self.tolerance.axis_rad,
+                s.tolerance.position_mm,
+                s.tolerance.axis_rad,
                 describe(pose)
             )));
         }
@@ -390,7 +420,7 @@ impl<W: Write> Job<'_, W> {
             }
             Motion::Feed => self.feed,
         };
-        self.writer.block(&Block {
+        s.writer.block(&Block {
             cl_line: Some(line),
             motion: match motion {
                 Motion::Rapid => kinpost_nc::Motion::Rapid,
@@ -402,6 +432,41 @@ impl<W: Write> Job<'_, W> {
         self.blocks += 1;
         Ok(())
     }
+}
+
+fn write_pending<W: Write>(writer: &mut NcWriter<W>, p: Pending) -> Result<(), PostError> {
+    match p {
+        Pending::Comment(text) => writer.comment(&text)?,
+        Pending::ToolChange(number, name) => writer.tool_change(number, &name)?,
+        Pending::Spindle(state) => writer.spindle(state)?,
+        Pending::Coolant(mode) => writer.coolant(mode.as_deref())?,
+        Pending::Insert(text) => writer.insert(&text)?,
+    }
+    Ok(())
+}
+
+/// With the derived tolerance, a block beyond the machine-wide bound is
+/// still right if its error is what rounding causes at its own levers; the
+/// tolerance in force (and reported) grows to it.
+fn within_block_bound<W: Write>(
+    s: &mut Setup<W>,
+    tolerance_given: bool,
+    want: &Pose,
+    got: &Pose,
+    written: &[f64],
+) -> bool {
+    if tolerance_given {
+        return false;
+    }
+    let resolution = &s.resolution;
+    let block = Tolerance::at_block(&s.machine, &s.kin, written, |i| resolution[i]);
+    let (p, a) = pose_error(want, got);
+    if p > block.position_mm || a > block.axis_rad {
+        return false;
+    }
+    s.tolerance.position_mm = s.tolerance.position_mm.max(p);
+    s.tolerance.axis_rad = s.tolerance.axis_rad.max(a);
+    true
 }
 
 /// The pose as a user reads it in a message.

@@ -66,6 +66,8 @@ struct RawAxis {
     point: Option<Spanned<Nums<3>>>,
     limits: Option<Spanned<Nums<2>>>,
     fixed: Option<Spanned<f64>>,
+    /// Locked (`fixed`) unless the CL gives reference directions.
+    free_with_reference: Option<Spanned<bool>>,
     /// Limits are machine coordinates: machine = NC + offset (DESIGN.md §2).
     machine_offset: Option<Spanned<f64>>,
 }
@@ -355,7 +357,16 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         }
         u.unwrap_or_else(Vector3::x)
     });
-    let free_rotary = axes.iter().filter(|a| a.is_rotary() && a.is_free()).count();
+    let free_rotary = axes
+        .iter()
+        .filter(|a| a.is_rotary() && (a.is_free() || a.free_with_reference))
+        .count();
+    if free_rotary > 3 && axes.iter().any(|a| a.free_with_reference) {
+        c.error(
+            tool.span(),
+            "with the `free_with_reference` axes unlocked there are more than 3 free rotary axes",
+        );
+    }
     if free_rotary == 3 && reference.is_none() {
         c.error(
             tool.span(),
@@ -494,7 +505,19 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         point,
         limits,
         fixed,
+        free_with_reference: false,
     };
+    let mut axis = axis;
+    if let Some(f) = &a.free_with_reference {
+        axis.free_with_reference = *f.get_ref();
+        if axis.free_with_reference && (axis.fixed.is_none() || !axis.is_rotary()) {
+            c.error(
+                f.span(),
+                "`free_with_reference` applies to a rotary axis locked with `fixed` \
+                 (the value it keeps for CL points without a reference direction)",
+            );
+        }
+    }
     (axis, direction_ok)
 }
 

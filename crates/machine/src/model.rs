@@ -38,6 +38,9 @@ pub struct Axis {
     pub limits: Option<[f64; 2]>,
     /// The value the axis is locked at, if it does not move in this mode.
     pub fixed: Option<f64>,
+    /// A locked axis that becomes free for CL points that carry a reference
+    /// direction (6-axis output, e.g. the C axis of the MTS1600).
+    pub free_with_reference: bool,
 }
 
 impl Axis {
@@ -124,6 +127,24 @@ impl Machine {
             .iter()
             .filter(|a| a.is_rotary() && a.is_free())
             .count()
+    }
+
+    /// Whether some axis is locked only until the CL gives reference
+    /// directions (see [`Axis::free_with_reference`]).
+    pub fn unlocks_with_reference(&self) -> bool {
+        self.axes.iter().any(|a| a.free_with_reference)
+    }
+
+    /// The machine for CL points with a reference direction: every axis
+    /// marked `free_with_reference` is free.
+    pub fn with_reference_axes_free(&self) -> Machine {
+        let mut m = self.clone();
+        for a in &mut m.axes {
+            if a.free_with_reference {
+                a.fixed = None;
+            }
+        }
+        m
     }
 
     /// The joint vector with every axis at home, fixed axes at their value.

@@ -1,0 +1,105 @@
+//! 6-axis output: on the mts1600, CL points with a reference direction free
+//! the C axis (locked at 0 for 5-axis CL, as in seed 000).
+
+use kinpost::machine::{Kinematics, builtin};
+use kinpost::{PostOptions, post};
+
+fn post_csv(cl: &str) -> Result<String, kinpost::PostError> {
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let mut out = Vec::new();
+    post(
+        cl.as_bytes(),
+        &machine,
+        &dialect,
+        &mut out,
+        &PostOptions::default(),
+    )?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+#[test]
+fn references_drive_the_c_axis_and_the_check_covers_them() {
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let six = Kinematics::new(&machine.with_reference_axes_free());
+    let mut cl = String::from("FEDRAT/MMPM,300\n");
+    let mut joints = Vec::new();
+    for k in 0..30 {
+        let t = k as f64 / 29.0;
+        // X A Y Z B C
+        let q = [
+            459.0 + 5.0 * t,
+            20.0 * t,
+            10.0 - 3.0 * t,
+            355.0 + t,
+            -15.0 + 30.0 * t,
+            -60.0 + 100.0 * t,
+        ];
+        let p = six.fk(&q);
+        let r = p.reference.unwrap();
+        cl.push_str(&format!(
+            "GOTO/{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9}\n",
+            p.point.x, p.point.y, p.point.z, p.axis.x, p.axis.y, p.axis.z, r.x, r.y, r.z
+        ));
+        joints.push(q);
+    }
+    let csv = post_csv(&cl).unwrap();
+    let mut rows = csv.lines();
+    assert_eq!(rows.next().unwrap(), "line,motion,X,A,Y,Z,B,C,feed");
+    for (row, q) in rows.zip(&joints) {
+        let f: Vec<f64> = row
+            .split(',')
+            .skip(2)
+            .take(6)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        for k in 0..6 {
+            assert!((f[k] - q[k]).abs() < 2e-6, "{row} vs {q:?}");
+        }
+    }
+}
+
+#[test]
+fn sinumerik_writes_c_only_in_six_axis_programs() {
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let run = |cl: &str| {
+        let mut out = Vec::new();
+        post(
+            cl.as_bytes(),
+            &machine,
+            &dialect,
+            &mut out,
+            &PostOptions::default(),
+        )
+        .unwrap();
+        String::from_utf8(out).unwrap()
+    };
+    let five = run("RAPID\nGOTO/-416,70.5,16.53,0,0,1\n");
+    assert!(
+        five.contains("X=459.000 Y=8.700 Z366.530 B0.000 A=DC(0.000)\n"),
+        "{five}"
+    );
+    let six = run("RAPID\nGOTO/-416,70.5,16.53,0,0,1,0.5,0.8660254038,0\n");
+    assert!(six.contains("B0.000 A=DC(0.000) C60.000"), "{six}");
+}
+
+#[test]
+fn mixing_five_and_six_axis_points_is_an_error_naming_the_line() {
+    // A 6-value GOTO keeps the reference of the last 9-value one (CL reader).
+    let csv = post_csv("FEDRAT/250\nGOTO/-416,70.5,16.53,0,0,1,0,1,0\nGOTO/-416,70.5,10,0,0,1\n")
+        .unwrap();
+    let c: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(7).unwrap())
+        .collect();
+    assert_eq!(c, ["90.000000", "90.000000"], "{csv}");
+    let err = post_csv("FEDRAT/250\nGOTO/-416,70.5,16.53,0,0,1\nGOTO/-416,70.5,10,0,0,1,1,0,0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(":3:1") && err.contains("began without"),
+        "{err}"
+    );
+}
