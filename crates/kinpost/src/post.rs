@@ -98,13 +98,18 @@ struct Job<'a, W: Write> {
     setup: Option<Setup<W>>,
     pending: Vec<Pending>,
     info: ProgramInfo,
+    point: PointState,
+    /// Scale from CL units to mm.
+    scale: f64,
+    cl_points: u64,
+}
+
+/// What the work on one CL point reads and updates besides the setup.
+struct PointState {
     solutions: Vec<Solution>,
     written: [f64; kinpost_machine::MAX_AXES],
     stats: CheckStats,
     feed: Option<f64>,
-    /// Scale from CL units to mm.
-    scale: f64,
-    cl_points: u64,
     blocks: u64,
 }
 
@@ -144,13 +149,15 @@ pub fn post<R: BufRead, W: Write>(
             cl_file: options.cl_file.clone(),
             ..ProgramInfo::default()
         },
-        solutions: Vec::with_capacity(16),
-        written: [0.0; kinpost_machine::MAX_AXES],
-        stats: CheckStats::default(),
-        feed: None,
+        point: PointState {
+            solutions: Vec::with_capacity(16),
+            written: [0.0; kinpost_machine::MAX_AXES],
+            stats: CheckStats::default(),
+            feed: None,
+            blocks: 0,
+        },
         scale: 1.0,
         cl_points: 0,
-        blocks: 0,
     };
     let mut named = options.program_name.is_some();
     let mut tool_loaded = false;
@@ -174,7 +181,7 @@ pub fn post<R: BufRead, W: Write>(
                 job.motion(&pose, motion, line, &reader)?;
             }
             ClEvent::Feedrate { value, unit } => {
-                job.feed = Some(match unit {
+                job.point.feed = Some(match unit {
                     FeedUnit::Mmpm | FeedUnit::Mmpr => value,
                     FeedUnit::Ipm | FeedUnit::Ipr => value * 25.4,
                 });
@@ -238,7 +245,10 @@ pub fn post<R: BufRead, W: Write>(
             ClEvent::Fini => break,
         }
     }
-    let mut setup = job.open(false)?;
+    job.open(false)?;
+    let Some(mut setup) = job.setup.take() else {
+        unreachable!("`open` sets the job up")
+    };
     setup
         .writer
         .footer(&job.info, machine.post.footer.as_deref())?;
@@ -249,10 +259,10 @@ pub fn post<R: BufRead, W: Write>(
     warnings.sort_by_key(|w| (w.line, w.column));
     Ok(Summary {
         cl_points: job.cl_points,
-        blocks: job.blocks,
+        blocks: job.point.blocks,
         warnings,
-        max_position_error_mm: job.stats.max_position_error_mm,
-        max_axis_error_rad: job.stats.max_axis_error_rad,
+        max_position_error_mm: job.point.stats.max_position_error_mm,
+        max_axis_error_rad: job.point.stats.max_axis_error_rad,
         tolerance_mm: tolerance.position_mm,
         tolerance_rad: tolerance.axis_rad,
         seconds: started.elapsed().as_secs_f64(),
@@ -261,9 +271,8 @@ pub fn post<R: BufRead, W: Write>(
 
 impl<W: Write> Job<'_, W> {
     /// Sets the machine up for the program (once) and writes the header and
-    /// whatever waited for it; hands the setup out of the job (put it back
-    /// with `self.setup = Some(..)` to keep using the job).
-    fn open(&mut self, six_axis: bool) -> Result<Setup<W>, PostError> {
+    /// whatever waited for it.
+    fn open(&mut self, six_axis: bool) -> Result<(), PostError> {
         if self.setup.is_none() {
             let machine = if six_axis {
                 self.machine.with_reference_axes_free()
@@ -304,7 +313,7 @@ impl<W: Write> Job<'_, W> {
                 tolerance,
             });
         }
-        Ok(self.setup.take().expect("set up above"))
+        Ok(())
     }
 
     /// Writes an NC output now, or once the program is set up.
@@ -338,33 +347,45 @@ impl<W: Write> Job<'_, W> {
         };
         let unlocks = self.machine.unlocks_with_reference();
         let six_axis = pose.reference.is_some() && unlocks;
-        let mut setup = self.open(six_axis)?;
-        let result = self.drive(&mut setup, pose, motion, line, six_axis, unlocks, &at);
-        self.setup = Some(setup);
-        result
+        self.open(six_axis)?;
+        let Some(setup) = self.setup.as_mut() else {
+            unreachable!("`open` sets the job up")
+        };
+        drive(
+            setup,
+            &mut self.point,
+            self.options.tolerance_mm.is_some(),
+            pose,
+            motion,
+            line,
+            six_axis,
+            &at,
+        )
     }
+}
 
-    /// The work of [`Job::motion`] once the machine is set up.
-    #[allow(clippy::too_many_arguments)]
-    fn drive(
-        &mut self,
-        s: &mut Setup<W>,
-        pose: &Pose,
-        motion: Motion,
-        line: usize,
-        six_axis: bool,
-        unlocks: bool,
-        at: &dyn Fn(String) -> PostError,
-    ) -> Result<(), PostError> {
-        let tolerance_given = self.options.tolerance_mm.is_some();
-        if unlocks && s.six_axis != six_axis {
+/// The work of [`Job::motion`] once the machine is set up. `six_axis`: the
+/// point asks for 6-axis output (it must match the program's).
+#[allow(clippy::too_many_arguments)]
+fn drive<W: Write>(
+    s: &mut Setup<W>,
+    st: &mut PointState,
+    tolerance_given: bool,
+    pose: &Pose,
+    motion: Motion,
+    line: usize,
+    six_axis: bool,
+    at: &dyn Fn(String) -> PostError,
+) -> Result<(), PostError> {
+    {
+        if s.six_axis != six_axis {
             return Err(at(if s.six_axis {
                 "this CL point has no reference direction, but the program began with them \
-                 (6-axis output): give every GOTO nine values, or none"
+             (6-axis output): give every GOTO nine values, or none"
                     .to_string()
             } else {
                 "this CL point has a reference direction, but the program began without \
-                 (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
+             (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
                     .to_string()
             }));
         }
@@ -375,12 +396,12 @@ impl<W: Write> Job<'_, W> {
         let n = s.machine.axes.len();
         if let Err(e) = s
             .kin
-            .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut self.solutions)
+            .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut st.solutions)
         {
             return Err(at(format!("{e}: {}", describe(pose))));
         }
-        let chosen = match s.planner.choose(&self.solutions) {
-            Ok(i) => self.solutions[i],
+        let chosen = match s.planner.choose(&st.solutions) {
+            Ok(i) => st.solutions[i],
             Err(Rejection::OutsideLimits(v)) => {
                 let a = &s.machine.axes[v.axis];
                 let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
@@ -396,16 +417,16 @@ impl<W: Write> Job<'_, W> {
             }
         };
         for i in 0..n {
-            self.written[i] = s.writer.quantized(i, chosen.joints[i]);
+            st.written[i] = s.writer.quantized(i, chosen.joints[i]);
         }
-        let reached = s.kin.fk(&self.written[..n]);
-        if !self.stats.record(pose, &reached, line, &s.tolerance)
-            && !within_block_bound(s, tolerance_given, pose, &reached, &self.written[..n])
+        let reached = s.kin.fk(&st.written[..n]);
+        if !st.stats.record(pose, &reached, line, &s.tolerance)
+            && !within_block_bound(s, tolerance_given, pose, &reached, &st.written[..n])
         {
             let (p, a) = pose_error(pose, &reached);
             return Err(at(format!(
                 "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
-                 from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
+             from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
                 s.tolerance.position_mm,
                 s.tolerance.axis_rad,
                 describe(pose)
@@ -413,12 +434,12 @@ impl<W: Write> Job<'_, W> {
         }
         let feed = match motion {
             Motion::Rapid => None,
-            Motion::Feed if self.feed.is_none() => {
+            Motion::Feed if st.feed.is_none() => {
                 return Err(at(
                     "feed move before any FEDRAT: the controller has no feed rate for it".into(),
                 ));
             }
-            Motion::Feed => self.feed,
+            Motion::Feed => st.feed,
         };
         s.writer.block(&Block {
             cl_line: Some(line),
@@ -429,7 +450,7 @@ impl<W: Write> Job<'_, W> {
             axes: &chosen.joints[..n],
             feed,
         })?;
-        self.blocks += 1;
+        st.blocks += 1;
         Ok(())
     }
 }
