@@ -377,82 +377,80 @@ fn drive<W: Write>(
     six_axis: bool,
     at: &dyn Fn(String) -> PostError,
 ) -> Result<(), PostError> {
-    {
-        if s.six_axis != six_axis {
-            return Err(at(if s.six_axis {
-                "this CL point has no reference direction, but the program began with them \
+    if s.six_axis != six_axis {
+        return Err(at(if s.six_axis {
+            "this CL point has no reference direction, but the program began with them \
              (6-axis output): give every GOTO nine values, or none"
-                    .to_string()
-            } else {
-                "this CL point has a reference direction, but the program began without \
+                .to_string()
+        } else {
+            "this CL point has a reference direction, but the program began without \
              (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
-                    .to_string()
-            }));
-        }
-        if motion == Motion::Rapid {
-            s.planner.break_segment();
-        }
-        let hint = s.planner.current().copied();
-        let n = s.machine.axes.len();
-        if let Err(e) = s
-            .kin
-            .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut st.solutions)
-        {
-            return Err(at(format!("{e}: {}", describe(pose))));
-        }
-        let chosen = match s.planner.choose(&st.solutions) {
-            Ok(i) => st.solutions[i],
-            Err(Rejection::OutsideLimits(v)) => {
-                let a = &s.machine.axes[v.axis];
-                let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
-                return Err(at(format!(
-                    "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
-                    a.name,
-                    v.value,
-                    describe(pose)
-                )));
-            }
-            Err(Rejection::NoSolution) => {
-                return Err(at(format!("no solution for {}", describe(pose))));
-            }
-        };
-        for i in 0..n {
-            st.written[i] = s.writer.quantized(i, chosen.joints[i]);
-        }
-        let reached = s.kin.fk(&st.written[..n]);
-        if !st.stats.record(pose, &reached, line, &s.tolerance)
-            && !within_block_bound(s, tolerance_given, pose, &reached, &st.written[..n])
-        {
-            let (p, a) = pose_error(pose, &reached);
+                .to_string()
+        }));
+    }
+    if motion == Motion::Rapid {
+        s.planner.break_segment();
+    }
+    let hint = s.planner.current().copied();
+    let n = s.machine.axes.len();
+    if let Err(e) = s
+        .kin
+        .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut st.solutions)
+    {
+        return Err(at(format!("{e}: {}", describe(pose))));
+    }
+    let chosen = match s.planner.choose(&st.solutions) {
+        Ok(i) => st.solutions[i],
+        Err(Rejection::OutsideLimits(v)) => {
+            let a = &s.machine.axes[v.axis];
+            let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
             return Err(at(format!(
-                "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
-             from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
-                s.tolerance.position_mm,
-                s.tolerance.axis_rad,
+                "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
+                a.name,
+                v.value,
                 describe(pose)
             )));
         }
-        let feed = match motion {
-            Motion::Rapid => None,
-            Motion::Feed if st.feed.is_none() => {
-                return Err(at(
-                    "feed move before any FEDRAT: the controller has no feed rate for it".into(),
-                ));
-            }
-            Motion::Feed => st.feed,
-        };
-        s.writer.block(&Block {
-            cl_line: Some(line),
-            motion: match motion {
-                Motion::Rapid => kinpost_nc::Motion::Rapid,
-                Motion::Feed => kinpost_nc::Motion::Feed,
-            },
-            axes: &chosen.joints[..n],
-            feed,
-        })?;
-        st.blocks += 1;
-        Ok(())
+        Err(Rejection::NoSolution) => {
+            return Err(at(format!("no solution for {}", describe(pose))));
+        }
+    };
+    for i in 0..n {
+        st.written[i] = s.writer.quantized(i, chosen.joints[i]);
     }
+    let reached = s.kin.fk(&st.written[..n]);
+    if !st.stats.record(pose, &reached, line, &s.tolerance)
+        && !within_block_bound(s, tolerance_given, pose, &reached, &st.written[..n])
+    {
+        let (p, a) = pose_error(pose, &reached);
+        return Err(at(format!(
+            "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
+             from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
+            s.tolerance.position_mm,
+            s.tolerance.axis_rad,
+            describe(pose)
+        )));
+    }
+    let feed = match motion {
+        Motion::Rapid => None,
+        Motion::Feed if st.feed.is_none() => {
+            return Err(at(
+                "feed move before any FEDRAT: the controller has no feed rate for it".into(),
+            ));
+        }
+        Motion::Feed => st.feed,
+    };
+    s.writer.block(&Block {
+        cl_line: Some(line),
+        motion: match motion {
+            Motion::Rapid => kinpost_nc::Motion::Rapid,
+            Motion::Feed => kinpost_nc::Motion::Feed,
+        },
+        axes: &chosen.joints[..n],
+        feed,
+    })?;
+    st.blocks += 1;
+    Ok(())
 }
 
 fn write_pending<W: Write>(writer: &mut NcWriter<W>, p: Pending) -> Result<(), PostError> {
