@@ -4,8 +4,22 @@ use kinpost_diag::Diagnostics;
 
 use crate::{Machine, machine_from_toml};
 
+/// A built-in machine: its name and the text of `machines/NAME.toml`.
+macro_rules! machine {
+    ($name:literal) => {
+        ($name, include_str!(concat!("../machines/", $name, ".toml")))
+    };
+}
+
 /// Name and TOML text of every built-in machine.
-pub const MACHINES: &[(&str, &str)] = &[("mts1600", include_str!("../machines/mts1600.toml"))];
+pub const MACHINES: &[(&str, &str)] = &[
+    machine!("mts1600"),
+    machine!("ac-grinder"),
+    machine!("htm40100h"),
+    machine!("trunnion-ac"),
+    machine!("head-head-bc"),
+    machine!("table-head-bc"),
+];
 
 /// Names of the built-in machines.
 pub fn names() -> impl Iterator<Item = &'static str> {
@@ -30,7 +44,10 @@ mod tests {
     #[test]
     fn every_builtin_loads() {
         for name in super::names() {
-            super::load(name).unwrap().unwrap();
+            let m = super::load(name).unwrap().unwrap();
+            // The registry name is the machine's own name.
+            assert_eq!(m.name, name);
+            assert!(!m.description.is_empty(), "{name}: no description");
         }
     }
 }
