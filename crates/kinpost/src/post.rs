@@ -249,9 +249,10 @@ pub fn post<R: BufRead, W: Write>(
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
     };
-    setup
-        .writer
-        .footer(&job.info, machine.post.footer.as_deref())?;
+    setup.writer.footer(
+        &job.info,
+        machine_template(machine, dialect, &machine.post.footer),
+    )?;
     let tolerance = setup.tolerance;
     setup.writer.finish()?;
 
@@ -299,7 +300,10 @@ impl<W: Write> Job<'_, W> {
             };
             let out = self.out.take().expect("the output is taken once, here");
             let mut writer = NcWriter::new(self.dialect, &axes, out);
-            writer.header(&self.info, self.machine.post.header.as_deref())?;
+            writer.header(
+                &self.info,
+                machine_template(self.machine, self.dialect, &self.machine.post.header),
+            )?;
             for p in std::mem::take(&mut self.pending) {
                 write_pending(&mut writer, p)?;
             }
@@ -451,6 +455,20 @@ fn drive<W: Write>(
     })?;
     st.blocks += 1;
     Ok(())
+}
+
+/// The machine's own header or footer: written for the machine's default
+/// dialect only (it is in that controller's language); other dialects use
+/// their own.
+fn machine_template<'a>(
+    machine: &Machine,
+    dialect: &Dialect,
+    template: &'a Option<String>,
+) -> Option<&'a str> {
+    match &machine.post.dialect {
+        Some(d) if d.eq_ignore_ascii_case(dialect.name()) => template.as_deref(),
+        _ => None,
+    }
 }
 
 fn write_pending<W: Write>(writer: &mut NcWriter<W>, p: Pending) -> Result<(), PostError> {

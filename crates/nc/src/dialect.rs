@@ -17,10 +17,21 @@ use crate::{AxisSpec, Motion};
 /// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
 const MAX_PREFIX: usize = 24;
 
-const SINUMERIK: &str = include_str!("../dialects/sinumerik.toml");
-const CSV: &str = include_str!("../dialects/csv.toml");
-const BUILTINS: &[(&str, &str)] = &[("sinumerik", SINUMERIK), ("csv", CSV)];
-const BUILTIN_NAMES: &[&str] = &["sinumerik", "csv"];
+/// A built-in dialect: its name and the text of `dialects/NAME.toml`.
+macro_rules! dialect {
+    ($name:literal) => {
+        ($name, include_str!(concat!("../dialects/", $name, ".toml")))
+    };
+}
+
+const BUILTINS: &[(&str, &str)] = &[
+    dialect!("sinumerik"),
+    dialect!("fanuc"),
+    dialect!("heidenhain"),
+    dialect!("linuxcnc"),
+    dialect!("csv"),
+];
+const BUILTIN_NAMES: &[&str] = &["sinumerik", "fanuc", "heidenhain", "linuxcnc", "csv"];
 
 /// What kind of file a dialect writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
