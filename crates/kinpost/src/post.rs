@@ -287,6 +287,7 @@ impl<W: Write> Job<'_, W> {
                     name: a.name.clone(),
                     rotary: a.is_rotary(),
                     fixed: a.fixed.is_some(),
+                    endless: a.is_endless(),
                 })
                 .collect();
             let resolution: Vec<f64> = axes

@@ -52,6 +52,13 @@ impl Axis {
         self.fixed.is_none()
     }
 
+    /// A rotary axis that turns without end: no limits, or at least a full
+    /// turn each way (±360°). Controllers run such axes as modulo axes, and
+    /// dialects may write them with shortest-path words (Sinumerik `DC`).
+    pub fn is_endless(&self) -> bool {
+        self.is_rotary() && self.limits.is_none_or(|[lo, hi]| hi - lo >= 720.0)
+    }
+
     /// Whether `value` lies inside the travel (with a tolerance of 1e-9 for
     /// values computed exactly at a limit).
     pub fn accepts(&self, value: f64) -> bool {

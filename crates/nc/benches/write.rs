@@ -30,7 +30,7 @@ fn bench(c: &mut Criterion) {
     let dialect = Dialect::builtin("sinumerik").unwrap();
     let axes = [
         AxisSpec::linear("X"),
-        AxisSpec::rotary("A"),
+        AxisSpec::endless("A"),
         AxisSpec::linear("Y"),
         AxisSpec::linear("Z"),
         AxisSpec::rotary("B"),

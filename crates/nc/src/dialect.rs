@@ -202,6 +202,8 @@ pub struct Dialect {
     pub(crate) block: BlockFormat,
     linear: PartialWord,
     rotary: PartialWord,
+    /// Over `rotary`, for rotary axes that turn without end.
+    endless: PartialWord,
     axis: BTreeMap<String, PartialWord>,
     pub(crate) feed: FeedFormat,
     pub(crate) motion: MotionWords,
@@ -312,6 +314,7 @@ impl Dialect {
         };
         check_word(&raw.linear, &mut err);
         check_word(&raw.rotary, &mut err);
+        check_word(&raw.endless, &mut err);
         for w in raw.axis.values() {
             check_word(w, &mut err);
         }
@@ -320,6 +323,7 @@ impl Dialect {
 
         let linear = base.over(&PartialWord::from(&raw.linear));
         let rotary = base.over(&PartialWord::from(&raw.rotary));
+        let endless = PartialWord::from(&raw.endless);
         let axis: BTreeMap<String, PartialWord> = raw
             .axis
             .iter()
@@ -344,6 +348,7 @@ impl Dialect {
         };
         whole(&raw.linear, &[linear.resolve("X")]);
         whole(&raw.rotary, &[rotary.resolve("A")]);
+        whole(&raw.endless, &[rotary.over(&endless).resolve("A")]);
         for (name, w) in &raw.axis {
             let o = PartialWord::from(w);
             whole(
@@ -458,6 +463,7 @@ impl Dialect {
             block,
             linear,
             rotary,
+            endless,
             axis,
             feed: FeedFormat {
                 word: feed_word,
@@ -530,10 +536,10 @@ impl Dialect {
     /// The word format of one machine axis: built-in default, then
     /// `[linear]` or `[rotary]`, then `[axis.NAME]`.
     pub fn word_format(&self, axis: &AxisSpec) -> WordFormat {
-        let kind_default = if axis.rotary {
-            &self.rotary
-        } else {
-            &self.linear
+        let kind_default = match (axis.rotary, axis.endless) {
+            (true, true) => self.rotary.over(&self.endless),
+            (true, false) => self.rotary.clone(),
+            (false, _) => self.linear.clone(),
         };
         match self.axis.get(&axis.name) {
             Some(o) => kind_default.over(o).resolve(&axis.name),
@@ -666,6 +672,8 @@ struct RawDialect {
     linear: RawWord,
     #[serde(default)]
     rotary: RawWord,
+    #[serde(default)]
+    endless: RawWord,
     #[serde(default)]
     axis: BTreeMap<String, RawWord>,
     #[serde(default)]

@@ -10,7 +10,7 @@
 //! ```
 //! use kinpost_nc::{AxisSpec, Block, Dialect, Motion, NcWriter};
 //! let dialect = Dialect::builtin("sinumerik").unwrap();
-//! let axes = [AxisSpec::linear("X"), AxisSpec::rotary("A"), AxisSpec::linear("Y"),
+//! let axes = [AxisSpec::linear("X"), AxisSpec::endless("A"), AxisSpec::linear("Y"),
 //!             AxisSpec::linear("Z"), AxisSpec::rotary("B"), AxisSpec::rotary("C").fixed()];
 //! let mut w = NcWriter::new(&dialect, &axes, Vec::new());
 //! w.block(&Block { cl_line: Some(16), motion: Motion::Feed,
@@ -47,6 +47,10 @@ pub struct AxisSpec {
     pub rotary: bool,
     /// Locked by the machine (e.g. C in 5-axis mode).
     pub fixed: bool,
+    /// A rotary axis that turns without end (a modulo axis on the
+    /// controller): dialects may write it with shortest-path words such as
+    /// Sinumerik's `DC(…)` (the `[endless]` word format).
+    pub endless: bool,
 }
 
 impl AxisSpec {
@@ -56,6 +60,7 @@ impl AxisSpec {
             name: name.to_string(),
             rotary: false,
             fixed: false,
+            endless: false,
         }
     }
 
@@ -65,6 +70,15 @@ impl AxisSpec {
             name: name.to_string(),
             rotary: true,
             fixed: false,
+            endless: false,
+        }
+    }
+
+    /// A free rotary axis that turns without end.
+    pub fn endless(name: &str) -> AxisSpec {
+        AxisSpec {
+            endless: true,
+            ..AxisSpec::rotary(name)
         }
     }
 

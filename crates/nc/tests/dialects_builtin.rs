@@ -15,7 +15,7 @@ use kinpost_nc::{
 fn axes() -> Vec<AxisSpec> {
     vec![
         AxisSpec::linear("X"),
-        AxisSpec::rotary("A"),
+        AxisSpec::endless("A"),
         AxisSpec::linear("Y"),
         AxisSpec::linear("Z"),
         AxisSpec::rotary("B"),

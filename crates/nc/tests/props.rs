@@ -103,7 +103,7 @@ proptest! {
 fn mts_axes() -> Vec<AxisSpec> {
     vec![
         AxisSpec::linear("X"),
-        AxisSpec::rotary("A"),
+        AxisSpec::endless("A"),
         AxisSpec::linear("Y"),
         AxisSpec::linear("Z"),
         AxisSpec::rotary("B"),

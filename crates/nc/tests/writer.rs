@@ -9,7 +9,7 @@ use kinpost_nc::{
 fn mts_axes() -> Vec<AxisSpec> {
     vec![
         AxisSpec::linear("X"),
-        AxisSpec::rotary("A"),
+        AxisSpec::endless("A"),
         AxisSpec::linear("Y"),
         AxisSpec::linear("Z"),
         AxisSpec::rotary("B"),
@@ -604,4 +604,29 @@ fn builtins_parse_and_list() {
         assert!(Dialect::builtin_source(name).unwrap().contains("name ="));
     }
     assert!(Dialect::builtin("nope").is_none());
+}
+
+/// Shortest-path `DC` words are for endless (modulo) rotary axes only: a
+/// tilting A (e.g. a trunnion's, −30…120°) is written as a plain position.
+#[test]
+fn sinumerik_dc_only_for_endless_axes() {
+    let d = Dialect::builtin("sinumerik").unwrap();
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::rotary("A"),
+        AxisSpec::endless("C"),
+    ];
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let values = [1.0, -30.0, -90.0];
+    w.block(&Block {
+        cl_line: Some(1),
+        motion: Motion::Feed,
+        axes: &values,
+        feed: Some(100.0),
+    })
+    .unwrap();
+    assert_eq!(w.quantized(1, -30.0), -30.0);
+    assert_eq!(w.quantized(2, -90.0), 270.0);
+    let out = text(w);
+    assert!(out.contains("X=1.000 A-30.000 C=DC(270.000) F100"), "{out}");
 }
