@@ -26,6 +26,13 @@ impl Tolerance {
         Self::with_levers(machine, resolution, |_| lever)
     }
 
+    /// The rounding error of tool-centre-point output: the tool point is
+    /// written directly (half a unit per linear word), the tool axis through
+    /// the rotary words.
+    pub fn for_tcp(machine: &Machine, resolution: impl Fn(usize) -> f64) -> Tolerance {
+        Self::with_levers(machine, resolution, |_| 0.0)
+    }
+
     /// The rounding error bound of one block at joint values `q`, with the
     /// actual lever of every rotary axis (how far the tool point moves per
     /// radian of that axis, by central differences through `kin`). Used where

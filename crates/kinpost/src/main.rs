@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
-use kinpost::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
 use kinpost::nc::Dialect;
 use kinpost::output::{AtomicFile, write_atomically};
 use kinpost::{PostError, PostOptions};
@@ -77,8 +77,8 @@ struct PostArgs {
     #[arg(long, short)]
     dialect: Option<String>,
     /// Output NC file; default: standard output.
-    #[arg(long, short)]
-    output: Option<PathBuf>,
+    #[arg(short = 'o', long = "output-file", value_name = "FILE")]
+    output_file: Option<PathBuf>,
     /// Write the run summary as JSON to this file.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -93,12 +93,23 @@ struct PostArgs {
     /// same input gives the same output bytes.
     #[arg(long)]
     date: Option<String>,
+    /// Joint output (machine axis values) or tool-centre-point output (tool
+    /// point and rotary axes; the controller does the kinematics). Default:
+    /// the machine's `[post] output`, else joint.
+    #[arg(long, value_enum, value_name = "MODE")]
+    output: Option<Output>,
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
     /// Print no summary on standard error.
     #[arg(long, short)]
     quiet: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Output {
+    Joint,
+    Tcp,
 }
 
 #[derive(Subcommand)]
@@ -284,6 +295,10 @@ fn post(args: PostArgs) -> Result<()> {
             None => String::new(),
         },
         tolerance_mm: args.tolerance,
+        output: args.output.map(|o| match o {
+            Output::Joint => OutputMode::Joint,
+            Output::Tcp => OutputMode::Tcp,
+        }),
         default_axis: args
             .default_axis
             .as_deref()
@@ -303,7 +318,7 @@ fn post(args: PostArgs) -> Result<()> {
         Box::new(BufReader::with_capacity(1 << 16, f))
     };
 
-    let result = match &args.output {
+    let result = match &args.output_file {
         Some(path) => {
             let mut file = AtomicFile::create(path)
                 .with_context(|| format!("cannot create {}", path.display()))?;

@@ -10,8 +10,10 @@ use std::time::Instant;
 
 use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, SpindleDir, Units};
 use kinpost_diag::{Diagnostic, Severity};
-use kinpost_machine::{Kinematics, Machine, Pose, Solution};
-use kinpost_nc::{AxisSpec, Block, Dialect, NcError, NcWriter, ProgramInfo, Spindle};
+use kinpost_machine::{Kinematics, Machine, OutputMode, Pose, Solution};
+use kinpost_nc::{
+    AxisSpec, Block, Dialect, DialectKind, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
+};
 use kinpost_plan::{NearestPlanner, Planner, Rejection};
 use nalgebra::Vector3;
 
@@ -33,6 +35,9 @@ pub struct PostOptions {
     pub tolerance_mm: Option<f64>,
     /// Tool axis for `GOTO/x,y,z` before any axis is given (3-axis APT).
     pub default_axis: Option<[f64; 3]>,
+    /// Joint or tool-centre-point output; default: the machine's (`[post]
+    /// output`), else joint.
+    pub output: Option<OutputMode>,
 }
 
 /// Why a post run failed.
@@ -47,6 +52,9 @@ pub enum PostError {
     /// A header, footer or event template failed.
     #[error("{0}")]
     Template(String),
+    /// The machine and dialect cannot write this kind of program.
+    #[error("{0}")]
+    Setup(String),
 }
 
 impl From<NcError> for PostError {
@@ -87,6 +95,9 @@ struct Setup<W: Write> {
     /// The tolerance in force; grows to a block's own rounding bound where
     /// that is larger (see `within_block_bound`).
     tolerance: Tolerance,
+    /// Tool-centre-point output: the indices of the linear axes X, Y, Z,
+    /// which carry the tool point in the part frame.
+    tcp: Option<[usize; 3]>,
 }
 
 /// State of the program being written.
@@ -249,6 +260,9 @@ pub fn post<R: BufRead, W: Write>(
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
     };
+    if setup.tcp.is_some() {
+        setup.writer.tcp(false)?;
+    }
     setup.writer.footer(
         &job.info,
         machine_template(machine, dialect, &machine.post.footer),
@@ -294,7 +308,19 @@ impl<W: Write> Job<'_, W> {
                 .iter()
                 .map(|a| 10f64.powi(-i32::from(self.dialect.word_format(a).number.decimals)))
                 .collect();
-            let derived = Tolerance::from_resolution(&machine, |i| resolution[i]);
+            let mode = self
+                .options
+                .output
+                .or(machine.post.output)
+                .unwrap_or_default();
+            let tcp = match mode {
+                OutputMode::Joint => None,
+                OutputMode::Tcp => Some(tcp_axes(&machine, self.dialect)?),
+            };
+            let derived = match tcp {
+                None => Tolerance::from_resolution(&machine, |i| resolution[i]),
+                Some(_) => Tolerance::for_tcp(&machine, |i| resolution[i]),
+            };
             let tolerance = Tolerance {
                 position_mm: self.options.tolerance_mm.unwrap_or(derived.position_mm),
                 ..derived
@@ -308,6 +334,9 @@ impl<W: Write> Job<'_, W> {
             for p in std::mem::take(&mut self.pending) {
                 write_pending(&mut writer, p)?;
             }
+            if tcp.is_some() {
+                writer.tcp(true)?;
+            }
             self.setup = Some(Setup {
                 kin: Kinematics::new(&machine),
                 planner: NearestPlanner::new(&machine),
@@ -316,6 +345,7 @@ impl<W: Write> Job<'_, W> {
                 writer,
                 resolution,
                 tolerance,
+                tcp,
             });
         }
         Ok(())
@@ -420,10 +450,23 @@ fn drive<W: Write>(
             return Err(at(format!("no solution for {}", describe(pose))));
         }
     };
-    for i in 0..n {
-        st.written[i] = s.writer.quantized(i, chosen.joints[i]);
+    // Joint output writes the axis values; tool-centre-point output writes
+    // the tool point on X, Y, Z and the rotary axis values.
+    let mut values = chosen.joints;
+    if let Some([x, y, z]) = s.tcp {
+        values[x] = pose.point.x;
+        values[y] = pose.point.y;
+        values[z] = pose.point.z;
     }
-    let reached = s.kin.fk(&st.written[..n]);
+    for (i, (w, v)) in st.written[..n].iter_mut().zip(&values[..n]).enumerate() {
+        *w = s.writer.quantized(i, *v);
+    }
+    let mut reached = s.kin.fk(&st.written[..n]);
+    if let Some([x, y, z]) = s.tcp {
+        // The controller puts the tool point where the words say; the
+        // orientation comes from the rotary words alone.
+        reached.point = Vector3::new(st.written[x], st.written[y], st.written[z]);
+    }
     if !st.stats.record(pose, &reached, line, &s.tolerance)
         && !within_block_bound(s, tolerance_given, pose, &reached, &st.written[..n])
     {
@@ -451,11 +494,36 @@ fn drive<W: Write>(
             Motion::Rapid => kinpost_nc::Motion::Rapid,
             Motion::Feed => kinpost_nc::Motion::Feed,
         },
-        axes: &chosen.joints[..n],
+        axes: &values[..n],
         feed,
     })?;
     st.blocks += 1;
     Ok(())
+}
+
+/// The linear axes named X, Y and Z, which carry the tool point in
+/// tool-centre-point output; the dialect must be able to switch it on.
+fn tcp_axes(machine: &Machine, dialect: &Dialect) -> Result<[usize; 3], PostError> {
+    let mut found = [usize::MAX; 3];
+    for (k, name) in ["X", "Y", "Z"].iter().enumerate() {
+        found[k] = machine
+            .axes
+            .iter()
+            .position(|a| !a.is_rotary() && a.is_free() && a.name.eq_ignore_ascii_case(name))
+            .ok_or_else(|| {
+                PostError::Setup(format!(
+                    "tool-centre-point output needs free linear axes named X, Y and Z; machine `{}` has no {name}",
+                    machine.name
+                ))
+            })?;
+    }
+    if dialect.kind() != DialectKind::Csv && dialect.template(TemplateKind::TcpOn).is_none() {
+        return Err(PostError::Setup(format!(
+            "dialect `{}` has no `tcp_on` template: it cannot switch tool-centre-point control on",
+            dialect.name()
+        )));
+    }
+    Ok(found)
 }
 
 /// The machine's own header or footer: written for the machine's default
@@ -493,7 +561,7 @@ fn within_block_bound<W: Write>(
     got: &Pose,
     written: &[f64],
 ) -> bool {
-    if tolerance_given {
+    if tolerance_given || s.tcp.is_some() {
         return false;
     }
     let resolution = &s.resolution;

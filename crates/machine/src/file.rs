@@ -10,7 +10,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Deserializer};
 use toml::Spanned;
 
-use crate::model::{Axis, AxisKind, MAX_AXES, Machine, PostSettings, Side, Tool};
+use crate::model::{Axis, AxisKind, MAX_AXES, Machine, OutputMode, PostSettings, Side, Tool};
 
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;
@@ -40,6 +40,14 @@ struct RawPost {
     dialect: Option<String>,
     header: Option<String>,
     footer: Option<String>,
+    output: Option<RawOutput>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum RawOutput {
+    Joint,
+    Tcp,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq)]
@@ -392,6 +400,10 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
             dialect: raw.post.dialect,
             header: raw.post.header,
             footer: raw.post.footer,
+            output: raw.post.output.map(|o| match o {
+                RawOutput::Joint => OutputMode::Joint,
+                RawOutput::Tcp => OutputMode::Tcp,
+            }),
         },
     })
 }

@@ -21,4 +21,4 @@ pub mod subproblems;
 
 pub use file::machine_from_toml;
 pub use kinematics::{IkError, Joints, Kinematics, Solution, Violation, wrap180};
-pub use model::{Axis, AxisKind, MAX_AXES, Machine, Pose, PostSettings, Side, Tool};
+pub use model::{Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Side, Tool};

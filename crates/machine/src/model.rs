@@ -91,6 +91,21 @@ pub struct PostSettings {
     pub header: Option<String>,
     /// Footer template replacing the dialect's own.
     pub footer: Option<String>,
+    /// Joint or tool-centre-point output when the command line names none.
+    pub output: Option<OutputMode>,
+}
+
+/// What the linear axis words of a program mean.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OutputMode {
+    /// Machine axis values: the post does the kinematics.
+    #[default]
+    Joint,
+    /// Tool-centre-point control: X, Y, Z are the tool point in the part
+    /// frame, the rotary words are axis values, and the controller does the
+    /// kinematics (Sinumerik TRAORI, Fanuc G43.4, Heidenhain TCPM, LinuxCNC
+    /// TCP kinematics).
+    Tcp,
 }
 
 /// A whole machine.

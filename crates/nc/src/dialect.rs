@@ -162,11 +162,15 @@ pub enum TemplateKind {
     CoolantOff,
     /// Process pressure (`pressure`, belt grinding H1).
     Pressure,
+    /// Tool-centre-point control on (TRAORI, G43.4, M128, …).
+    TcpOn,
+    /// Tool-centre-point control off.
+    TcpOff,
 }
 
 impl TemplateKind {
     /// All kinds, in file order.
-    pub const ALL: [TemplateKind; 8] = [
+    pub const ALL: [TemplateKind; 10] = [
         TemplateKind::Header,
         TemplateKind::Footer,
         TemplateKind::ToolChange,
@@ -175,6 +179,8 @@ impl TemplateKind {
         TemplateKind::CoolantOn,
         TemplateKind::CoolantOff,
         TemplateKind::Pressure,
+        TemplateKind::TcpOn,
+        TemplateKind::TcpOff,
     ];
 
     /// The key in `[templates]`.
@@ -188,6 +194,8 @@ impl TemplateKind {
             TemplateKind::CoolantOn => "coolant_on",
             TemplateKind::CoolantOff => "coolant_off",
             TemplateKind::Pressure => "pressure",
+            TemplateKind::TcpOn => "tcp_on",
+            TemplateKind::TcpOff => "tcp_off",
         }
     }
 }
@@ -899,6 +907,8 @@ struct RawTemplates {
     coolant_on: Option<Spanned<String>>,
     coolant_off: Option<Spanned<String>>,
     pressure: Option<Spanned<String>>,
+    tcp_on: Option<Spanned<String>>,
+    tcp_off: Option<Spanned<String>>,
 }
 
 impl RawTemplates {
@@ -911,6 +921,8 @@ impl RawTemplates {
             TemplateKind::SpindleOff => self.spindle_off.as_ref(),
             TemplateKind::CoolantOn => self.coolant_on.as_ref(),
             TemplateKind::CoolantOff => self.coolant_off.as_ref(),
+            TemplateKind::TcpOn => self.tcp_on.as_ref(),
+            TemplateKind::TcpOff => self.tcp_off.as_ref(),
             TemplateKind::Pressure => self.pressure.as_ref(),
         }
     }

@@ -344,6 +344,16 @@ impl<W: Write> NcWriter<W> {
         }
     }
 
+    /// Tool-centre-point control on or off (templates `tcp_on`, `tcp_off`).
+    pub fn tcp(&mut self, on: bool) -> Result<(), NcError> {
+        let kind = if on {
+            TemplateKind::TcpOn
+        } else {
+            TemplateKind::TcpOff
+        };
+        self.command(kind, Vec::new())
+    }
+
     /// Process pressure (template `pressure` with `pressure`).
     pub fn pressure(&mut self, value: f64) -> Result<(), NcError> {
         self.command(

@@ -1,0 +1,101 @@
+//! Tool-centre-point output: X, Y, Z carry the CL point, the rotary words
+//! the same axis values as joint output, and the closed-loop check runs on
+//! those semantics.
+
+mod common;
+
+use kinpost::machine::{Kinematics, OutputMode, builtin};
+use kinpost::nc::Dialect;
+use kinpost::{PostError, PostOptions, post};
+
+fn run(machine: &str, dialect: &str, output: OutputMode, cl: &str) -> Result<String, PostError> {
+    let machine = builtin::load(machine).unwrap().unwrap();
+    let dialect = Dialect::builtin(dialect).unwrap();
+    let mut out = Vec::new();
+    let options = PostOptions {
+        output: Some(output),
+        ..Default::default()
+    };
+    post(cl.as_bytes(), &machine, &dialect, &mut out, &options)?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+fn rows(csv: &str) -> Vec<Vec<String>> {
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn tcp_rows_carry_the_cl_point_and_the_joint_rotaries() {
+    for name in builtin::names() {
+        let machine = builtin::load(name).unwrap().unwrap();
+        let kin = Kinematics::new(&machine);
+        let cl = common::job(&machine);
+        let tcp = rows(&run(name, "csv", OutputMode::Tcp, &cl).unwrap());
+        let joint = rows(&run(name, "csv", OutputMode::Joint, &cl).unwrap());
+        assert_eq!(tcp.len(), 10);
+        let col = |axis: &str| 2 + machine.axis_index(axis).unwrap();
+        for (k, (t, j)) in tcp.iter().zip(&joint).enumerate() {
+            let p = kin.fk(&common::joints(&machine, k as f64 / 9.0));
+            // The CL is written with 4 decimals, the CSV with 6.
+            for (axis, want) in [("X", p.point.x), ("Y", p.point.y), ("Z", p.point.z)] {
+                let got: f64 = t[col(axis)].parse().unwrap();
+                assert!((got - want).abs() < 6e-5, "{name} {axis}: {got} vs {want}");
+            }
+            for (i, a) in machine.axes.iter().enumerate() {
+                if a.is_rotary() {
+                    assert_eq!(t[2 + i], j[2 + i], "{name} row {k} axis {}", a.name);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_word_dialect_switches_tcp_on_and_off() {
+    let cl = common::job(&builtin::load("trunnion-ac").unwrap().unwrap());
+    for (dialect, on, off) in [
+        ("sinumerik", "TRAORI", "TRAFOOF"),
+        ("fanuc", "G43.4 H3", "G49"),
+        ("heidenhain", "FUNCTION TCPM", "FUNCTION RESET TCPM"),
+        ("linuxcnc", "M428", "M429"),
+    ] {
+        let nc = run("trunnion-ac", dialect, OutputMode::Tcp, &cl).unwrap();
+        let first_move = nc.find("X").unwrap();
+        let on_at = nc
+            .find(on)
+            .unwrap_or_else(|| panic!("{dialect}: no {on}\n{nc}"));
+        let off_at = nc
+            .rfind(off)
+            .unwrap_or_else(|| panic!("{dialect}: no {off}\n{nc}"));
+        assert!(on_at < first_move && off_at > on_at, "{dialect}\n{nc}");
+        let joint = run("trunnion-ac", dialect, OutputMode::Joint, &cl).unwrap();
+        assert!(
+            !joint.contains(on),
+            "{dialect}: joint output switched TCP on\n{joint}"
+        );
+    }
+}
+
+#[test]
+fn tcp_needs_xyz_axes_and_a_dialect_that_can_switch() {
+    let dialect =
+        Dialect::from_toml("name = \"plain\"\nextension = \"nc\"\n", "plain.toml").unwrap();
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let options = PostOptions {
+        output: Some(OutputMode::Tcp),
+        ..Default::default()
+    };
+    let err = post(
+        "RAPID\nGOTO/-416,70.5,16.53,0,0,1\n".as_bytes(),
+        &machine,
+        &dialect,
+        Vec::new(),
+        &options,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("no `tcp_on` template"), "{err}");
+}
