@@ -294,16 +294,7 @@ impl<W: Write> Job<'_, W> {
             } else {
                 self.machine.clone()
             };
-            let axes: Vec<AxisSpec> = machine
-                .axes
-                .iter()
-                .map(|a| AxisSpec {
-                    name: a.name.clone(),
-                    rotary: a.is_rotary(),
-                    fixed: a.fixed.is_some(),
-                    endless: a.is_endless(),
-                })
-                .collect();
+            let axes = axis_specs(&machine);
             let resolution: Vec<f64> = axes
                 .iter()
                 .map(|a| 10f64.powi(-i32::from(self.dialect.word_format(a).number.decimals)))
@@ -499,6 +490,20 @@ fn drive<W: Write>(
     })?;
     st.blocks += 1;
     Ok(())
+}
+
+/// The machine's axes as a dialect writes them.
+pub fn axis_specs(machine: &Machine) -> Vec<AxisSpec> {
+    machine
+        .axes
+        .iter()
+        .map(|a| AxisSpec {
+            name: a.name.clone(),
+            rotary: a.is_rotary(),
+            fixed: a.fixed.is_some(),
+            endless: a.is_endless(),
+        })
+        .collect()
 }
 
 /// The linear axes named X, Y and Z, which carry the tool point in

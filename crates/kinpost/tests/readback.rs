@@ -6,7 +6,7 @@
 mod common;
 
 use kinpost::machine::{Kinematics, OutputMode, Pose, builtin};
-use kinpost::nc::{AxisSpec, Dialect, read_program};
+use kinpost::nc::{Dialect, read_program};
 use kinpost::{PostOptions, post};
 use nalgebra::Vector3;
 
@@ -32,16 +32,7 @@ fn every_dialect_reads_back_onto_the_cl() {
         let kin = Kinematics::new(&machine);
         let cl = common::job(&machine);
         let poses = cl_poses(&cl);
-        let axes: Vec<AxisSpec> = machine
-            .axes
-            .iter()
-            .map(|a| AxisSpec {
-                name: a.name.clone(),
-                rotary: a.is_rotary(),
-                fixed: a.fixed.is_some(),
-                endless: a.is_endless(),
-            })
-            .collect();
+        let axes = kinpost::axis_specs(&machine);
         for dialect_name in Dialect::builtin_names() {
             let dialect = Dialect::builtin(dialect_name).unwrap();
             for output in [OutputMode::Joint, OutputMode::Tcp] {
