@@ -29,5 +29,5 @@ pub use kinpost_diag as diag;
 pub use kinpost_machine as machine;
 pub use kinpost_nc as nc;
 pub use kinpost_plan as plan;
-pub use post::{PostError, PostOptions, axis_specs, post};
+pub use post::{FeedMode, PostError, PostOptions, axis_specs, post};
 pub use summary::Summary;

@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand};
 use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
 use kinpost::nc::Dialect;
 use kinpost::output::{AtomicFile, write_atomically};
-use kinpost::{PostError, PostOptions};
+use kinpost::{FeedMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
 #[derive(Parser)]
@@ -98,12 +98,23 @@ struct PostArgs {
     /// the machine's `[post] output`, else joint.
     #[arg(long, value_enum, value_name = "MODE")]
     output: Option<Output>,
+    /// Feed words: `tip` (the CL feed at the tool point, mm/min) or
+    /// `inverse-time` (G93: F = 1 / block time in minutes; fanuc, linuxcnc,
+    /// sinumerik).
+    #[arg(long, value_enum, default_value = "tip")]
+    feed_mode: FeedModeArg,
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
     /// Print no summary on standard error.
     #[arg(long, short)]
     quiet: bool,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FeedModeArg {
+    Tip,
+    InverseTime,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -299,6 +310,10 @@ fn post(args: PostArgs) -> Result<()> {
             Output::Joint => OutputMode::Joint,
             Output::Tcp => OutputMode::Tcp,
         }),
+        feed_mode: match args.feed_mode {
+            FeedModeArg::Tip => FeedMode::Tip,
+            FeedModeArg::InverseTime => FeedMode::InverseTime,
+        },
         default_axis: args
             .default_axis
             .as_deref()

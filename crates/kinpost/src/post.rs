@@ -38,6 +38,21 @@ pub struct PostOptions {
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
+    /// How feed words are written.
+    pub feed_mode: FeedMode,
+}
+
+/// What the feed word of a feed block means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FeedMode {
+    /// The CL feed rate, mm/min at the tool (contact) point.
+    #[default]
+    Tip,
+    /// Inverse time (`G93`): F = 1 / block time in minutes, the block time
+    /// being the CL segment length over the CL feed rate. A block that does
+    /// not move the tool point but turns rotary axes takes its largest
+    /// rotary change in degrees over the feed rate (degrees per minute).
+    InverseTime,
 }
 
 /// Why a post run failed.
@@ -98,6 +113,8 @@ struct Setup<W: Write> {
     /// Tool-centre-point output: the indices of the linear axes X, Y, Z,
     /// which carry the tool point in the part frame.
     tcp: Option<[usize; 3]>,
+    /// Feed words are inverse time.
+    inverse_time: bool,
 }
 
 /// State of the program being written.
@@ -117,6 +134,9 @@ struct Job<'a, W: Write> {
 
 /// What the work on one CL point reads and updates besides the setup.
 struct PointState {
+    /// The previous CL point and the axis values written for it (for
+    /// inverse-time feeds).
+    previous: Option<(Vector3<f64>, [f64; kinpost_machine::MAX_AXES])>,
     solutions: Vec<Solution>,
     written: [f64; kinpost_machine::MAX_AXES],
     stats: CheckStats,
@@ -161,6 +181,7 @@ pub fn post<R: BufRead, W: Write>(
             ..ProgramInfo::default()
         },
         point: PointState {
+            previous: None,
             solutions: Vec::with_capacity(16),
             written: [0.0; kinpost_machine::MAX_AXES],
             stats: CheckStats::default(),
@@ -260,6 +281,9 @@ pub fn post<R: BufRead, W: Write>(
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
     };
+    if setup.inverse_time {
+        setup.writer.inverse_time(false)?;
+    }
     if setup.tcp.is_some() {
         setup.writer.tcp(false)?;
     }
@@ -328,6 +352,18 @@ impl<W: Write> Job<'_, W> {
             if tcp.is_some() {
                 writer.tcp(true)?;
             }
+            let inverse_time = self.options.feed_mode == FeedMode::InverseTime;
+            if inverse_time {
+                if self.dialect.kind() != DialectKind::Csv
+                    && self.dialect.template(TemplateKind::InverseTimeOn).is_none()
+                {
+                    return Err(PostError::Setup(format!(
+                        "dialect `{}` has no `inverse_time_on` template: it cannot write inverse-time feeds",
+                        self.dialect.name()
+                    )));
+                }
+                writer.inverse_time(true)?;
+            }
             self.setup = Some(Setup {
                 kin: Kinematics::new(&machine),
                 planner: NearestPlanner::new(&machine),
@@ -337,6 +373,7 @@ impl<W: Write> Job<'_, W> {
                 resolution,
                 tolerance,
                 tcp,
+                inverse_time,
             });
         }
         Ok(())
@@ -477,8 +514,13 @@ fn drive<W: Write>(
                 "feed move before any FEDRAT: the controller has no feed rate for it".into(),
             ));
         }
+        Motion::Feed if s.inverse_time => st
+            .feed
+            .map(|f| inverse_time(f, pose, &st.previous, &values[..n], &s.machine)),
         Motion::Feed => st.feed,
     };
+    // Unwrapped axis values (not the modulo ones written for `DC`).
+    st.previous = Some((pose.point, values));
     s.writer.block(&Block {
         cl_line: Some(line),
         motion: match motion {
@@ -490,6 +532,35 @@ fn drive<W: Write>(
     })?;
     st.blocks += 1;
     Ok(())
+}
+
+/// The inverse-time feed word of a block: 1 / (segment length / feed) in
+/// 1/min; a block that only turns rotary axes takes its largest rotary
+/// change in degrees over the feed (see [`FeedMode::InverseTime`]).
+fn inverse_time(
+    feed: f64,
+    pose: &Pose,
+    previous: &Option<(Vector3<f64>, [f64; kinpost_machine::MAX_AXES])>,
+    values: &[f64],
+    machine: &Machine,
+) -> f64 {
+    let Some((point, joints)) = previous else {
+        return feed;
+    };
+    let length = (pose.point - point).norm();
+    let turn = machine
+        .axes
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.is_rotary())
+        .map(|(i, _)| (values[i] - joints[i]).abs())
+        .fold(0.0, f64::max);
+    let distance = if length > 1e-9 { length } else { turn };
+    if distance > 1e-9 {
+        feed / distance
+    } else {
+        feed
+    }
 }
 
 /// The machine's axes as a dialect writes them.

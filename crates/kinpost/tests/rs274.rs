@@ -527,3 +527,72 @@ fn rs274_rejects_bad_programs() {
         assert!(run(&rs274, bad, "bad").is_err(), "rs274 accepted {bad:?}");
     }
 }
+
+/// Inverse-time feed (`G93`): the program parses, and the time LinuxCNC
+/// gives every feed block (its move length over the feed rate its canon
+/// derives from F) equals the CL segment length over the CL feed rate
+/// within 0.1 %.
+#[test]
+fn inverse_time_block_times_are_the_cl_times() {
+    let Some(rs274) = interpreter("inverse_time_block_times_are_the_cl_times") else {
+        return;
+    };
+    let cl = example("five-axis.cls");
+    let machine = mts1600();
+    let dialect = Dialect::builtin("linuxcnc").unwrap();
+    let mut out = Vec::new();
+    let options = PostOptions {
+        feed_mode: kinpost::FeedMode::InverseTime,
+        ..PostOptions::default()
+    };
+    post(cl.as_bytes(), &machine, &dialect, &mut out, &options).unwrap();
+    let program = String::from_utf8(out).unwrap();
+    assert!(
+        program.contains("\nG93\n") && program.contains("\nG94\n"),
+        "{program}"
+    );
+    let moves = interpret(&rs274, &program, "five-axis.cls, G93");
+
+    // CL points and the feed rate in force (the example uses one FEDRAT).
+    let mut points = Vec::new();
+    let mut feed = 0.0;
+    for l in cl.lines() {
+        if let Some(f) = l.strip_prefix("FEDRAT/MMPM,") {
+            feed = f.parse::<f64>().unwrap();
+        }
+        if let Some(v) = l.strip_prefix("GOTO/") {
+            let v: Vec<f64> = v.split(',').map(|x| x.parse().unwrap()).collect();
+            points.push([v[0], v[1], v[2]]);
+        }
+    }
+    assert_eq!(moves.len(), points.len());
+    let mut checked = 0;
+    for k in 1..moves.len() {
+        if !moves[k].feed {
+            continue;
+        }
+        let d = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        let want = d(&points[k], &points[k - 1]) / feed;
+        // LinuxCNC's move length: the XYZ distance, or the ABC one for a
+        // move of the rotary axes alone.
+        let xyz = d(&moves[k].at[..3], &moves[k - 1].at[..3]);
+        let length = if xyz > 1e-6 {
+            xyz
+        } else {
+            d(&moves[k].at[3..], &moves[k - 1].at[3..])
+        };
+        let got = length / moves[k].rate;
+        assert!(
+            (got - want).abs() <= 1e-3 * want,
+            "block {k}: LinuxCNC time {got} min, CL time {want} min"
+        );
+        checked += 1;
+    }
+    assert!(checked > 20, "{checked}");
+}

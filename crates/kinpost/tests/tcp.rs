@@ -99,3 +99,23 @@ fn tcp_needs_xyz_axes_and_a_dialect_that_can_switch() {
     .to_string();
     assert!(err.contains("no `tcp_on` template"), "{err}");
 }
+
+#[test]
+fn inverse_time_needs_a_dialect_that_can_switch() {
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let dialect = Dialect::builtin("heidenhain").unwrap();
+    let options = PostOptions {
+        feed_mode: kinpost::FeedMode::InverseTime,
+        ..Default::default()
+    };
+    let err = post(
+        "RAPID\nGOTO/-416,70.5,16.53,0,0,1\n".as_bytes(),
+        &machine,
+        &dialect,
+        Vec::new(),
+        &options,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("no `inverse_time_on` template"), "{err}");
+}

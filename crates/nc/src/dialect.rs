@@ -166,11 +166,15 @@ pub enum TemplateKind {
     TcpOn,
     /// Tool-centre-point control off.
     TcpOff,
+    /// Inverse-time feed on (`G93`): every feed word is 1 / block time in minutes.
+    InverseTimeOn,
+    /// Feed per minute again (`G94`).
+    InverseTimeOff,
 }
 
 impl TemplateKind {
     /// All kinds, in file order.
-    pub const ALL: [TemplateKind; 10] = [
+    pub const ALL: [TemplateKind; 12] = [
         TemplateKind::Header,
         TemplateKind::Footer,
         TemplateKind::ToolChange,
@@ -181,6 +185,8 @@ impl TemplateKind {
         TemplateKind::Pressure,
         TemplateKind::TcpOn,
         TemplateKind::TcpOff,
+        TemplateKind::InverseTimeOn,
+        TemplateKind::InverseTimeOff,
     ];
 
     /// The key in `[templates]`.
@@ -196,6 +202,8 @@ impl TemplateKind {
             TemplateKind::Pressure => "pressure",
             TemplateKind::TcpOn => "tcp_on",
             TemplateKind::TcpOff => "tcp_off",
+            TemplateKind::InverseTimeOn => "inverse_time_on",
+            TemplateKind::InverseTimeOff => "inverse_time_off",
         }
     }
 }
@@ -909,6 +917,8 @@ struct RawTemplates {
     pressure: Option<Spanned<String>>,
     tcp_on: Option<Spanned<String>>,
     tcp_off: Option<Spanned<String>>,
+    inverse_time_on: Option<Spanned<String>>,
+    inverse_time_off: Option<Spanned<String>>,
 }
 
 impl RawTemplates {
@@ -923,6 +933,8 @@ impl RawTemplates {
             TemplateKind::CoolantOff => self.coolant_off.as_ref(),
             TemplateKind::TcpOn => self.tcp_on.as_ref(),
             TemplateKind::TcpOff => self.tcp_off.as_ref(),
+            TemplateKind::InverseTimeOn => self.inverse_time_on.as_ref(),
+            TemplateKind::InverseTimeOff => self.inverse_time_off.as_ref(),
             TemplateKind::Pressure => self.pressure.as_ref(),
         }
     }

@@ -148,6 +148,8 @@ pub struct NcWriter<W: Write> {
     /// Words written in a block, in output order.
     words: Vec<Word>,
     feed: Word,
+    /// Whether the dialect's feed word is modal (feed per minute).
+    feed_modal: bool,
     last_feed: Option<i64>,
     feed_rapid: Box<[u8]>,
     motion_rapid: Box<[u8]>,
@@ -234,6 +236,7 @@ impl<W: Write> NcWriter<W> {
             axis_specs: axes.to_vec(),
             formats,
             words,
+            feed_modal: feed.modal,
             feed,
             last_feed: None,
             feed_rapid: bytes(&dialect.feed.rapid),
@@ -352,6 +355,22 @@ impl<W: Write> NcWriter<W> {
             TemplateKind::TcpOff
         };
         self.command(kind, Vec::new())
+    }
+
+    /// Inverse-time feed on or off (templates `inverse_time_on`,
+    /// `inverse_time_off`). While on, every feed block carries its feed word
+    /// (inverse time is not modal): the caller passes 1 / block time in
+    /// minutes as the block's feed.
+    pub fn inverse_time(&mut self, on: bool) -> Result<(), NcError> {
+        let kind = if on {
+            TemplateKind::InverseTimeOn
+        } else {
+            TemplateKind::InverseTimeOff
+        };
+        self.command(kind, Vec::new())?;
+        self.feed.modal = self.feed_modal && !on;
+        self.last_feed = None;
+        Ok(())
     }
 
     /// Process pressure (template `pressure` with `pressure`).
