@@ -325,12 +325,22 @@ fn post(args: PostArgs) -> Result<()> {
     {
         return Err(anyhow!("--tolerance must be a positive number of mm"));
     }
+    let progress = progress_bar(&args);
     let input: Box<dyn BufRead> = if args.input == "-" {
         Box::new(BufReader::with_capacity(1 << 16, io::stdin().lock()))
     } else {
         let f = std::fs::File::open(&args.input)
             .with_context(|| format!("cannot open CL file {}", args.input))?;
-        Box::new(BufReader::with_capacity(1 << 16, f))
+        if let (Some(bar), Ok(meta)) = (&progress, f.metadata()) {
+            bar.set_length(meta.len());
+        }
+        Box::new(BufReader::with_capacity(
+            1 << 16,
+            Progress {
+                inner: f,
+                bar: progress.clone(),
+            },
+        ))
     };
 
     let result = match &args.output_file {
@@ -356,6 +366,9 @@ fn post(args: PostArgs) -> Result<()> {
             summary
         }
     };
+    if let Some(bar) = &progress {
+        bar.finish_and_clear();
+    }
     let summary = match result {
         Ok(s) => s,
         Err(PostError::Input(d)) => return Err(report(d)),
@@ -372,6 +385,43 @@ fn post(args: PostArgs) -> Result<()> {
         eprintln!("{}", summary.one_line());
     }
     Ok(())
+}
+
+/// A progress bar over the bytes of the CL file, on a terminal only (never
+/// in pipes, never with `--quiet`), for files large enough to take a while.
+fn progress_bar(args: &PostArgs) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if args.quiet || args.input == "-" || !io::stderr().is_terminal() {
+        return None;
+    }
+    let size = std::fs::metadata(&args.input).map(|m| m.len()).ok()?;
+    if size < 8 << 20 {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(size);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "posting {wide_bar} {bytes}/{total_bytes} ({eta} left)",
+        )
+        .ok()?,
+    );
+    Some(bar)
+}
+
+/// The CL file, reporting how much of it has been read.
+struct Progress<R> {
+    inner: R,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl<R: io::Read> io::Read for Progress<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        if let Some(bar) = &self.bar {
+            bar.inc(n as u64);
+        }
+        Ok(n)
+    }
 }
 
 fn fk(machine: &str, values: &[String]) -> Result<()> {
