@@ -301,6 +301,7 @@ pub fn post<R: BufRead, W: Write>(
         blocks: job.point.blocks,
         warnings,
         max_position_error_mm: job.point.stats.max_position_error_mm,
+        max_position_error_line: job.point.stats.worst_line,
         max_axis_error_rad: job.point.stats.max_axis_error_rad,
         tolerance_mm: tolerance.position_mm,
         tolerance_rad: tolerance.axis_rad,

@@ -15,6 +15,8 @@ pub struct Summary {
     /// Largest distance between a block's tool point (values as written,
     /// through the forward kinematics) and its CL point, mm.
     pub max_position_error_mm: f64,
+    /// CL line of the block with that largest position error.
+    pub max_position_error_line: Option<usize>,
     /// Largest angle between a block's tool axis and its CL axis, rad.
     pub max_axis_error_rad: f64,
     /// The position tolerance the check used, mm.
@@ -39,6 +41,7 @@ struct JsonSummary<'a> {
     blocks: u64,
     warnings: Vec<JsonWarning<'a>>,
     max_position_error_mm: f64,
+    max_position_error_line: Option<usize>,
     max_axis_error_rad: f64,
     tolerance_mm: f64,
     tolerance_rad: f64,
@@ -62,6 +65,7 @@ impl Summary {
                 })
                 .collect(),
             max_position_error_mm: self.max_position_error_mm,
+            max_position_error_line: self.max_position_error_line,
             max_axis_error_rad: self.max_axis_error_rad,
             tolerance_mm: self.tolerance_mm,
             tolerance_rad: self.tolerance_rad,

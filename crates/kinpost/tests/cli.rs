@@ -135,6 +135,13 @@ fn post_to_file_with_json_summary() {
     assert_eq!(warnings[1]["line"], 3);
     let position = summary["max_position_error_mm"].as_f64().unwrap();
     assert!((0.0..0.01).contains(&position), "{summary}");
+    // The largest error is at a GOTO of the file.
+    let worst = summary["max_position_error_line"].as_u64().unwrap() as usize;
+    let cl = std::fs::read_to_string(root().join("examples/flat-part.cls")).unwrap();
+    assert!(
+        cl.lines().nth(worst - 1).unwrap().starts_with("GOTO/"),
+        "{summary}"
+    );
     assert!(summary["max_axis_error_rad"].as_f64().unwrap() >= 0.0);
     assert!(summary["seconds"].as_f64().unwrap() >= 0.0);
 
