@@ -167,6 +167,23 @@ impl<R: BufRead> ClReader<R> {
         self.diag(severity, (start, end), message)
     }
 
+    /// The first physical line of the current statement, without its line
+    /// ending, and its number: for diagnostics about the statement made after
+    /// the reader has moved on (the planner decides a whole path at once).
+    pub fn statement_line(&self) -> (usize, &[u8]) {
+        match self.segments.first() {
+            Some(seg) => {
+                let raw = &self.raw[seg.raw_start..seg.raw_end];
+                let end = raw
+                    .iter()
+                    .rposition(|&b| b != b'\n' && b != b'\r')
+                    .map_or(0, |i| i + 1);
+                (seg.line, &raw[..end])
+            }
+            None => (self.line, &[]),
+        }
+    }
+
     /// The next statement that means something; `Ok(None)` at the end of the
     /// input. Blank lines and silently ignored statements (`RAPID`, which only
     /// marks the next `GOTO`, `PAINT/…`, unknown statements, …) are skipped.

@@ -20,8 +20,11 @@
 //! ```
 
 pub mod check;
+mod emit;
 pub mod output;
+mod path;
 mod post;
+mod solve;
 pub mod summary;
 
 pub use kinpost_cl as cl;
@@ -29,5 +32,8 @@ pub use kinpost_diag as diag;
 pub use kinpost_machine as machine;
 pub use kinpost_nc as nc;
 pub use kinpost_plan as plan;
-pub use post::{FeedMode, PostError, PostOptions, axis_specs, post};
+pub use post::{
+    DEFAULT_LINTOL_MM, DEFAULT_RETRACT_MM, DEFAULT_SINGULAR_CONE_DEG, FeedMode, PLANNER_LAG,
+    PlannerMode, PostError, PostOptions, axis_specs, post,
+};
 pub use summary::Summary;

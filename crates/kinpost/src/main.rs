@@ -11,7 +11,7 @@ use clap::{Parser, Subcommand};
 use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
 use kinpost::nc::Dialect;
 use kinpost::output::{AtomicFile, write_atomically};
-use kinpost::{FeedMode, PostError, PostOptions};
+use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
 #[derive(Parser)]
@@ -98,11 +98,37 @@ struct PostArgs {
     /// the machine's `[post] output`, else joint.
     #[arg(long, value_enum, value_name = "MODE")]
     output: Option<Output>,
-    /// Feed words: `tip` (the CL feed at the tool point, mm/min) or
+    /// Feed words: `tip` (the CL feed at the tool point, mm/min),
     /// `inverse-time` (G93: F = 1 / block time in minutes; fanuc, linuxcnc,
-    /// sinumerik).
-    #[arg(long, value_enum, default_value = "tip")]
-    feed_mode: FeedModeArg,
+    /// sinumerik) or `dpm` (F = length of the vector of all axis changes, mm
+    /// and degrees, per minute, so that the block time is the CL segment
+    /// length over the CL feed). Default: the dialect's `[feed] mode`, else
+    /// tip. Every mode slows blocks down to the axes' `max_velocity`.
+    #[arg(long, value_enum)]
+    feed_mode: Option<FeedModeArg>,
+    /// Choose the configurations over the whole path (`global`: dynamic
+    /// programming, no flips or unwinding inside a cut where the travel
+    /// allows) or point by point (`nearest`).
+    #[arg(long, value_enum, default_value = "global")]
+    planner: PlannerArg,
+    /// Linearization tolerance in mm: blocks are inserted until the contact
+    /// point, moved linearly in joint space, stays this close to the straight
+    /// CL segment. 0 turns linearization off. Joint output only.
+    #[arg(long, value_name = "MM", default_value_t = kinpost::DEFAULT_LINTOL_MM)]
+    lintol: f64,
+    /// Half-angle in degrees of the cone around a singular tool-axis
+    /// direction inside which the free rotary angle is held (default: the
+    /// machine's `[post] singular_cone`, else 0.5).
+    #[arg(long, value_name = "DEG")]
+    singular_cone: Option<f64>,
+    /// Retract distance along the tool axis for a reconfiguration, mm
+    /// (default: the machine's `[post] retract`, else 50).
+    #[arg(long, value_name = "MM")]
+    retract: Option<f64>,
+    /// Fail where the path needs a retract and reconfiguration, naming the
+    /// CL line, instead of inserting one.
+    #[arg(long)]
+    no_reconfigure: bool,
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
@@ -115,6 +141,13 @@ struct PostArgs {
 enum FeedModeArg {
     Tip,
     InverseTime,
+    Dpm,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PlannerArg {
+    Global,
+    Nearest,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -310,16 +343,42 @@ fn post(args: PostArgs) -> Result<()> {
             Output::Joint => OutputMode::Joint,
             Output::Tcp => OutputMode::Tcp,
         }),
-        feed_mode: match args.feed_mode {
+        feed_mode: args.feed_mode.map(|m| match m {
             FeedModeArg::Tip => FeedMode::Tip,
             FeedModeArg::InverseTime => FeedMode::InverseTime,
+            FeedModeArg::Dpm => FeedMode::Dpm,
+        }),
+        planner: match args.planner {
+            PlannerArg::Global => PlannerMode::Global,
+            PlannerArg::Nearest => PlannerMode::Nearest,
         },
+        lintol_mm: Some(args.lintol),
+        singular_cone_deg: args.singular_cone,
+        retract_mm: args.retract,
+        no_reconfigure: args.no_reconfigure,
         default_axis: args
             .default_axis
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
     };
+    if !(args.lintol.is_finite() && args.lintol >= 0.0) {
+        return Err(anyhow!("--lintol must be a distance of 0 or more (mm)"));
+    }
+    if let Some(c) = args.singular_cone
+        && !(c.is_finite() && (0.0..45.0).contains(&c))
+    {
+        return Err(anyhow!(
+            "--singular-cone must be an angle from 0 to less than 45 degrees"
+        ));
+    }
+    if let Some(r) = args.retract
+        && !(r.is_finite() && r > 0.0)
+    {
+        return Err(anyhow!(
+            "--retract must be a distance greater than zero (mm)"
+        ));
+    }
     if let Some(t) = args.tolerance
         && !(t.is_finite() && t > 0.0)
     {

@@ -10,14 +10,16 @@ use std::time::Instant;
 
 use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, SpindleDir, Units};
 use kinpost_diag::{Diagnostic, Severity};
-use kinpost_machine::{Kinematics, Machine, OutputMode, Pose, Solution};
+use kinpost_machine::{Kinematics, Machine, OutputMode, Pose};
 use kinpost_nc::{
-    AxisSpec, Block, Dialect, DialectKind, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
+    AxisSpec, Dialect, DialectKind, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
 };
-use kinpost_plan::{NearestPlanner, Planner, Rejection};
+use kinpost_plan::{Costs, Rejection, Trellis};
 use nalgebra::Vector3;
 
-use crate::check::{CheckStats, Tolerance, pose_error};
+use crate::check::Tolerance;
+use crate::emit::{EmitSettings, Emitter};
+use crate::path::{PathPlan, PointError};
 use crate::summary::Summary;
 
 /// Settings of one post run.
@@ -38,8 +40,40 @@ pub struct PostOptions {
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
-    /// How feed words are written.
-    pub feed_mode: FeedMode,
+    /// How feed words are written; default: the dialect's.
+    pub feed_mode: Option<FeedMode>,
+    /// Whole-path or point-by-point choice of configurations.
+    pub planner: PlannerMode,
+    /// Linearization tolerance, mm (default [`DEFAULT_LINTOL_MM`]; 0: off).
+    pub lintol_mm: Option<f64>,
+    /// Singular cone half-angle, degrees (default: the machine's, else
+    /// [`DEFAULT_SINGULAR_CONE_DEG`]).
+    pub singular_cone_deg: Option<f64>,
+    /// Retract distance of a reconfiguration, mm (default: the machine's,
+    /// else [`DEFAULT_RETRACT_MM`]).
+    pub retract_mm: Option<f64>,
+    /// Fail instead of retracting and reconfiguring.
+    pub no_reconfigure: bool,
+}
+
+/// Default linearization tolerance, mm.
+pub const DEFAULT_LINTOL_MM: f64 = 0.002;
+/// Default half-angle of the singular cone, degrees.
+pub const DEFAULT_SINGULAR_CONE_DEG: f64 = 0.5;
+/// Default retract distance of a reconfiguration, mm.
+pub const DEFAULT_RETRACT_MM: f64 = 50.0;
+/// Points the whole-path planner looks ahead at most before it decides.
+pub const PLANNER_LAG: usize = 1 << 15;
+
+/// How the configuration of each point is chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PlannerMode {
+    /// Over the whole path (dynamic programming over up to
+    /// [`PLANNER_LAG`] points at a time).
+    #[default]
+    Global,
+    /// Point by point: least motion from the previous block.
+    Nearest,
 }
 
 /// What the feed word of a feed block means.
@@ -53,6 +87,10 @@ pub enum FeedMode {
     /// not move the tool point but turns rotary axes takes its largest
     /// rotary change in degrees over the feed rate (degrees per minute).
     InverseTime,
+    /// Degrees per minute, the combined feed of a controller without
+    /// inverse time: F = length of the vector of every axis change (mm and
+    /// degrees together) / block time.
+    Dpm,
 }
 
 /// Why a post run failed.
@@ -72,6 +110,18 @@ pub enum PostError {
     Setup(String),
 }
 
+impl FeedMode {
+    /// `tip`, `inverse-time` or `dpm`.
+    pub fn parse(name: &str) -> Option<FeedMode> {
+        match name {
+            "tip" => Some(FeedMode::Tip),
+            "inverse-time" => Some(FeedMode::InverseTime),
+            "dpm" => Some(FeedMode::Dpm),
+            _ => None,
+        }
+    }
+}
+
 impl From<NcError> for PostError {
     fn from(e: NcError) -> Self {
         match e {
@@ -89,7 +139,8 @@ impl From<Diagnostic> for PostError {
 
 /// An NC output met before the first CL point decides how the machine is
 /// driven (which axes the program writes); written once it is known.
-enum Pending {
+#[derive(Debug)]
+pub(crate) enum Pending {
     Comment(String),
     ToolChange(u32, String),
     Spindle(Spindle),
@@ -103,17 +154,8 @@ struct Setup<W: Write> {
     machine: Machine,
     six_axis: bool,
     kin: Kinematics,
-    planner: NearestPlanner,
-    writer: NcWriter<W>,
-    /// One unit of the last written decimal, per axis.
-    resolution: Vec<f64>,
-    /// The tolerance in force; grows to a block's own rounding bound where
-    /// that is larger (see `within_block_bound`).
-    tolerance: Tolerance,
-    /// Tool-centre-point output: the indices of the linear axes X, Y, Z,
-    /// which carry the tool point in the part frame.
-    tcp: Option<[usize; 3]>,
-    /// Feed words are inverse time.
+    path: PathPlan,
+    emitter: Emitter<W>,
     inverse_time: bool,
 }
 
@@ -126,22 +168,10 @@ struct Job<'a, W: Write> {
     setup: Option<Setup<W>>,
     pending: Vec<Pending>,
     info: ProgramInfo,
-    point: PointState,
     /// Scale from CL units to mm.
     scale: f64,
-    cl_points: u64,
-}
-
-/// What the work on one CL point reads and updates besides the setup.
-struct PointState {
-    /// The previous CL point and the axis values written for it (for
-    /// inverse-time feeds).
-    previous: Option<(Vector3<f64>, [f64; kinpost_machine::MAX_AXES])>,
-    solutions: Vec<Solution>,
-    written: [f64; kinpost_machine::MAX_AXES],
-    stats: CheckStats,
     feed: Option<f64>,
-    blocks: u64,
+    cl_points: u64,
 }
 
 /// Posts the CL text read from `input` for `machine` in `dialect`, writing
@@ -180,15 +210,8 @@ pub fn post<R: BufRead, W: Write>(
             cl_file: options.cl_file.clone(),
             ..ProgramInfo::default()
         },
-        point: PointState {
-            previous: None,
-            solutions: Vec::with_capacity(16),
-            written: [0.0; kinpost_machine::MAX_AXES],
-            stats: CheckStats::default(),
-            feed: None,
-            blocks: 0,
-        },
         scale: 1.0,
+        feed: None,
         cl_points: 0,
     };
     let mut named = options.program_name.is_some();
@@ -213,7 +236,7 @@ pub fn post<R: BufRead, W: Write>(
                 job.motion(&pose, motion, line, &reader)?;
             }
             ClEvent::Feedrate { value, unit } => {
-                job.point.feed = Some(match unit {
+                job.feed = Some(match unit {
                     FeedUnit::Mmpm | FeedUnit::Mmpr => value,
                     FeedUnit::Ipm | FeedUnit::Ipr => value * 25.4,
                 });
@@ -281,31 +304,39 @@ pub fn post<R: BufRead, W: Write>(
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
     };
+    setup
+        .path
+        .flush(&setup.machine, &setup.kin, &mut setup.emitter, true)?;
+    let emitter = setup.emitter;
+    let mut writer = emitter.writer;
     if setup.inverse_time {
-        setup.writer.inverse_time(false)?;
+        writer.inverse_time(false)?;
     }
-    if setup.tcp.is_some() {
-        setup.writer.tcp(false)?;
+    if emitter.settings.tcp.is_some() {
+        writer.tcp(false)?;
     }
-    setup.writer.footer(
+    writer.footer(
         &job.info,
         machine_template(machine, dialect, &machine.post.footer),
     )?;
-    let tolerance = setup.tolerance;
-    setup.writer.finish()?;
+    let tolerance = emitter.settings.tolerance;
+    writer.finish()?;
 
     warnings.extend(reader.take_warnings());
     warnings.sort_by_key(|w| (w.line, w.column));
+    let mut planning = emitter.planning;
+    planning.singular_stretches = setup.path.stretches;
     Ok(Summary {
         cl_points: job.cl_points,
-        blocks: job.point.blocks,
+        blocks: emitter.blocks,
         warnings,
-        max_position_error_mm: job.point.stats.max_position_error_mm,
-        max_position_error_line: job.point.stats.worst_line,
-        max_axis_error_rad: job.point.stats.max_axis_error_rad,
+        max_position_error_mm: emitter.stats.max_position_error_mm,
+        max_position_error_line: emitter.stats.worst_line,
+        max_axis_error_rad: emitter.stats.max_axis_error_rad,
         tolerance_mm: tolerance.position_mm,
         tolerance_rad: tolerance.axis_rad,
         seconds: started.elapsed().as_secs_f64(),
+        planning,
     })
 }
 
@@ -353,7 +384,12 @@ impl<W: Write> Job<'_, W> {
             if tcp.is_some() {
                 writer.tcp(true)?;
             }
-            let inverse_time = self.options.feed_mode == FeedMode::InverseTime;
+            let feed_mode = self
+                .options
+                .feed_mode
+                .or(self.dialect.default_feed_mode().and_then(FeedMode::parse))
+                .unwrap_or_default();
+            let inverse_time = feed_mode == FeedMode::InverseTime;
             if inverse_time {
                 if self.dialect.kind() != DialectKind::Csv
                     && self.dialect.template(TemplateKind::InverseTimeOn).is_none()
@@ -365,25 +401,70 @@ impl<W: Write> Job<'_, W> {
                 }
                 writer.inverse_time(true)?;
             }
+            // A modulo axis reaches every angle: its limits only bound the
+            // counter, so the kinematics sees it without them and takes the
+            // turn nearest the previous point.
+            let mut planned = machine.clone();
+            for a in &mut planned.axes {
+                if a.is_endless() {
+                    a.limits = None;
+                }
+            }
+            let kin = Kinematics::new(&planned);
+            let cone = self
+                .options
+                .singular_cone_deg
+                .or(machine.post.singular_cone_deg)
+                .unwrap_or(DEFAULT_SINGULAR_CONE_DEG);
+            let lag = match self.options.planner {
+                PlannerMode::Global => PLANNER_LAG,
+                PlannerMode::Nearest => 1,
+            };
+            let costs = Costs::new(&planned, cone, kin.singularity().map(|s| s.axis));
+            let path = PathPlan::new(
+                &planned,
+                &kin,
+                Trellis::new(costs, lag),
+                cone,
+                &self.options.cl_file,
+            );
+            let settings = EmitSettings {
+                feed_mode,
+                lintol: self.options.lintol_mm.unwrap_or(DEFAULT_LINTOL_MM),
+                retract_mm: self
+                    .options
+                    .retract_mm
+                    .or(machine.post.retract)
+                    .unwrap_or(DEFAULT_RETRACT_MM),
+                reconfigure: !self.options.no_reconfigure,
+                tolerance,
+                tolerance_given: self.options.tolerance_mm.is_some(),
+                tcp,
+                resolution,
+                singularity: kin.singularity(),
+                cone_rad: cone.to_radians(),
+            };
             self.setup = Some(Setup {
-                kin: Kinematics::new(&machine),
-                planner: NearestPlanner::new(&machine),
+                emitter: Emitter::new(&machine, writer, settings),
+                kin,
+                path,
                 machine,
                 six_axis,
-                writer,
-                resolution,
-                tolerance,
-                tcp,
                 inverse_time,
             });
         }
         Ok(())
     }
 
-    /// Writes an NC output now, or once the program is set up.
+    /// Writes an NC output in its place among the points (once the program
+    /// is set up).
     fn emit(&mut self, p: Pending) -> Result<(), PostError> {
         match &mut self.setup {
-            Some(s) => write_pending(&mut s.writer, p),
+            Some(s) if s.path.is_idle() => write_pending(&mut s.emitter.writer, p),
+            Some(s) => {
+                s.path.push_output(p);
+                Ok(())
+            }
             None => {
                 self.pending.push(p);
                 Ok(())
@@ -393,11 +474,12 @@ impl<W: Write> Job<'_, W> {
 
     fn break_segment(&mut self) {
         if let Some(s) = &mut self.setup {
-            s.planner.break_segment();
+            s.path.break_segment();
         }
     }
 
-    /// One CL point: solve, choose, round, check, write.
+    /// One CL point: solve and hand it to the planner, which writes it once
+    /// the path around it is decided.
     fn motion<R: BufRead>(
         &mut self,
         pose: &Pose,
@@ -412,155 +494,55 @@ impl<W: Write> Job<'_, W> {
         let unlocks = self.machine.unlocks_with_reference();
         let six_axis = pose.reference.is_some() && unlocks;
         self.open(six_axis)?;
-        let Some(setup) = self.setup.as_mut() else {
+        let Some(s) = self.setup.as_mut() else {
             unreachable!("`open` sets the job up")
         };
-        drive(
-            setup,
-            &mut self.point,
-            self.options.tolerance_mm.is_some(),
-            pose,
-            motion,
-            line,
-            six_axis,
-            &at,
-        )
-    }
-}
-
-/// The work of [`Job::motion`] once the machine is set up. `six_axis`: the
-/// point asks for 6-axis output (it must match the program's).
-#[allow(clippy::too_many_arguments)]
-fn drive<W: Write>(
-    s: &mut Setup<W>,
-    st: &mut PointState,
-    tolerance_given: bool,
-    pose: &Pose,
-    motion: Motion,
-    line: usize,
-    six_axis: bool,
-    at: &dyn Fn(String) -> PostError,
-) -> Result<(), PostError> {
-    if s.six_axis != six_axis {
-        return Err(at(if s.six_axis {
-            "this CL point has no reference direction, but the program began with them \
-             (6-axis output): give every GOTO nine values, or none"
-                .to_string()
-        } else {
-            "this CL point has a reference direction, but the program began without \
-             (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
-                .to_string()
-        }));
-    }
-    if motion == Motion::Rapid {
-        s.planner.break_segment();
-    }
-    let hint = s.planner.current().copied();
-    let n = s.machine.axes.len();
-    if let Err(e) = s
-        .kin
-        .ik(pose, hint.as_ref().map(|h| &h[..n]), &mut st.solutions)
-    {
-        return Err(at(format!("{e}: {}", describe(pose))));
-    }
-    let chosen = match s.planner.choose(&st.solutions) {
-        Ok(i) => st.solutions[i],
-        Err(Rejection::OutsideLimits(v)) => {
-            let a = &s.machine.axes[v.axis];
-            let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
-            return Err(at(format!(
-                "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
-                a.name,
-                v.value,
-                describe(pose)
-            )));
+        if s.six_axis != six_axis {
+            return Err(at(if s.six_axis {
+                "this CL point has no reference direction, but the program began with them \
+                 (6-axis output): give every GOTO nine values, or none"
+                    .to_string()
+            } else {
+                "this CL point has a reference direction, but the program began without \
+                 (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
+                    .to_string()
+            }));
         }
-        Err(Rejection::NoSolution) => {
-            return Err(at(format!("no solution for {}", describe(pose))));
-        }
-    };
-    // Joint output writes the axis values; tool-centre-point output writes
-    // the tool point on X, Y, Z and the rotary axis values.
-    let mut values = chosen.joints;
-    if let Some([x, y, z]) = s.tcp {
-        values[x] = pose.point.x;
-        values[y] = pose.point.y;
-        values[z] = pose.point.z;
-    }
-    for (i, (w, v)) in st.written[..n].iter_mut().zip(&values[..n]).enumerate() {
-        *w = s.writer.quantized(i, *v);
-    }
-    let mut reached = s.kin.fk(&st.written[..n]);
-    if let Some([x, y, z]) = s.tcp {
-        // The controller puts the tool point where the words say; the
-        // orientation comes from the rotary words alone.
-        reached.point = Vector3::new(st.written[x], st.written[y], st.written[z]);
-    }
-    if !st.stats.record(pose, &reached, line, &s.tolerance)
-        && !within_block_bound(s, tolerance_given, pose, &reached, &st.written[..n])
-    {
-        let (p, a) = pose_error(pose, &reached);
-        return Err(at(format!(
-            "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
-             from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
-            s.tolerance.position_mm,
-            s.tolerance.axis_rad,
-            describe(pose)
-        )));
-    }
-    let feed = match motion {
-        Motion::Rapid => None,
-        Motion::Feed if st.feed.is_none() => {
+        if motion == Motion::Feed && self.feed.is_none() {
             return Err(at(
                 "feed move before any FEDRAT: the controller has no feed rate for it".into(),
             ));
         }
-        Motion::Feed if s.inverse_time => st
-            .feed
-            .map(|f| inverse_time(f, pose, &st.previous, &values[..n], &s.machine)),
-        Motion::Feed => st.feed,
-    };
-    // Unwrapped axis values (not the modulo ones written for `DC`).
-    st.previous = Some((pose.point, values));
-    s.writer.block(&Block {
-        cl_line: Some(line),
-        motion: match motion {
+        let nc_motion = match motion {
             Motion::Rapid => kinpost_nc::Motion::Rapid,
             Motion::Feed => kinpost_nc::Motion::Feed,
-        },
-        axes: &values[..n],
-        feed,
-    })?;
-    st.blocks += 1;
-    Ok(())
-}
-
-/// The inverse-time feed word of a block: 1 / (segment length / feed) in
-/// 1/min; a block that only turns rotary axes takes its largest rotary
-/// change in degrees over the feed (see [`FeedMode::InverseTime`]).
-fn inverse_time(
-    feed: f64,
-    pose: &Pose,
-    previous: &Option<(Vector3<f64>, [f64; kinpost_machine::MAX_AXES])>,
-    values: &[f64],
-    machine: &Machine,
-) -> f64 {
-    let Some((point, joints)) = previous else {
-        return feed;
-    };
-    let length = (pose.point - point).norm();
-    let turn = machine
-        .axes
-        .iter()
-        .enumerate()
-        .filter(|(_, a)| a.is_rotary())
-        .map(|(i, _)| (values[i] - joints[i]).abs())
-        .fold(0.0, f64::max);
-    let distance = if length > 1e-9 { length } else { turn };
-    if distance > 1e-9 {
-        feed / distance
-    } else {
-        feed
+        };
+        let (_, source) = reader.statement_line();
+        if let Err(e) = s
+            .path
+            .push_point(&s.kin, *pose, nc_motion, line, self.feed, source)
+        {
+            return Err(at(match e {
+                PointError::Ik(e) => format!("{e}: {}", describe(pose)),
+                PointError::Rejected(Rejection::OutsideLimits(v)) => {
+                    let a = &s.machine.axes[v.axis];
+                    let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
+                    format!(
+                        "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
+                        a.name,
+                        v.value,
+                        describe(pose)
+                    )
+                }
+                PointError::Rejected(Rejection::NoSolution) => {
+                    format!("no solution for {}", describe(pose))
+                }
+            }));
+        }
+        if s.path.is_full() {
+            s.path.flush(&s.machine, &s.kin, &mut s.emitter, false)?;
+        }
+        Ok(())
     }
 }
 
@@ -617,7 +599,10 @@ fn machine_template<'a>(
     }
 }
 
-fn write_pending<W: Write>(writer: &mut NcWriter<W>, p: Pending) -> Result<(), PostError> {
+pub(crate) fn write_pending<W: Write>(
+    writer: &mut NcWriter<W>,
+    p: Pending,
+) -> Result<(), PostError> {
     match p {
         Pending::Comment(text) => writer.comment(&text)?,
         Pending::ToolChange(number, name) => writer.tool_change(number, &name)?,
@@ -628,32 +613,8 @@ fn write_pending<W: Write>(writer: &mut NcWriter<W>, p: Pending) -> Result<(), P
     Ok(())
 }
 
-/// With the derived tolerance, a block beyond the machine-wide bound is
-/// still right if its error is what rounding causes at its own levers; the
-/// tolerance in force (and reported) grows to it.
-fn within_block_bound<W: Write>(
-    s: &mut Setup<W>,
-    tolerance_given: bool,
-    want: &Pose,
-    got: &Pose,
-    written: &[f64],
-) -> bool {
-    if tolerance_given || s.tcp.is_some() {
-        return false;
-    }
-    let resolution = &s.resolution;
-    let block = Tolerance::at_block(&s.machine, &s.kin, written, |i| resolution[i]);
-    let (p, a) = pose_error(want, got);
-    if p > block.position_mm || a > block.axis_rad {
-        return false;
-    }
-    s.tolerance.position_mm = s.tolerance.position_mm.max(p);
-    s.tolerance.axis_rad = s.tolerance.axis_rad.max(a);
-    true
-}
-
 /// The pose as a user reads it in a message.
-fn describe(pose: &Pose) -> String {
+pub(crate) fn describe(pose: &Pose) -> String {
     let (p, a) = (pose.point, pose.axis);
     format!(
         "point ({:.4}, {:.4}, {:.4}) axis ({:.7}, {:.7}, {:.7})",

@@ -25,6 +25,74 @@ pub struct Summary {
     pub tolerance_rad: f64,
     /// Wall-clock time of the run.
     pub seconds: f64,
+    /// The path planning: singular stretches, reconfigurations, inserted
+    /// blocks, feed clamps.
+    pub planning: Planning,
+}
+
+/// What the planner did to the path.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Planning {
+    /// Runs of CL points whose tool axis lies within the singular cone,
+    /// where the singular angle was held or interpolated.
+    pub singular_stretches: Vec<SingularStretch>,
+    /// Retract-and-reconfigure events.
+    pub reconfigurations: Vec<Reconfiguration>,
+    /// Blocks the post inserted: linearization, retracts, re-approaches.
+    pub inserted_blocks: u64,
+    /// Largest distance of the contact point at the joint-space midpoint of a
+    /// feed block from its straight CL segment, mm.
+    pub max_linearization_error_mm: f64,
+    /// Largest change of one rotary axis between two consecutive feed
+    /// blocks, degrees, and the CL line of the block.
+    pub max_rotary_step_deg: f64,
+    pub max_rotary_step_line: Option<usize>,
+    /// Feed blocks slowed down to the axes' maximum velocities (the first
+    /// 1000), and how many there were in all.
+    pub feed_clamps: Vec<FeedClamp>,
+    pub feed_clamp_count: u64,
+}
+
+/// A run of singular CL points.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SingularStretch {
+    pub first_line: usize,
+    pub last_line: usize,
+    /// The axis whose angle is free there.
+    pub axis: String,
+    /// Its value at the first and the last point of the run, degrees.
+    pub from_deg: f64,
+    pub to_deg: f64,
+    /// Largest angle between the CL tool axis and the axis the machine
+    /// points with the angle held, degrees (at most the cone).
+    pub max_axis_deviation_deg: f64,
+}
+
+/// A retract and reconfiguration between two CL points of a cut.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reconfiguration {
+    /// The CL line reached after the reconfiguration.
+    pub line: usize,
+    /// The CL line before it.
+    pub previous_line: Option<usize>,
+    /// The rotary axis with the largest jump, and its values before and after.
+    pub axis: String,
+    pub from_deg: f64,
+    pub to_deg: f64,
+    /// Retract distance along the tool axis, mm.
+    pub retract_mm: f64,
+}
+
+/// A feed block slowed down by an axis's maximum velocity.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeedClamp {
+    /// CL line of the block (an inserted block gives the line it leads to).
+    pub line: usize,
+    /// The axis that limits the block.
+    pub axis: String,
+    /// Block time as programmed and as written, minutes.
+    pub programmed_min: f64,
+    pub written_min: f64,
 }
 
 #[derive(Serialize)]
@@ -46,6 +114,8 @@ struct JsonSummary<'a> {
     tolerance_mm: f64,
     tolerance_rad: f64,
     seconds: f64,
+    #[serde(flatten)]
+    planning: &'a Planning,
 }
 
 impl Summary {
@@ -70,14 +140,32 @@ impl Summary {
             tolerance_mm: self.tolerance_mm,
             tolerance_rad: self.tolerance_rad,
             seconds: self.seconds,
+            planning: &self.planning,
         };
         serde_json::to_string_pretty(&json).expect("plain data serializes") + "\n"
     }
 
     /// One line for the terminal.
     pub fn one_line(&self) -> String {
+        let p = &self.planning;
+        let mut planning = String::new();
+        if p.inserted_blocks > 0 {
+            planning += &format!(
+                "; {} inserted block(s), linearization max {:.4} mm",
+                p.inserted_blocks, p.max_linearization_error_mm
+            );
+        }
+        if !p.singular_stretches.is_empty() {
+            planning += &format!("; {} singular stretch(es)", p.singular_stretches.len());
+        }
+        if !p.reconfigurations.is_empty() {
+            planning += &format!("; {} reconfiguration(s)", p.reconfigurations.len());
+        }
+        if p.feed_clamp_count > 0 {
+            planning += &format!("; {} feed block(s) clamped", p.feed_clamp_count);
+        }
         format!(
-            "{} CL points, {} blocks, {} warning(s); closed loop: max {:.6} mm / {:.3e} rad (tolerance {:.6} mm / {:.3e} rad); {:.3} s",
+            "{} CL points, {} blocks, {} warning(s); closed loop: max {:.6} mm / {:.3e} rad (tolerance {:.6} mm / {:.3e} rad){planning}; {:.3} s",
             self.cl_points,
             self.blocks,
             self.warnings.len(),

@@ -147,7 +147,13 @@ proptest! {
         }
         let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
         let mut out = Vec::new();
-        let summary = post(cl.as_bytes(), &machine, &dialect, &mut out, &PostOptions::default())
+        // Linearization off: a linear axis carried by a rotary one can make
+        // the straight CL segment between two reachable poses pass through a
+        // configuration where the linear axes lose a direction, which these
+        // chains do at random; tests/planning.rs covers linearization on
+        // machines whose linear axes are not carried by rotary axes.
+        let options = PostOptions { lintol_mm: Some(0.0), ..Default::default() };
+        let summary = post(cl.as_bytes(), &machine, &dialect, &mut out, &options)
             .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
         let csv = String::from_utf8(out).unwrap();
         let mut rows = csv.lines();
@@ -156,6 +162,11 @@ proptest! {
         let mut seen = 0;
         for row in rows {
             let f: Vec<&str> = row.split(',').collect();
+            // Blocks inserted by the linearization have no CL line; the
+            // planning tests check them.
+            if f[col("line")].is_empty() {
+                continue;
+            }
             let line: usize = f[col("line")].parse().unwrap();
             let want = &poses[line - 2];
             let values: Vec<f64> = machine.axes.iter().map(|a| f[col(&a.name)].parse().unwrap()).collect();

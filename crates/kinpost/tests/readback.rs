@@ -37,8 +37,11 @@ fn every_dialect_reads_back_onto_the_cl() {
             let dialect = Dialect::builtin(dialect_name).unwrap();
             for output in [OutputMode::Joint, OutputMode::Tcp] {
                 let mut out = Vec::new();
+                // One block per CL point (no linearization), so that block k
+                // belongs to CL point k.
                 let options = PostOptions {
                     output: Some(output),
+                    lintol_mm: Some(0.0),
                     ..Default::default()
                 };
                 let summary = post(cl.as_bytes(), &machine, &dialect, &mut out, &options).unwrap();

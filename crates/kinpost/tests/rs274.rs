@@ -542,7 +542,7 @@ fn inverse_time_block_times_are_the_cl_times() {
     let dialect = Dialect::builtin("linuxcnc").unwrap();
     let mut out = Vec::new();
     let options = PostOptions {
-        feed_mode: kinpost::FeedMode::InverseTime,
+        feed_mode: Some(kinpost::FeedMode::InverseTime),
         ..PostOptions::default()
     };
     post(cl.as_bytes(), &machine, &dialect, &mut out, &options).unwrap();
@@ -565,34 +565,60 @@ fn inverse_time_block_times_are_the_cl_times() {
             points.push([v[0], v[1], v[2]]);
         }
     }
-    assert_eq!(moves.len(), points.len());
+    // Which blocks reach a CL point: the same run in the csv dialect marks
+    // the blocks the linearization inserted with an empty line.
+    let csv_dialect = Dialect::builtin("csv").unwrap();
+    let mut csv = Vec::new();
+    post(cl.as_bytes(), &machine, &csv_dialect, &mut csv, &options).unwrap();
+    let reaches_cl: Vec<bool> = String::from_utf8(csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|row| !row.starts_with(','))
+        .collect();
+    assert_eq!(moves.len(), reaches_cl.len());
+    assert_eq!(reaches_cl.iter().filter(|r| **r).count(), points.len());
+    assert!(
+        moves.len() > points.len(),
+        "the example's rotary moves need linearization"
+    );
+    let d = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    // The blocks from one CL point to the next take, together, the CL
+    // segment length over the feed rate.
     let mut checked = 0;
+    let mut point = 0;
+    let mut time = 0.0;
     for k in 1..moves.len() {
-        if !moves[k].feed {
+        if moves[k].feed {
+            // LinuxCNC's move length: the XYZ distance, or the ABC one for a
+            // move of the rotary axes alone.
+            let xyz = d(&moves[k].at[..3], &moves[k - 1].at[..3]);
+            let length = if xyz > 1e-6 {
+                xyz
+            } else {
+                d(&moves[k].at[3..], &moves[k - 1].at[3..])
+            };
+            time += length / moves[k].rate;
+        }
+        if !reaches_cl[k] {
             continue;
         }
-        let d = |a: &[f64], b: &[f64]| {
-            a.iter()
-                .zip(b)
-                .map(|(x, y)| (x - y).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        };
-        let want = d(&points[k], &points[k - 1]) / feed;
-        // LinuxCNC's move length: the XYZ distance, or the ABC one for a
-        // move of the rotary axes alone.
-        let xyz = d(&moves[k].at[..3], &moves[k - 1].at[..3]);
-        let length = if xyz > 1e-6 {
-            xyz
-        } else {
-            d(&moves[k].at[3..], &moves[k - 1].at[3..])
-        };
-        let got = length / moves[k].rate;
-        assert!(
-            (got - want).abs() <= 1e-3 * want,
-            "block {k}: LinuxCNC time {got} min, CL time {want} min"
-        );
-        checked += 1;
+        point += 1;
+        if moves[k].feed {
+            let want = d(&points[point], &points[point - 1]) / feed;
+            assert!(
+                (time - want).abs() <= 1e-3 * want,
+                "CL point {point}: LinuxCNC time {time} min, CL time {want} min"
+            );
+            checked += 1;
+        }
+        time = 0.0;
     }
     assert!(checked > 20, "{checked}");
 }

@@ -10,7 +10,9 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Deserializer};
 use toml::Spanned;
 
-use crate::model::{Axis, AxisKind, MAX_AXES, Machine, OutputMode, PostSettings, Side, Tool};
+use crate::model::{
+    Axis, AxisKind, MAX_AXES, Machine, OutputMode, PostSettings, Prefer, Side, Tool, Wrap,
+};
 
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;
@@ -41,6 +43,26 @@ struct RawPost {
     header: Option<String>,
     footer: Option<String>,
     output: Option<RawOutput>,
+    /// Safe distance of a retract-and-reconfigure, mm.
+    retract: Option<Spanned<f64>>,
+    /// Singular cone half-angle, degrees.
+    singular_cone: Option<Spanned<f64>>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum RawWrap {
+    None,
+    Modulo,
+    Unwind,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq)]
+#[serde(rename_all = "lowercase")]
+enum RawPrefer {
+    Positive,
+    Negative,
+    Zero,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq)]
@@ -78,6 +100,10 @@ struct RawAxis {
     free_with_reference: Option<Spanned<bool>>,
     /// Limits are machine coordinates: machine = NC + offset (DESIGN.md §2).
     machine_offset: Option<Spanned<f64>>,
+    wrap: Option<Spanned<RawWrap>>,
+    prefer: Option<Spanned<RawPrefer>>,
+    /// mm/min or degrees/min.
+    max_velocity: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -382,6 +408,27 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         );
     }
 
+    let retract = raw.post.retract.as_ref().map(|r| {
+        let v = *r.get_ref();
+        if !(v.is_finite() && v > 0.0) {
+            c.error(
+                r.span(),
+                "retract must be a distance greater than zero (mm)",
+            );
+        }
+        v
+    });
+    let singular_cone_deg = raw.post.singular_cone.as_ref().map(|r| {
+        let v = *r.get_ref();
+        if !(v.is_finite() && (0.0..45.0).contains(&v)) {
+            c.error(
+                r.span(),
+                "singular_cone must be an angle from 0 to less than 45 degrees",
+            );
+        }
+        v
+    });
+
     if !c.errors.is_empty() {
         return Err(Diagnostics(c.errors));
     }
@@ -404,6 +451,8 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
                 RawOutput::Joint => OutputMode::Joint,
                 RawOutput::Tcp => OutputMode::Tcp,
             }),
+            retract,
+            singular_cone_deg,
         },
     })
 }
@@ -515,11 +564,44 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         },
         direction,
         point,
+        wrap: Axis::default_wrap(kind, limits),
         limits,
         fixed,
         free_with_reference: false,
+        prefer: None,
+        max_velocity: None,
     };
     let mut axis = axis;
+    if let Some(w) = &a.wrap {
+        if kind != AxisKind::Rotary {
+            c.error(w.span(), "`wrap` applies to rotary axes only");
+        }
+        axis.wrap = match w.get_ref() {
+            RawWrap::None => Wrap::None,
+            RawWrap::Modulo => Wrap::Modulo,
+            RawWrap::Unwind => Wrap::Unwind,
+        };
+    }
+    if let Some(p) = &a.prefer {
+        if kind != AxisKind::Rotary {
+            c.error(p.span(), "`prefer` applies to rotary axes only");
+        }
+        axis.prefer = Some(match p.get_ref() {
+            RawPrefer::Positive => Prefer::Positive,
+            RawPrefer::Negative => Prefer::Negative,
+            RawPrefer::Zero => Prefer::Zero,
+        });
+    }
+    if let Some(v) = &a.max_velocity {
+        let value = *v.get_ref();
+        if !(value.is_finite() && value > 0.0) {
+            c.error(
+                v.span(),
+                "max_velocity must be a speed greater than zero (mm/min or degrees/min)",
+            );
+        }
+        axis.max_velocity = Some(value);
+    }
     if let Some(f) = &a.free_with_reference {
         axis.free_with_reference = *f.get_ref();
         if axis.free_with_reference && (axis.fixed.is_none() || !axis.is_rotary()) {

@@ -21,6 +21,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+mod singular;
+pub use singular::Singularity;
+
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
 use crate::subproblems::{Angle, FREE_EPS, rotation, sp1_cs, sp2};
 

@@ -20,5 +20,7 @@ mod model;
 pub mod subproblems;
 
 pub use file::machine_from_toml;
-pub use kinematics::{IkError, Joints, Kinematics, Solution, Violation, wrap180};
-pub use model::{Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Side, Tool};
+pub use kinematics::{IkError, Joints, Kinematics, Singularity, Solution, Violation, wrap180};
+pub use model::{
+    Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,
+};

@@ -41,6 +41,39 @@ pub struct Axis {
     /// A locked axis that becomes free for CL points that carry a reference
     /// direction (6-axis output, e.g. the C axis of the MTS1600).
     pub free_with_reference: bool,
+    /// How a rotary axis counts its turns (see [`Wrap`]).
+    pub wrap: Wrap,
+    /// Which of equivalent values the planner prefers, if the user said so.
+    pub prefer: Option<Prefer>,
+    /// Largest speed of the axis, mm/min or degrees/min; feed moves that
+    /// would need more are slowed down.
+    pub max_velocity: Option<f64>,
+}
+
+/// How a rotary axis counts its turns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// The value is continuous (it may grow over several turns, inside the
+    /// travel) and written as it is.
+    #[default]
+    None,
+    /// A modulo axis: written as 0 ≤ value < 360 with shortest-path words
+    /// (Sinumerik `DC`); the controller turns the short way, which is the
+    /// way the planner moves it.
+    Modulo,
+    /// Continuous inside a cut; between segments (rapids, tool changes) the
+    /// axis turns back to the equivalent nearest zero, so turns do not add
+    /// up over a program.
+    Unwind,
+}
+
+/// A preference among equivalent rotary values (`prefer` in the machine
+/// file).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Prefer {
+    Positive,
+    Negative,
+    Zero,
 }
 
 impl Axis {
@@ -52,11 +85,21 @@ impl Axis {
         self.fixed.is_none()
     }
 
-    /// A rotary axis that turns without end: no limits, or at least a full
-    /// turn each way (±360°). Controllers run such axes as modulo axes, and
-    /// dialects may write them with shortest-path words (Sinumerik `DC`).
+    /// A rotary axis written as a modulo axis, with shortest-path words
+    /// (Sinumerik `DC`): `wrap = "modulo"`.
     pub fn is_endless(&self) -> bool {
-        self.is_rotary() && self.limits.is_none_or(|[lo, hi]| hi - lo >= 720.0)
+        self.is_rotary() && self.wrap == Wrap::Modulo
+    }
+
+    /// The `wrap` of an axis whose machine file does not say: modulo for a
+    /// rotary axis without limits or with at least a full turn each way
+    /// (±360°), continuous otherwise.
+    pub fn default_wrap(kind: AxisKind, limits: Option<[f64; 2]>) -> Wrap {
+        if kind == AxisKind::Rotary && limits.is_none_or(|[lo, hi]| hi - lo >= 720.0) {
+            Wrap::Modulo
+        } else {
+            Wrap::None
+        }
     }
 
     /// Whether `value` lies inside the travel (with a tolerance of 1e-9 for
@@ -93,6 +136,11 @@ pub struct PostSettings {
     pub footer: Option<String>,
     /// Joint or tool-centre-point output when the command line names none.
     pub output: Option<OutputMode>,
+    /// Safe distance along the tool axis for a retract-and-reconfigure, mm.
+    pub retract: Option<f64>,
+    /// Half-angle of the cone around a singular tool-axis direction inside
+    /// which the free angle is held, degrees.
+    pub singular_cone_deg: Option<f64>,
 }
 
 /// What the linear axis words of a program mean.

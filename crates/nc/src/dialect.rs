@@ -66,10 +66,14 @@ pub struct FeedFormat {
     /// Literal word written on rapid blocks instead of a feed word
     /// (Heidenhain `FMAX`); empty for none.
     pub rapid: String,
-    /// The feed values are inverse time (Fanuc/LinuxCNC `G93`): the caller
-    /// computes them; the writer formats them like any feed.
-    pub inverse_time: bool,
+    /// The feed mode a program in this dialect uses unless told otherwise:
+    /// `tip`, `inverse-time` or `dpm` (`mode` in `[feed]`; the values are
+    /// computed by the caller, the writer formats them like any feed).
+    pub mode: Option<String>,
 }
+
+/// The feed modes a dialect may name as its default.
+pub const FEED_MODES: [&str; 3] = ["tip", "inverse-time", "dpm"];
 
 /// The motion (interpolation) words.
 #[derive(Debug, Clone, PartialEq)]
@@ -461,6 +465,18 @@ impl Dialect {
                 ),
             );
         }
+        if let Some(mode) = &raw.feed.mode
+            && !FEED_MODES.contains(&mode.get_ref().as_str())
+        {
+            err(
+                mode.span(),
+                format!(
+                    "unknown feed mode `{}`: use one of {}",
+                    mode.get_ref(),
+                    FEED_MODES.join(", ")
+                ),
+            );
+        }
         if !block.line_end.ends_with('\n') {
             err(
                 raw.block.line_end.span(),
@@ -484,7 +500,7 @@ impl Dialect {
             feed: FeedFormat {
                 word: feed_word,
                 rapid: raw.feed.rapid,
-                inverse_time: raw.feed.inverse_time,
+                mode: raw.feed.mode.map(Spanned::into_inner),
             },
             motion,
             numbering,
@@ -522,6 +538,12 @@ impl Dialect {
     /// Block layout.
     pub fn block_format(&self) -> &BlockFormat {
         &self.block
+    }
+
+    /// The feed mode programs use unless told otherwise (see
+    /// [`FeedFormat::mode`]).
+    pub fn default_feed_mode(&self) -> Option<&str> {
+        self.feed.mode.as_deref()
     }
 
     /// The feed word.
@@ -729,8 +751,7 @@ struct RawFeed {
     modal: Option<bool>,
     #[serde(default)]
     rapid: String,
-    #[serde(default)]
-    inverse_time: bool,
+    mode: Option<Spanned<String>>,
 }
 
 impl RawFeed {

@@ -1,0 +1,530 @@
+//! Writing the planned path: every block is rounded as the dialect writes it,
+//! run back through the forward kinematics and checked, given its feed word,
+//! and written. Between two feed blocks the post inserts blocks until the
+//! contact point, moved linearly in joint space, stays on the straight CL
+//! segment (linearization); where the planner found no continuous motion it
+//! retracts along the tool axis, reconfigures and re-approaches.
+
+use std::io::Write;
+
+use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_nc::{Block, Motion, NcWriter};
+use nalgebra::Vector3;
+
+use crate::check::{CheckStats, Tolerance, angle_between, pose_error};
+use crate::post::{FeedMode, PostError, describe};
+use crate::solve::{Hold, interpolate, solve_near};
+use crate::summary::{FeedClamp, Planning, Reconfiguration};
+
+/// Deepest halving of one CL segment by the linearization (2^16 blocks).
+const MAX_DEPTH: u32 = 16;
+/// At most this many feed clamps are listed (all are counted).
+const MAX_CLAMPS_LISTED: usize = 1000;
+
+/// A configuration to write, with the pose it must reach.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Node {
+    /// The pose the block must reach (the CL pose, or the pose the machine
+    /// points with a singular angle held).
+    pub pose: Pose,
+    /// Exact (unrounded, unwrapped) axis values.
+    pub joints: Joints,
+    /// The singular angle held at this node, if any.
+    pub hold: Option<Hold>,
+}
+
+/// One CL point as the planner hands it over.
+pub(crate) struct Target<'a> {
+    pub node: Node,
+    pub motion: Motion,
+    pub line: usize,
+    /// CL feed rate, mm/min.
+    pub feed: Option<f64>,
+    /// The move into it is continuous (else: retract and reconfigure).
+    pub continuous: bool,
+    /// The move into it is part of a cut (not the start of a segment).
+    pub cut: bool,
+    /// Makes an error diagnostic at this point's CL line.
+    pub at: &'a dyn Fn(String) -> PostError,
+}
+
+/// The previous written block.
+#[derive(Debug, Clone, Copy)]
+struct Last {
+    node: Node,
+    line: usize,
+    /// Values as handed to the writer (tool point on X, Y, Z in TCP output).
+    values: Joints,
+}
+
+/// Settings of the emitter.
+#[derive(Debug, Clone)]
+pub(crate) struct EmitSettings {
+    pub feed_mode: FeedMode,
+    /// Linearization tolerance, mm; 0: off.
+    pub lintol: f64,
+    pub retract_mm: f64,
+    pub reconfigure: bool,
+    pub tolerance: Tolerance,
+    pub tolerance_given: bool,
+    /// Tool-centre-point output: indices of X, Y, Z.
+    pub tcp: Option<[usize; 3]>,
+    /// One unit of the last written decimal, per axis.
+    pub resolution: Vec<f64>,
+    /// The machine's singular direction and the cone around it, rad.
+    pub singularity: Option<Singularity>,
+    pub cone_rad: f64,
+}
+
+pub(crate) struct Emitter<W: Write> {
+    pub writer: NcWriter<W>,
+    pub settings: EmitSettings,
+    n: usize,
+    /// Free rotary axes.
+    rotary: Vec<usize>,
+    /// Axes with a maximum velocity (index, units per minute).
+    vmax: Vec<(usize, f64)>,
+    names: Vec<String>,
+    last: Option<Last>,
+    written: Joints,
+    solutions: Vec<Solution>,
+    inserted: Vec<Node>,
+    pub stats: CheckStats,
+    pub blocks: u64,
+    pub planning: Planning,
+}
+
+impl<W: Write> Emitter<W> {
+    pub fn new(machine: &Machine, writer: NcWriter<W>, settings: EmitSettings) -> Self {
+        let axes = &machine.axes;
+        Emitter {
+            writer,
+            settings,
+            n: axes.len(),
+            rotary: (0..axes.len())
+                .filter(|&i| axes[i].is_rotary() && axes[i].is_free())
+                .collect(),
+            vmax: (0..axes.len())
+                .filter(|&i| axes[i].is_free())
+                .filter_map(|i| axes[i].max_velocity.map(|v| (i, v)))
+                .collect(),
+            names: axes.iter().map(|a| a.name.clone()).collect(),
+            last: None,
+            written: [0.0; MAX_AXES],
+            solutions: Vec::with_capacity(16),
+            inserted: Vec::new(),
+            stats: CheckStats::default(),
+            blocks: 0,
+            planning: Planning::default(),
+        }
+    }
+
+    /// Writes one planned CL point and whatever must come before it.
+    pub fn emit(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        t: &Target,
+    ) -> Result<(), PostError> {
+        if let Some(last) = self.last
+            && t.motion == Motion::Feed
+        {
+            if t.cut && !t.continuous {
+                self.reconfigure(machine, kin, &last, t)?;
+            } else if self.settings.lintol > 0.0 && self.settings.tcp.is_none() {
+                self.inserted.clear();
+                let mut inserted = std::mem::take(&mut self.inserted);
+                let result = self.linearize(kin, &last.node, &t.node, 0, &mut inserted);
+                match result {
+                    Ok(()) => {}
+                    // A move that starts a segment may be a repositioning
+                    // the CL asks for at feed: it is written as it is.
+                    Err(_) if !t.cut => inserted.clear(),
+                    Err(e) => {
+                        return Err((t.at)(format!(
+                            "{e} between CL line {} and this point, {}",
+                            last.line,
+                            describe(&t.node.pose)
+                        )));
+                    }
+                }
+                for node in &inserted {
+                    self.block(machine, kin, node, Motion::Feed, None, t.line, t.feed, t.at)?;
+                    self.planning.inserted_blocks += 1;
+                }
+                self.inserted = inserted;
+            }
+        }
+        self.block(
+            machine,
+            kin,
+            &t.node,
+            t.motion,
+            Some(t.line),
+            t.line,
+            t.feed,
+            t.at,
+        )
+    }
+
+    /// Halves the CL segment `a`–`b` until the contact point at the
+    /// joint-space midpoint of every piece lies within the tolerance of the
+    /// straight segment; the inserted nodes go to `out` in path order.
+    fn linearize(
+        &mut self,
+        kin: &Kinematics,
+        a: &Node,
+        b: &Node,
+        depth: u32,
+        out: &mut Vec<Node>,
+    ) -> Result<(), &'static str> {
+        let mut mid = a.joints;
+        for (m, v) in mid.iter_mut().zip(&b.joints).take(self.n) {
+            *m = 0.5 * (*m + v);
+        }
+        let reached = kin.fk(&mid[..self.n]).point;
+        let deviation = distance_to_segment(&reached, &a.pose.point, &b.pose.point);
+        if deviation <= self.settings.lintol {
+            let p = &mut self.planning;
+            p.max_linearization_error_mm = p.max_linearization_error_mm.max(deviation);
+            return Ok(());
+        }
+        let turn = angle_between(&a.pose.axis, &b.pose.axis);
+        let span = (a.pose.point - b.pose.point).norm();
+        if depth >= MAX_DEPTH || (span < 1e-7 && turn < 1e-9) {
+            // The axes move while the pose hardly does: not a continuous
+            // motion of the tool.
+            return Err(
+                "the rotary axes cannot follow the path continuously (the joint motion does not converge to the straight CL segment)",
+            );
+        }
+        let pose = interpolate(&a.pose, &b.pose, 0.5);
+        // Inside the singular cone the singular angle moves linearly in
+        // joint space (held between the ends) instead of swinging.
+        let hold = self.settings.singularity.and_then(|s| {
+            let held = a.hold.is_some() || b.hold.is_some();
+            (held || s.distance(&pose.axis) < self.settings.cone_rad).then_some(Hold {
+                axis: s.axis,
+                value: mid[s.axis],
+            })
+        });
+        let solved =
+            solve_near(kin, &pose, &mid, hold, &self.rotary, &mut self.solutions).or_else(|| {
+                // The machine cannot point the interpolated tool axis (two
+                // rotary axes at an angle other than 90° reach a band of
+                // directions only): keep the axis of the rotary midpoint
+                // and put the contact point on the segment.
+                let natural = Pose {
+                    axis: kin.fk(&mid[..self.n]).axis,
+                    ..pose
+                };
+                solve_near(kin, &natural, &mid, hold, &self.rotary, &mut self.solutions)
+            });
+        let Some((pose, sol)) = solved else {
+            return Err("an intermediate pose of the linearization is outside the travel");
+        };
+        let m = Node {
+            pose,
+            joints: sol.joints,
+            hold,
+        };
+        self.linearize(kin, a, &m, depth + 1, out)?;
+        out.push(m);
+        self.linearize(kin, &m, b, depth + 1, out)
+    }
+
+    /// Retract along the tool axis from the last block, turn the rotary axes
+    /// to the new configuration above the next point, and re-approach.
+    fn reconfigure(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        last: &Last,
+        t: &Target,
+    ) -> Result<(), PostError> {
+        let (from, to) = (&last.node, &t.node);
+        if !self.settings.reconfigure {
+            return Err((t.at)(format!(
+                "no continuous motion reaches this point from CL line {} inside the travel ({}); \
+                 a retract and reconfiguration is needed, but --no-reconfigure forbids it",
+                last.line,
+                self.jump_text(&from.joints, &to.joints)
+            )));
+        }
+        let d = self.settings.retract_mm;
+        let lift = |node: &Node| Pose {
+            point: node.pose.point + node.pose.axis * d,
+            ..node.pose
+        };
+        let up = lift(from);
+        let over = lift(to);
+        let mut nodes = [*from, *to];
+        for (k, (pose, near)) in [(up, from), (over, to)].into_iter().enumerate() {
+            let Some((pose, sol)) = solve_near(
+                kin,
+                &pose,
+                &near.joints,
+                near.hold,
+                &self.rotary,
+                &mut self.solutions,
+            ) else {
+                return Err((t.at)(format!(
+                    "the retract of {d} mm along the tool axis for a reconfiguration {} is outside the travel \
+                     (set a smaller distance with --retract or [post] retract)",
+                    if k == 0 {
+                        "before this point"
+                    } else {
+                        "above this point"
+                    }
+                )));
+            };
+            nodes[k] = Node {
+                pose,
+                joints: sol.joints,
+                hold: near.hold,
+            };
+        }
+        let (axis, a, b) = self.largest_jump(&from.joints, &to.joints);
+        self.planning.reconfigurations.push(Reconfiguration {
+            line: t.line,
+            previous_line: Some(last.line),
+            axis: self.names[axis].clone(),
+            from_deg: a,
+            to_deg: b,
+            retract_mm: d,
+        });
+        for node in &nodes {
+            self.block(
+                machine,
+                kin,
+                node,
+                Motion::Rapid,
+                None,
+                t.line,
+                t.feed,
+                t.at,
+            )?;
+            self.planning.inserted_blocks += 1;
+        }
+        Ok(())
+    }
+
+    fn largest_jump(&self, a: &Joints, b: &Joints) -> (usize, f64, f64) {
+        let i = self
+            .rotary
+            .iter()
+            .copied()
+            .max_by(|&i, &j| (b[i] - a[i]).abs().total_cmp(&(b[j] - a[j]).abs()))
+            .unwrap_or(0);
+        (i, a[i], b[i])
+    }
+
+    fn jump_text(&self, a: &Joints, b: &Joints) -> String {
+        let (i, x, y) = self.largest_jump(a, b);
+        format!(
+            "{} would have to jump from {x:.3}° to {y:.3}°",
+            self.names[i]
+        )
+    }
+
+    /// Rounds, checks and writes one block.
+    #[allow(clippy::too_many_arguments)]
+    fn block(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        node: &Node,
+        motion: Motion,
+        cl_line: Option<usize>,
+        line: usize,
+        feed: Option<f64>,
+        at: &dyn Fn(String) -> PostError,
+    ) -> Result<(), PostError> {
+        let n = self.n;
+        let pose = &node.pose;
+        // Joint output writes the axis values; tool-centre-point output
+        // writes the tool point on X, Y, Z and the rotary axis values.
+        let mut values = node.joints;
+        if let Some([x, y, z]) = self.settings.tcp {
+            values[x] = pose.point.x;
+            values[y] = pose.point.y;
+            values[z] = pose.point.z;
+        }
+        for (i, (w, v)) in self.written[..n].iter_mut().zip(&values[..n]).enumerate() {
+            *w = self.writer.quantized(i, *v);
+        }
+        let mut reached = kin.fk(&self.written[..n]);
+        if let Some([x, y, z]) = self.settings.tcp {
+            // The controller puts the tool point where the words say; the
+            // orientation comes from the rotary words alone.
+            reached.point = Vector3::new(self.written[x], self.written[y], self.written[z]);
+        }
+        if !self
+            .stats
+            .record(pose, &reached, line, &self.settings.tolerance)
+            && !self.within_block_bound(machine, kin, pose, &reached)
+        {
+            let (p, a) = pose_error(pose, &reached);
+            let s = &self.settings;
+            return Err(at(format!(
+                "closed-loop check failed: the block as written puts the tool {p:.6} mm and {a:.3e} rad \
+                 from the CL pose (tolerance {:.6} mm, {:.3e} rad); {}",
+                s.tolerance.position_mm,
+                s.tolerance.axis_rad,
+                describe(pose)
+            )));
+        }
+        let feed = match motion {
+            Motion::Rapid => None,
+            Motion::Feed => {
+                let Some(f) = feed else {
+                    return Err(at(
+                        "feed move before any FEDRAT: the controller has no feed rate for it"
+                            .into(),
+                    ));
+                };
+                Some(self.feed_word(f, node, &values, line))
+            }
+        };
+        if motion == Motion::Feed
+            && let Some(last) = &self.last
+        {
+            for &i in &self.rotary {
+                let step = (node.joints[i] - last.node.joints[i]).abs();
+                if step > self.planning.max_rotary_step_deg {
+                    self.planning.max_rotary_step_deg = step;
+                    self.planning.max_rotary_step_line = Some(line);
+                }
+            }
+        }
+        self.last = Some(Last {
+            node: *node,
+            line,
+            values,
+        });
+        self.writer.block(&Block {
+            cl_line,
+            motion,
+            axes: &values[..n],
+            feed,
+        })?;
+        self.blocks += 1;
+        Ok(())
+    }
+
+    /// The feed word of a feed block reaching `node` from the last block:
+    /// the block time is the CL segment length over the CL feed rate (a
+    /// block that only turns rotary axes takes its largest rotary change in
+    /// degrees over the feed rate), slowed down where an axis would exceed
+    /// its maximum velocity; the word says that time in the feed mode's
+    /// terms.
+    fn feed_word(&mut self, feed: f64, node: &Node, values: &Joints, line: usize) -> f64 {
+        let Some(last) = &self.last else {
+            return feed;
+        };
+        let length = (node.pose.point - last.node.pose.point).norm();
+        let turn = self
+            .rotary
+            .iter()
+            .map(|&i| (node.joints[i] - last.node.joints[i]).abs())
+            .fold(0.0, f64::max);
+        let distance = if length > 1e-9 { length } else { turn };
+        if distance <= 1e-9 || feed <= 0.0 {
+            return feed;
+        }
+        let programmed = distance / feed;
+        let mut time = programmed;
+        let mut limiting = None;
+        for &(i, v) in &self.vmax {
+            let need = (values[i] - last.values[i]).abs() / v;
+            if need > time * (1.0 + 1e-9) {
+                time = need;
+                limiting = Some(i);
+            }
+        }
+        if let Some(i) = limiting {
+            let p = &mut self.planning;
+            p.feed_clamp_count += 1;
+            if p.feed_clamps.len() < MAX_CLAMPS_LISTED {
+                p.feed_clamps.push(FeedClamp {
+                    line,
+                    axis: self.names[i].clone(),
+                    programmed_min: programmed,
+                    written_min: time,
+                });
+            }
+        }
+        match self.settings.feed_mode {
+            FeedMode::Tip => feed * programmed / time,
+            FeedMode::InverseTime => 1.0 / time,
+            FeedMode::Dpm => {
+                // The controller moves the vector of every axis (mm and
+                // degrees together) at F: F = its length / block time.
+                let d2: f64 = (0..self.n)
+                    .map(|i| (values[i] - last.values[i]).powi(2))
+                    .sum();
+                if d2 > 0.0 { d2.sqrt() / time } else { feed }
+            }
+        }
+    }
+
+    /// With the derived tolerance, a block beyond the machine-wide bound is
+    /// still right if its error is what rounding causes at its own levers; the
+    /// tolerance in force (and reported) grows to it.
+    fn within_block_bound(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        want: &Pose,
+        got: &Pose,
+    ) -> bool {
+        let s = &mut self.settings;
+        if s.tolerance_given || s.tcp.is_some() {
+            return false;
+        }
+        let resolution = &s.resolution;
+        let block = Tolerance::at_block(machine, kin, &self.written[..self.n], |i| resolution[i]);
+        let (p, a) = pose_error(want, got);
+        if p > block.position_mm || a > block.axis_rad {
+            return false;
+        }
+        s.tolerance.position_mm = s.tolerance.position_mm.max(p);
+        s.tolerance.axis_rad = s.tolerance.axis_rad.max(a);
+        true
+    }
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+pub(crate) fn distance_to_segment(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_to_a_segment() {
+        let a = Vector3::new(0.0, 0.0, 0.0);
+        let b = Vector3::new(10.0, 0.0, 0.0);
+        assert_eq!(
+            distance_to_segment(&Vector3::new(5.0, 3.0, 0.0), &a, &b),
+            3.0
+        );
+        assert_eq!(
+            distance_to_segment(&Vector3::new(-4.0, 3.0, 0.0), &a, &b),
+            5.0
+        );
+        assert_eq!(
+            distance_to_segment(&Vector3::new(1.0, 1.0, 0.0), &a, &a),
+            2f64.sqrt()
+        );
+    }
+}

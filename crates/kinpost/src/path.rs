@@ -1,0 +1,474 @@
+//! The path waiting for its plan: CL points (with their candidate
+//! configurations in the [`Trellis`]) and the NC outputs between them, in
+//! order, until the planner decides (every `lag` points and at the end).
+//!
+//! Points whose tool axis lies within the singular cone are not planned by
+//! the trellis: their singular angle is interpolated between the decided
+//! points around them in the same segment (held at the one there is, if
+//! only one), and the other axes are solved for it exactly.
+
+use std::io::Write;
+use std::ops::Range;
+
+use kinpost_diag::Diagnostic;
+use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_nc::Motion;
+use kinpost_plan::{Choice, Link, Trellis, rejection};
+
+use crate::check::angle_between;
+use crate::emit::{Emitter, Node, Target};
+use crate::post::{Pending, PostError, write_pending};
+use crate::solve::{Hold, solve_near};
+use crate::summary::SingularStretch;
+
+/// One CL point waiting for the plan.
+#[derive(Debug, Clone)]
+pub(crate) struct PlanPoint {
+    pub pose: Pose,
+    pub line: usize,
+    pub motion: Motion,
+    pub feed: Option<f64>,
+    /// Its CL line's text in `PathPlan::source`.
+    pub source: Range<usize>,
+    /// In the singular cone: not in the trellis.
+    pub singular: bool,
+    /// Segment number (a new one at every rapid and break).
+    pub segment: u64,
+    /// First point of its segment.
+    pub starts_segment: bool,
+}
+
+enum Item {
+    Point(PlanPoint),
+    Output(Pending),
+}
+
+/// What was decided for a point.
+#[derive(Clone, Copy)]
+struct Decided {
+    node: Node,
+    continuous: bool,
+}
+
+pub(crate) struct PathPlan {
+    trellis: Trellis,
+    singularity: Option<Singularity>,
+    /// Singular cone half-angle, rad (0: only exactly singular points).
+    cone_rad: f64,
+    rotary: Vec<usize>,
+    names: Vec<String>,
+    file: String,
+    items: Vec<Item>,
+    /// CL line texts of the waiting points, back to back.
+    source: Vec<u8>,
+    /// Since the last point in the trellis: tool-axis turn, singular points,
+    /// a segment start.
+    turn: f64,
+    across: bool,
+    free: bool,
+    /// Tool axis and reference of the last point.
+    previous_axes: Option<(nalgebra::Vector3<f64>, Option<nalgebra::Vector3<f64>>)>,
+    segment: u64,
+    break_pending: bool,
+    /// The last point written: its node and segment.
+    last: Option<(Node, u64)>,
+    choices: Vec<Choice>,
+    solutions: Vec<Solution>,
+    pub stretches: Vec<SingularStretch>,
+}
+
+impl PathPlan {
+    pub fn new(
+        machine: &Machine,
+        kin: &Kinematics,
+        trellis: Trellis,
+        cone_deg: f64,
+        file: &str,
+    ) -> Self {
+        let axes = &machine.axes;
+        PathPlan {
+            trellis,
+            singularity: kin.singularity(),
+            cone_rad: cone_deg.to_radians(),
+            rotary: (0..axes.len())
+                .filter(|&i| axes[i].is_rotary() && axes[i].is_free())
+                .collect(),
+            names: axes.iter().map(|a| a.name.clone()).collect(),
+            file: file.to_string(),
+            items: Vec::new(),
+            source: Vec::new(),
+            turn: 0.0,
+            across: false,
+            free: true,
+            previous_axes: None,
+            segment: 0,
+            break_pending: true,
+            last: None,
+            choices: Vec::new(),
+            solutions: Vec::with_capacity(16),
+            stretches: Vec::new(),
+        }
+    }
+
+    /// The path is interrupted here (rapid, tool change, end of an
+    /// operation): the next point starts a segment.
+    pub fn break_segment(&mut self) {
+        self.break_pending = true;
+    }
+
+    /// An NC output between points, written in its place.
+    pub fn push_output(&mut self, p: Pending) {
+        self.items.push(Item::Output(p));
+    }
+
+    /// Whether nothing waits.
+    pub fn is_idle(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    /// Adds a CL point. An error is returned for the point at once when it
+    /// cannot be reached at all (the caller makes the diagnostic).
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_point(
+        &mut self,
+        kin: &Kinematics,
+        pose: Pose,
+        motion: Motion,
+        line: usize,
+        feed: Option<f64>,
+        source_line: &[u8],
+    ) -> Result<(), PointError> {
+        if motion == Motion::Rapid {
+            self.break_pending = true;
+        }
+        let starts_segment = std::mem::take(&mut self.break_pending);
+        if starts_segment {
+            self.segment += 1;
+            self.free = true;
+        }
+        if let Some((axis, reference)) = &self.previous_axes {
+            let mut turn = angle_between(axis, &pose.axis);
+            if let (Some(a), Some(b)) = (reference, &pose.reference) {
+                turn = turn.max(angle_between(a, b));
+            }
+            self.turn += turn.to_degrees();
+        }
+        self.previous_axes = Some((pose.axis, pose.reference));
+        // The hint picks the turn of axes without limits: near the cheapest
+        // configuration of the previous point.
+        let hint: Joints = self.trellis.best_last().copied().unwrap_or([0.0; MAX_AXES]);
+        let n = kin.axis_count();
+        kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
+            .map_err(|e| PointError::Ik(e.to_string()))?;
+        let in_cone = self
+            .singularity
+            .is_some_and(|s| s.distance(&pose.axis) < self.cone_rad);
+        let singular = in_cone || self.solutions.iter().all(|s| s.singular);
+        if singular {
+            if !self.solutions.iter().any(Solution::is_valid) {
+                return Err(PointError::Rejected(rejection(&self.solutions)));
+            }
+            self.across = true;
+        } else {
+            let link = if self.free {
+                Link::Free
+            } else {
+                Link::Cut {
+                    turn_deg: self.turn,
+                    across_singular: self.across,
+                }
+            };
+            if !self.trellis.push(&self.solutions, link) {
+                return Err(PointError::Rejected(rejection(&self.solutions)));
+            }
+            self.turn = 0.0;
+            self.across = false;
+            self.free = false;
+        }
+        let start = self.source.len();
+        self.source.extend_from_slice(source_line);
+        self.items.push(Item::Point(PlanPoint {
+            pose,
+            line,
+            motion,
+            feed,
+            source: start..self.source.len(),
+            singular,
+            segment: self.segment,
+            starts_segment,
+        }));
+        Ok(())
+    }
+
+    /// Whether the planner should decide now (see [`Trellis::is_full`]).
+    pub fn is_full(&self) -> bool {
+        self.trellis.is_full()
+    }
+
+    /// Decides the waiting points and writes them. Unless `all`, singular
+    /// points after the last planned one keep waiting for their next
+    /// neighbour.
+    pub fn flush<W: Write>(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        emitter: &mut Emitter<W>,
+        all: bool,
+    ) -> Result<(), PostError> {
+        self.choices.clear();
+        self.trellis.decide(&mut self.choices);
+        let end = if all {
+            self.items.len()
+        } else {
+            self.items
+                .iter()
+                .rposition(|i| matches!(i, Item::Point(p) if !p.singular))
+                .map_or(0, |k| k + 1)
+        };
+        let mut items = std::mem::take(&mut self.items);
+        self.items = items.split_off(end);
+        let decided = self.decide(kin, &items)?;
+        let mut k = 0;
+        for item in items {
+            match item {
+                Item::Output(p) => write_pending(&mut emitter.writer, p)?,
+                Item::Point(p) => {
+                    let d = decided[k];
+                    k += 1;
+                    let at = |message: String| self.error_at(&p, message);
+                    emitter.emit(
+                        machine,
+                        kin,
+                        &Target {
+                            node: d.node,
+                            motion: p.motion,
+                            line: p.line,
+                            feed: p.feed,
+                            continuous: d.continuous,
+                            cut: !p.starts_segment,
+                            at: &at,
+                        },
+                    )?;
+                    self.last = Some((d.node, p.segment));
+                }
+            }
+        }
+        // Keep the text of the points still waiting only.
+        let keep = self.items.iter().find_map(|i| match i {
+            Item::Point(p) => Some(p.source.start),
+            Item::Output(_) => None,
+        });
+        match keep {
+            None => self.source.clear(),
+            Some(from) => {
+                self.source.drain(..from);
+                for i in &mut self.items {
+                    if let Item::Point(p) = i {
+                        p.source = p.source.start - from..p.source.end - from;
+                    }
+                }
+            }
+        }
+        if let Some((node, _)) = &self.last {
+            // Branch labels do not matter across a decision boundary.
+            self.trellis.set_anchor(node.joints, 0);
+        }
+        Ok(())
+    }
+
+    /// The configuration of each point among `items`, in order.
+    fn decide(&mut self, kin: &Kinematics, items: &[Item]) -> Result<Vec<Decided>, PostError> {
+        let points: Vec<&PlanPoint> = items
+            .iter()
+            .filter_map(|i| match i {
+                Item::Point(p) => Some(p),
+                Item::Output(_) => None,
+            })
+            .collect();
+        let mut out: Vec<Option<Decided>> = vec![None; points.len()];
+        // Planned points take the trellis's choices.
+        let mut c = 0;
+        for (k, p) in points.iter().enumerate() {
+            if !p.singular {
+                let choice = self.choices[c];
+                c += 1;
+                out[k] = Some(Decided {
+                    node: Node {
+                        pose: p.pose,
+                        joints: choice.joints,
+                        hold: None,
+                    },
+                    continuous: choice.continuous,
+                });
+            }
+        }
+        // Runs of singular points.
+        let mut k = 0;
+        while k < points.len() {
+            if !points[k].singular {
+                k += 1;
+                continue;
+            }
+            let seg = points[k].segment;
+            let mut e = k;
+            while e < points.len() && points[e].singular && points[e].segment == seg {
+                e += 1;
+            }
+            self.fill_run(kin, &points, k..e, &mut out)?;
+            k = e;
+        }
+        Ok(out
+            .into_iter()
+            .map(|d| d.expect("every point decided"))
+            .collect())
+    }
+
+    /// Holds the singular angle over `run` and solves its points.
+    fn fill_run(
+        &mut self,
+        kin: &Kinematics,
+        points: &[&PlanPoint],
+        run: Range<usize>,
+        out: &mut [Option<Decided>],
+    ) -> Result<(), PostError> {
+        let seg = points[run.start].segment;
+        // The decided neighbours in the same segment.
+        let before: Option<Node> = if run.start > 0 {
+            let p = points[run.start - 1];
+            (p.segment == seg)
+                .then(|| out[run.start - 1].map(|d| d.node))
+                .flatten()
+        } else {
+            self.last.filter(|(_, s)| *s == seg).map(|(n, _)| n)
+        };
+        let after: Option<Node> = points
+            .get(run.end)
+            .filter(|p| p.segment == seg && !p.singular)
+            .and_then(|_| out[run.end])
+            .filter(|d| d.continuous)
+            .map(|d| d.node);
+        let anchor = self
+            .last
+            .map(|(n, _)| n.joints)
+            .or_else(|| self.trellis.anchor().copied())
+            .unwrap_or([0.0; MAX_AXES]);
+        let axis = self.singularity.map(|s| s.axis);
+        let value_of = |node: &Node| axis.map_or(0.0, |i| node.joints[i]);
+        let (from, to) = match (before, after) {
+            (Some(b), Some(a)) => (value_of(&b), value_of(&a)),
+            (Some(b), None) => (value_of(&b), value_of(&b)),
+            (None, Some(a)) => (value_of(&a), value_of(&a)),
+            (None, None) => {
+                let v = axis.map_or(0.0, |i| anchor[i]);
+                (v, v)
+            }
+        };
+        // Interpolate by distance along the CL path from the point before
+        // to the point after (by count where it does not move).
+        let mut lengths = Vec::with_capacity(run.len() + 1);
+        let mut total = 0.0;
+        let mut previous = before.map(|b| b.pose.point);
+        for k in run.clone() {
+            let p = points[k].pose.point;
+            total += previous.map_or(0.0, |q| (p - q).norm());
+            lengths.push(total);
+            previous = Some(p);
+        }
+        if let Some(a) = after {
+            total += previous.map_or(0.0, |q| (a.pose.point - q).norm());
+        }
+        let count = run.len() + usize::from(after.is_some());
+        let mut guess = before.map_or(anchor, |b| b.joints);
+        let mut deviation: f64 = 0.0;
+        let mut held_values = (f64::NAN, f64::NAN);
+        for (j, k) in run.clone().enumerate() {
+            let p = points[k];
+            let t = if total > 1e-9 {
+                lengths[j] / total
+            } else {
+                (j + usize::from(before.is_some())) as f64 / count.max(1) as f64
+            };
+            let hold = axis.map(|i| Hold {
+                axis: i,
+                value: from + (to - from) * t,
+            });
+            let solved = solve_near(
+                kin,
+                &p.pose,
+                &guess,
+                hold,
+                &self.rotary,
+                &mut self.solutions,
+            )
+            .map(|(pose, s)| (pose, s, hold))
+            .or_else(|| {
+                // The held angle is out of reach here: the exact solution
+                // nearest the previous point.
+                solve_near(
+                    kin,
+                    &p.pose,
+                    &guess,
+                    None,
+                    &self.rotary,
+                    &mut self.solutions,
+                )
+                .map(|(pose, s)| (pose, s, None))
+            });
+            let Some((pose, sol, hold)) = solved else {
+                return Err(self.error_at(
+                    p,
+                    format!(
+                        "no solution inside the travel for this singular point with {} held at {:.4}°",
+                        axis.map_or("the free axis", |i| self.names[i].as_str()),
+                        hold.map_or(f64::NAN, |h| h.value)
+                    ),
+                ));
+            };
+            deviation = deviation.max(angle_between(&pose.axis, &p.pose.axis));
+            if j == 0 {
+                held_values.0 = axis.map_or(0.0, |i| sol.joints[i]);
+            }
+            held_values.1 = axis.map_or(0.0, |i| sol.joints[i]);
+            guess = sol.joints;
+            out[k] = Some(Decided {
+                node: Node {
+                    pose,
+                    joints: sol.joints,
+                    hold,
+                },
+                continuous: true,
+            });
+        }
+        if let Some(i) = axis {
+            self.stretches.push(SingularStretch {
+                first_line: points[run.start].line,
+                last_line: points[run.end - 1].line,
+                axis: self.names[i].clone(),
+                from_deg: held_values.0,
+                to_deg: held_values.1,
+                max_axis_deviation_deg: deviation.to_degrees(),
+            });
+        }
+        Ok(())
+    }
+
+    /// An error diagnostic at a waiting point's CL line.
+    fn error_at(&self, p: &PlanPoint, message: String) -> PostError {
+        let text = String::from_utf8_lossy(&self.source[p.source.clone()]);
+        let start = text.len() - text.trim_start().len();
+        let column = text[..start].chars().count() + 1;
+        let width = text.trim().chars().count();
+        PostError::Input(Box::new(Diagnostic::error(
+            &self.file, p.line, column, width, text, message,
+        )))
+    }
+}
+
+/// Why a point cannot be added.
+#[derive(Debug)]
+pub(crate) enum PointError {
+    /// The kinematics has no solution (the message says why).
+    Ik(String),
+    /// Every solution is outside the travel.
+    Rejected(kinpost_plan::Rejection),
+}

@@ -1,0 +1,97 @@
+//! Solving a pose near a known configuration: for points the post makes
+//! itself (linearization, retracts) and for points where a singular angle is
+//! held.
+
+use kinpost_machine::{Joints, Kinematics, Pose, Solution};
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// A singular angle held at a value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Hold {
+    /// Index of the axis.
+    pub axis: usize,
+    /// Its value, degrees (unwrapped).
+    pub value: f64,
+}
+
+/// The pose at `t` between `a` and `b`: the point linearly, the tool axis
+/// (and reference) by spherical interpolation (DESIGN.md: the tool axis
+/// turns in the plane of the two axes at constant speed).
+pub(crate) fn interpolate(a: &Pose, b: &Pose, t: f64) -> Pose {
+    Pose {
+        point: a.point.lerp(&b.point, t),
+        axis: slerp(&a.axis, &b.axis, t),
+        reference: match (a.reference, b.reference) {
+            (Some(ra), Some(rb)) => Some(slerp(&ra, &rb, t)),
+            (r, _) => r,
+        },
+    }
+}
+
+/// Spherical interpolation of unit vectors; opposite vectors have no
+/// plane, and keep `a`.
+fn slerp(a: &Vector3<f64>, b: &Vector3<f64>, t: f64) -> Vector3<f64> {
+    match UnitQuaternion::rotation_between(a, b) {
+        Some(q) => {
+            let part = UnitQuaternion::identity().slerp(&q, t);
+            part * a
+        }
+        None => *a,
+    }
+}
+
+/// The valid solution of `pose` whose rotary axes are nearest `near`
+/// (`rotary`: the free rotary axes), with the singular angle held if `hold`
+/// says so: the tool axis is then the nearest one the machine points with
+/// that angle, and the pose solved is returned with it.
+pub(crate) fn solve_near(
+    kin: &Kinematics,
+    pose: &Pose,
+    near: &Joints,
+    hold: Option<Hold>,
+    rotary: &[usize],
+    scratch: &mut Vec<Solution>,
+) -> Option<(Pose, Solution)> {
+    let n = kin.axis_count();
+    let mut hint = *near;
+    let mut pose = *pose;
+    if let Some(h) = hold {
+        hint[h.axis] = h.value;
+        if let Some(axis) = kin.held_axis(&pose.axis, h.value) {
+            pose.axis = axis;
+        }
+    }
+    kin.ik(&pose, Some(&hint[..n]), scratch).ok()?;
+    let travel =
+        |s: &Solution| -> f64 { rotary.iter().map(|&i| (s.joints[i] - hint[i]).abs()).sum() };
+    let held = |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value).abs() < 1e-6);
+    let best = scratch
+        .iter()
+        .filter(|s| s.is_valid() && held(s))
+        .min_by(|a, b| travel(a).total_cmp(&travel(b)))
+        .copied()?;
+    Some((pose, best))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolation_turns_the_axis_in_its_plane() {
+        let a = Pose {
+            point: Vector3::new(0.0, 0.0, 0.0),
+            axis: Vector3::z(),
+            reference: None,
+        };
+        let b = Pose {
+            point: Vector3::new(10.0, 0.0, 0.0),
+            axis: Vector3::x(),
+            reference: None,
+        };
+        let m = interpolate(&a, &b, 0.5);
+        assert!((m.point - Vector3::new(5.0, 0.0, 0.0)).norm() < 1e-12);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((m.axis - Vector3::new(h, 0.0, h)).norm() < 1e-12);
+    }
+}

@@ -1,0 +1,259 @@
+//! What a choice of configurations costs, and which moves are continuous.
+//!
+//! Units are degrees of rotary travel: the planner minimises the rotary
+//! motion along the path, with small extra costs for switching the
+//! closed-form branch, for running close to a travel limit and for values
+//! the user does not prefer.
+
+use kinpost_machine::{Joints, Machine, Prefer, Wrap, wrap180};
+
+/// Cost of switching the orientation branch between two points of a cut.
+const BRANCH_SWITCH: f64 = 1.0;
+/// Cost per point at a travel limit; falls quadratically to zero at the
+/// margin (see [`Costs::unary`]).
+const NEAR_LIMIT: f64 = 1.0;
+/// Cost per point and degree away from the preferred side (`prefer`).
+const PREFERENCE: f64 = 0.01;
+/// Cost per whole turn away from the principal value, for `wrap = "unwind"`
+/// axes at the start of a segment: large enough to always unwind.
+const UNWIND: f64 = 1e4;
+/// A rotary step this small is always continuous, whatever the tool axis did
+/// (round-off, CL points that repeat the tool axis).
+const STEP_FLOOR_DEG: f64 = 1.0;
+/// No rotary axis turns by half a turn or more between two points of a cut.
+const STEP_CEILING_DEG: f64 = 179.0;
+/// Largest step of the rotary axis that is not singular, per degree of
+/// tool-axis turn. With perpendicular axes it sets the angle between the tool
+/// axis and the singular direction, so its step is at most the turn; the
+/// factor leaves room for axes at other angles.
+const TILT_RATE: f64 = 4.0;
+
+/// How two consecutive points are connected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Link {
+    /// A new segment begins (a rapid, a tool change, a new operation, the
+    /// start of the program): the axes may go anywhere.
+    Free,
+    /// A cutting move along which the tool axis turns by `turn_deg` (with a
+    /// reference direction, the larger of its turn and the axis's).
+    /// `across_singular`: singular points in between, where the singular
+    /// angle is interpolated, so it may turn by up to half a turn.
+    Cut {
+        turn_deg: f64,
+        across_singular: bool,
+    },
+}
+
+#[derive(Debug, Clone)]
+struct Rotary {
+    index: usize,
+    wrap: Wrap,
+    prefer: Option<Prefer>,
+}
+
+#[derive(Debug, Clone)]
+struct Limited {
+    index: usize,
+    lo: f64,
+    hi: f64,
+    margin: f64,
+}
+
+/// The cost model of one machine.
+#[derive(Debug, Clone)]
+pub struct Costs {
+    rotary: Vec<Rotary>,
+    limited: Vec<Limited>,
+    /// Largest rotary step per degree of tool-axis turn on a continuous
+    /// path outside the singular cone: 1 / sin(cone).
+    step_rate: f64,
+    singular_axis: Option<usize>,
+}
+
+impl Costs {
+    /// `cone_deg`: half-angle of the singular cone (see the crate docs);
+    /// `singular_axis`: the axis whose angle is free at the singular
+    /// direction, if the machine has one.
+    pub fn new(machine: &Machine, cone_deg: f64, singular_axis: Option<usize>) -> Costs {
+        let free = |i: &usize| machine.axes[*i].is_free();
+        let rotary = (0..machine.axes.len())
+            .filter(free)
+            .filter(|&i| machine.axes[i].is_rotary())
+            .map(|i| Rotary {
+                index: i,
+                wrap: machine.axes[i].wrap,
+                prefer: machine.axes[i].prefer,
+            })
+            .collect();
+        let limited = (0..machine.axes.len())
+            .filter(free)
+            .filter_map(|i| {
+                let a = &machine.axes[i];
+                let [lo, hi] = a.limits?;
+                // A modulo axis reaches every angle: its limits bound the
+                // counter, not the machine.
+                if a.is_rotary() && a.wrap == Wrap::Modulo {
+                    return None;
+                }
+                let margin = ((hi - lo) * 0.05).min(if a.is_rotary() { 5.0 } else { 10.0 });
+                (margin > 0.0).then_some(Limited {
+                    index: i,
+                    lo,
+                    hi,
+                    margin,
+                })
+            })
+            .collect();
+        // Outside the cone a rotary angle changes at most 1/sin(cone) times
+        // as fast as the tool axis turns; a cone of zero (no pole handling)
+        // still bounds the rate by that of a 0.1° cone.
+        let step_rate = 1.0 / cone_deg.max(0.1).to_radians().sin();
+        Costs {
+            rotary,
+            limited,
+            step_rate,
+            singular_axis,
+        }
+    }
+
+    /// Cost of being at `q` for one point: closeness to the travel limits
+    /// and distance from the preferred values.
+    pub fn unary(&self, q: &Joints) -> f64 {
+        let mut cost = 0.0;
+        for l in &self.limited {
+            let d = (q[l.index] - l.lo).min(l.hi - q[l.index]);
+            if d < l.margin {
+                let x = (l.margin - d.max(0.0)) / l.margin;
+                cost += NEAR_LIMIT * x * x;
+            }
+        }
+        for r in &self.rotary {
+            let v = q[r.index];
+            cost += PREFERENCE
+                * match r.prefer {
+                    None => 0.0,
+                    Some(Prefer::Zero) => v.abs(),
+                    Some(Prefer::Positive) => (-v).max(0.0),
+                    Some(Prefer::Negative) => v.max(0.0),
+                };
+        }
+        cost
+    }
+
+    /// Cost of moving from `a` (branch `ba`) to `b` (branch `bb`) and whether
+    /// the move is continuous (a cut may follow it without lifting the tool).
+    pub fn transition(&self, a: &Joints, ba: u8, b: &Joints, bb: u8, link: Link) -> (f64, bool) {
+        let mut cost = 0.0;
+        let mut continuous = true;
+        match link {
+            Link::Free => {
+                for r in &self.rotary {
+                    let (va, vb) = (a[r.index], b[r.index]);
+                    cost += match r.wrap {
+                        Wrap::None => (vb - va).abs(),
+                        Wrap::Modulo => wrap180(vb - va).abs(),
+                        Wrap::Unwind => {
+                            wrap180(vb - va).abs() + UNWIND * ((vb - wrap180(vb)) / 360.0).abs()
+                        }
+                    };
+                }
+            }
+            Link::Cut {
+                turn_deg,
+                across_singular,
+            } => {
+                let bound = |rate: f64| (turn_deg * rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
+                for r in &self.rotary {
+                    let step = (b[r.index] - a[r.index]).abs();
+                    let limit = match self.singular_axis {
+                        Some(i) if i == r.index && across_singular => 180.0 + 1e-9,
+                        Some(i) if i == r.index => bound(self.step_rate),
+                        Some(_) => bound(TILT_RATE),
+                        None => bound(self.step_rate),
+                    };
+                    if step > limit {
+                        continuous = false;
+                    }
+                    cost += step;
+                }
+                if ba != bb {
+                    cost += BRANCH_SWITCH;
+                }
+            }
+        }
+        (cost, continuous)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinpost_machine::{MAX_AXES, builtin};
+
+    fn joints(a: f64, c: f64) -> Joints {
+        let mut q = [0.0; MAX_AXES];
+        q[3] = a;
+        q[4] = c;
+        q
+    }
+
+    fn trunnion() -> Machine {
+        builtin::load("trunnion-ac").unwrap().unwrap()
+    }
+
+    #[test]
+    fn a_flip_is_not_continuous_but_a_small_step_is() {
+        let m = trunnion();
+        let (ia, ic) = (m.axis_index("A").unwrap(), m.axis_index("C").unwrap());
+        assert_eq!((ia, ic), (3, 4), "test joints assume X Y Z A C");
+        let costs = Costs::new(&m, 0.5, Some(ic));
+        let cut = Link::Cut {
+            turn_deg: 0.5,
+            across_singular: false,
+        };
+        let (c, ok) = costs.transition(&joints(30.0, 10.0), 0, &joints(30.5, 10.2), 0, cut);
+        assert!(ok);
+        assert!((c - 0.7).abs() < 1e-12, "{c}");
+        let (_, ok) = costs.transition(&joints(30.0, 10.0), 0, &joints(-30.0, 190.0), 1, cut);
+        assert!(!ok, "a 180° flip of C for a 0.5° turn of the tool axis");
+        // Across a singular stretch C may turn by half a turn, A may not.
+        let across = Link::Cut {
+            turn_deg: 1.0,
+            across_singular: true,
+        };
+        let (_, ok) = costs.transition(&joints(0.4, 10.0), 0, &joints(0.4, 190.0), 0, across);
+        assert!(ok);
+        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(-40.0, 10.0), 0, across);
+        assert!(!ok);
+        // Free moves only cost travel.
+        let (c, ok) = costs.transition(&joints(0.0, 0.0), 0, &joints(90.0, 170.0), 1, Link::Free);
+        assert!(ok);
+        assert_eq!(c, 260.0);
+    }
+
+    #[test]
+    fn near_a_limit_and_against_the_preference_cost_more() {
+        let mut m = trunnion();
+        let ia = m.axis_index("A").unwrap();
+        let [_, hi] = m.axes[ia].limits.unwrap();
+        let costs = Costs::new(&m, 0.5, None);
+        assert_eq!(costs.unary(&joints(0.0, 0.0)), 0.0);
+        assert!(costs.unary(&joints(hi, 0.0)) >= NEAR_LIMIT * 0.999);
+        m.axes[ia].prefer = Some(Prefer::Negative);
+        let costs = Costs::new(&m, 0.5, None);
+        assert!(costs.unary(&joints(10.0, 0.0)) > costs.unary(&joints(-10.0, 0.0)));
+    }
+
+    #[test]
+    fn unwind_axes_return_to_the_principal_turn_between_segments() {
+        let mut m = trunnion();
+        let ic = m.axis_index("C").unwrap();
+        m.axes[ic].wrap = Wrap::Unwind;
+        m.axes[ic].limits = Some([-1080.0, 1080.0]);
+        let costs = Costs::new(&m, 0.5, None);
+        let from = joints(0.0, 700.0);
+        let (near, _) = costs.transition(&from, 0, &joints(0.0, 710.0), 0, Link::Free);
+        let (principal, _) = costs.transition(&from, 0, &joints(0.0, -10.0), 0, Link::Free);
+        assert!(principal < near);
+    }
+}

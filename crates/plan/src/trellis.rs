@@ -1,0 +1,279 @@
+//! Dynamic programming over the inverse-kinematics solutions of a path
+//! (Viterbi): one layer of candidate configurations per CL point, the
+//! cheapest sequence through them by [`Costs`]. Work and memory are linear in
+//! the number of points; the layers wait in memory until the caller decides
+//! (at the end of the input, or every `lag` points, see
+//! [`Trellis::is_full`]).
+
+use kinpost_machine::{Joints, Solution};
+
+use crate::cost::{Costs, Link};
+
+/// Cost added to a move that is not continuous, so that a retract and
+/// reconfiguration is only chosen where no continuous sequence exists.
+pub const RECONFIGURE: f64 = 1e9;
+
+/// One candidate configuration of one point.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    joints: Joints,
+    branch: u8,
+    /// Cheapest cost of a sequence ending here.
+    cost: f64,
+    /// Index in `nodes` of the predecessor on that sequence (`u32::MAX`:
+    /// the anchor).
+    back: u32,
+    /// Whether the move from that predecessor is continuous.
+    continuous: bool,
+}
+
+/// A decided point: the configuration chosen and how it is reached.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Choice {
+    pub joints: Joints,
+    pub branch: u8,
+    /// The move into this point is continuous; `false` for a cut that needs
+    /// a retract and reconfiguration first.
+    pub continuous: bool,
+}
+
+/// The layers of the points not decided yet.
+#[derive(Debug, Clone)]
+pub struct Trellis {
+    costs: Costs,
+    lag: usize,
+    nodes: Vec<Node>,
+    /// Index in `nodes` of the first node of each layer.
+    layers: Vec<u32>,
+    /// The configuration before the first layer (the last decided point),
+    /// if any.
+    anchor: Option<(Joints, u8)>,
+}
+
+impl Trellis {
+    /// `lag`: how many points may wait before [`Trellis::is_full`] asks for a
+    /// decision (1: decide point by point).
+    pub fn new(costs: Costs, lag: usize) -> Trellis {
+        Trellis {
+            costs,
+            lag: lag.max(1),
+            nodes: Vec::new(),
+            layers: Vec::new(),
+            anchor: None,
+        }
+    }
+
+    pub fn costs(&self) -> &Costs {
+        &self.costs
+    }
+
+    /// Number of points waiting.
+    pub fn len(&self) -> usize {
+        self.layers.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.layers.is_empty()
+    }
+
+    /// Whether the caller should decide now.
+    pub fn is_full(&self) -> bool {
+        self.layers.len() >= self.lag
+    }
+
+    /// The configuration before the waiting points.
+    pub fn anchor(&self) -> Option<&Joints> {
+        self.anchor.as_ref().map(|(j, _)| j)
+    }
+
+    /// The cheapest configuration of the last waiting point, else the
+    /// anchor.
+    pub fn best_last(&self) -> Option<&Joints> {
+        match self.layers.last() {
+            Some(&first) => self.nodes[first as usize..]
+                .iter()
+                .min_by(|a, b| a.cost.total_cmp(&b.cost))
+                .map(|n| &n.joints),
+            None => self.anchor(),
+        }
+    }
+
+    /// Adds a point with its candidate configurations (invalid ones are left
+    /// out) reached from the previous point by `link`. The first point of a
+    /// program starts from home (all zero), as a free move. Returns `false`
+    /// (and adds nothing) when no candidate is valid.
+    pub fn push(&mut self, candidates: &[Solution], link: Link) -> bool {
+        if !candidates.iter().any(Solution::is_valid) {
+            return false;
+        }
+        let first = self.nodes.len() as u32;
+        let previous = self.layers.last().map(|&s| s as usize..first as usize);
+        for s in candidates.iter().filter(|s| s.is_valid()) {
+            let unary = self.costs.unary(&s.joints);
+            let mut best = (f64::INFINITY, u32::MAX, true);
+            match &previous {
+                Some(range) => {
+                    for k in range.clone() {
+                        let p = &self.nodes[k];
+                        let (c, continuous) = self
+                            .costs
+                            .transition(&p.joints, p.branch, &s.joints, s.branch, link);
+                        let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
+                        // Strictly less: ties keep the earlier candidate.
+                        if total < best.0 {
+                            best = (total, k as u32, continuous);
+                        }
+                    }
+                }
+                None => {
+                    let (from, branch, link) = match &self.anchor {
+                        Some((j, b)) => (*j, *b, link),
+                        None => ([0.0; kinpost_machine::MAX_AXES], s.branch, Link::Free),
+                    };
+                    let (c, continuous) = self
+                        .costs
+                        .transition(&from, branch, &s.joints, s.branch, link);
+                    best = (
+                        c + if continuous { 0.0 } else { RECONFIGURE },
+                        u32::MAX,
+                        continuous,
+                    );
+                }
+            }
+            self.nodes.push(Node {
+                joints: s.joints,
+                branch: s.branch,
+                cost: best.0 + unary,
+                back: best.1,
+                continuous: best.2,
+            });
+        }
+        self.layers.push(first);
+        true
+    }
+
+    /// Decides every waiting point: the cheapest sequence, in path order,
+    /// appended to `out`. The last choice becomes the anchor of what follows.
+    pub fn decide(&mut self, out: &mut Vec<Choice>) {
+        let Some(&last) = self.layers.last() else {
+            return;
+        };
+        let mut best = last as usize;
+        for k in last as usize..self.nodes.len() {
+            if self.nodes[k].cost < self.nodes[best].cost {
+                best = k;
+            }
+        }
+        let start = out.len();
+        let mut k = best as u32;
+        while k != u32::MAX {
+            let n = &self.nodes[k as usize];
+            out.push(Choice {
+                joints: n.joints,
+                branch: n.branch,
+                continuous: n.continuous,
+            });
+            k = n.back;
+        }
+        out[start..].reverse();
+        debug_assert_eq!(out.len() - start, self.layers.len());
+        let n = &self.nodes[best];
+        self.anchor = Some((n.joints, n.branch));
+        self.nodes.clear();
+        self.layers.clear();
+    }
+
+    /// Sets the configuration the machine is in (e.g. after points decided
+    /// outside the trellis).
+    pub fn set_anchor(&mut self, joints: Joints, branch: u8) {
+        self.anchor = Some((joints, branch));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinpost_machine::{MAX_AXES, Machine, builtin};
+
+    fn sol(a: f64, c: f64, branch: u8) -> Solution {
+        let mut joints = [0.0; MAX_AXES];
+        joints[3] = a;
+        joints[4] = c;
+        Solution {
+            joints,
+            branch,
+            singular: false,
+            violation: None,
+        }
+    }
+
+    fn machine() -> Machine {
+        builtin::load("trunnion-ac").unwrap().unwrap()
+    }
+
+    fn cut(turn_deg: f64) -> Link {
+        Link::Cut {
+            turn_deg,
+            across_singular: false,
+        }
+    }
+
+    #[test]
+    fn the_whole_path_decides_the_first_choice() {
+        // Point by point, the first point takes A = 10 (nearest zero); but
+        // only the A = -10 family stays continuous up to the end, where
+        // A = +40 is not offered.
+        let m = machine();
+        let path: Vec<Vec<Solution>> = vec![
+            vec![sol(10.0, 0.0, 0), sol(-12.0, 180.0, 1)],
+            vec![sol(20.0, 0.0, 0), sol(-20.0, 180.0, 1)],
+            vec![sol(-40.0, 180.0, 1)],
+        ];
+        let mut global = Trellis::new(Costs::new(&m, 0.5, Some(4)), 100);
+        let mut greedy = Trellis::new(Costs::new(&m, 0.5, Some(4)), 1);
+        let (mut g, mut p) = (Vec::new(), Vec::new());
+        for (i, layer) in path.iter().enumerate() {
+            let link = if i == 0 { Link::Free } else { cut(10.0) };
+            assert!(global.push(layer, link));
+            assert!(greedy.push(layer, link));
+            if greedy.is_full() {
+                greedy.decide(&mut p);
+            }
+        }
+        global.decide(&mut g);
+        let a: Vec<f64> = g.iter().map(|c| c.joints[3]).collect();
+        assert_eq!(a, [-12.0, -20.0, -40.0]);
+        assert!(g.iter().all(|c| c.continuous));
+        let a: Vec<f64> = p.iter().map(|c| c.joints[3]).collect();
+        assert_eq!(a, [10.0, 20.0, -40.0]);
+        assert!(!p[2].continuous, "point by point needs a reconfiguration");
+    }
+
+    #[test]
+    fn no_valid_candidate_is_refused() {
+        let m = machine();
+        let mut t = Trellis::new(Costs::new(&m, 0.5, None), 10);
+        let mut bad = sol(0.0, 0.0, 0);
+        bad.violation = Some(kinpost_machine::Violation {
+            axis: 3,
+            value: 200.0,
+        });
+        assert!(!t.push(&[bad], Link::Free));
+        assert!(t.is_empty());
+    }
+
+    #[test]
+    fn a_forced_flip_is_reported_once() {
+        let m = machine();
+        let mut t = Trellis::new(Costs::new(&m, 0.5, Some(4)), 10);
+        t.push(&[sol(5.0, 0.0, 0)], Link::Free);
+        t.push(&[sol(5.0, 0.0, 0)], cut(0.0));
+        t.push(&[sol(-5.0, 180.0, 1)], cut(0.1));
+        t.push(&[sol(-5.2, 180.0, 1)], cut(0.2));
+        let mut out = Vec::new();
+        t.decide(&mut out);
+        let flags: Vec<bool> = out.iter().map(|c| c.continuous).collect();
+        assert_eq!(flags, [true, true, false, true]);
+        assert_eq!(t.anchor().unwrap()[3], -5.2);
+    }
+}
