@@ -16,19 +16,26 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("post");
     group.sample_size(10);
     group.throughput(Throughput::Elements(points as u64));
-    group.bench_function("mts1600_sinumerik_1M_points", |b| {
-        b.iter(|| {
-            let summary = post(
-                cl.as_bytes(),
-                &machine,
-                &dialect,
-                std::io::sink(),
-                &PostOptions::default(),
-            )
-            .unwrap();
-            assert_eq!(summary.cl_points, points as u64);
-        })
-    });
+    // Default: whole-path planning and linearization on. The point-by-point
+    // run without linearization is the foundation's pipeline (issue 4: the
+    // planned run stays within 2× of it).
+    let point_by_point = PostOptions {
+        planner: kinpost::PlannerMode::Nearest,
+        lintol_mm: Some(0.0),
+        ..PostOptions::default()
+    };
+    for (name, options) in [
+        ("mts1600_sinumerik_1M_points", PostOptions::default()),
+        ("mts1600_sinumerik_1M_points_point_by_point", point_by_point),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let summary =
+                    post(cl.as_bytes(), &machine, &dialect, std::io::sink(), &options).unwrap();
+                assert_eq!(summary.cl_points, points as u64);
+            })
+        });
+    }
     group.finish();
 }
 

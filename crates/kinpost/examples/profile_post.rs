@@ -1,6 +1,8 @@
 //! Posts a generated CL file of N points (default 1,000,000) on mts1600 to
 //! sinumerik into a sink, for profilers (`perf record`, callgrind); the
 //! criterion benchmark `benches/post.rs` is the measurement of record.
+//! A second argument `point-by-point` turns whole-path planning and
+//! linearization off.
 
 #[path = "../benches/cl_gen.rs"]
 mod cl_gen;
@@ -10,20 +12,23 @@ fn main() {
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(1_000_000);
+    let options = match std::env::args().nth(2).as_deref() {
+        Some("point-by-point") => kinpost::PostOptions {
+            planner: kinpost::PlannerMode::Nearest,
+            lintol_mm: Some(0.0),
+            ..Default::default()
+        },
+        _ => kinpost::PostOptions::default(),
+    };
     let cl = cl_gen::generate_cl(points);
     let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
     let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
-    let summary = kinpost::post(
-        cl.as_bytes(),
-        &machine,
-        &dialect,
-        std::io::sink(),
-        &kinpost::PostOptions::default(),
-    )
-    .unwrap();
+    let summary =
+        kinpost::post(cl.as_bytes(), &machine, &dialect, std::io::sink(), &options).unwrap();
     eprintln!(
-        "{} points in {:.3} s: {:.2} M points/s",
+        "{} points, {} blocks in {:.3} s: {:.2} M points/s",
         summary.cl_points,
+        summary.blocks,
         summary.seconds,
         summary.cl_points as f64 / summary.seconds / 1e6
     );
