@@ -367,7 +367,7 @@ proptest! {
             return Err(TestCaseError::reject("degenerate"));
         }
         let kin = Kinematics::new(&m);
-        let mut q: Vec<f64> = (0..5).map(|i| if m.axes[i].is_rotary() { rng.range(-50.0, 50.0) } else { rng.range(-50.0, 50.0) }).collect();
+        let mut q: Vec<f64> = (0..5).map(|_| rng.range(-50.0, 50.0)).collect();
         let mut cl = String::from("FEDRAT/MMPM,600\n");
         for _ in 0..25 {
             for (i, v) in q.iter_mut().enumerate() {
