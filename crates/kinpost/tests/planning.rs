@@ -410,3 +410,87 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
+    // The trunnion with C limited to 3600°/min; a pass that turns C fast.
+    let source = builtin::source("trunnion-ac").unwrap().replace(
+        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+        "point = [0, 0, 0]\nmax_velocity = 3600",
+    );
+    let m = machine_from_toml(&source, "slow-c.toml").unwrap();
+    let ic = m.axis_index("C").unwrap();
+    let mut cl = String::from("FEDRAT/MMPM,1000\nRAPID\n");
+    let tilt = 30f64.to_radians();
+    for k in 0..=10 {
+        // 10 mm per point at 1000 mm/min: 0.01 min; C turns 9° per point
+        // (900°/min), then 45° per point (4500°/min > 3600).
+        let phi = if k <= 5 {
+            9.0 * k as f64
+        } else {
+            45.0 + 45.0 * (k - 5) as f64
+        };
+        let phi = phi.to_radians();
+        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
+        cl.push_str(&goto(&Vector3::new(10.0 * k as f64, 0.0, 0.0), &axis));
+    }
+    let options = |mode| PostOptions {
+        feed_mode: Some(mode),
+        lintol_mm: Some(0.0),
+        ..Default::default()
+    };
+    let (csv, summary) = post_csv(&m, &cl, &options(kinpost::FeedMode::InverseTime)).unwrap();
+    let clamps = &summary.planning.feed_clamps;
+    assert_eq!(summary.planning.feed_clamp_count, 5, "{clamps:?}");
+    assert!(
+        clamps
+            .iter()
+            .all(|c| c.axis == "C" && c.written_min > c.programmed_min)
+    );
+    let all = rows(&csv, m.axes.len());
+    let feed_col = |csv: &str| -> Vec<f64> {
+        csv.lines()
+            .skip(1)
+            .map(|r| r.rsplit(',').next().unwrap().parse().unwrap_or(f64::NAN))
+            .collect()
+    };
+    let f = feed_col(&csv);
+    for k in 2..all.len() {
+        let dc = (all[k].2[ic] - all[k - 1].2[ic]).abs();
+        let time = 1.0 / f[k];
+        // Never faster than the CL asks (0.01 min) nor than C allows.
+        assert!(time >= 0.01 * (1.0 - 1e-5), "row {k}: {time}");
+        assert!(
+            time >= dc / 3600.0 * (1.0 - 1e-5),
+            "row {k}: C at {} °/min",
+            dc / time
+        );
+        // And no slower than needed.
+        let want = f64::max(0.01, dc / 3600.0);
+        assert!(
+            (time - want).abs() <= 1e-5 * want + 1e-7,
+            "row {k}: {time} vs {want}"
+        );
+    }
+    // dpm: F is the length of the change of all axes over the same time.
+    let (csv, _) = post_csv(&m, &cl, &options(kinpost::FeedMode::Dpm)).unwrap();
+    let all = rows(&csv, m.axes.len());
+    let f = feed_col(&csv);
+    for k in 2..all.len() {
+        let d: f64 = all[k]
+            .2
+            .iter()
+            .zip(&all[k - 1].2)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let dc = (all[k].2[ic] - all[k - 1].2[ic]).abs();
+        let want = f64::max(0.01, dc / 3600.0);
+        // The csv values are rounded to 6 decimals; F too.
+        assert!(
+            (d / f[k] - want).abs() <= 1e-4 * want,
+            "row {k}: {} vs {want}",
+            d / f[k]
+        );
+    }
+}
