@@ -7,7 +7,7 @@
 
 use std::collections::BTreeMap;
 
-use kinpost_diag::{Diagnostic, Diagnostics};
+pub use kinpost_diag::{Diagnostic, Diagnostics};
 
 /// An m × n grid of points, row-major (`points[i * cols + j]`): rows run
 /// along the surface's u direction, columns along v.
