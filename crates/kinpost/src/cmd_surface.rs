@@ -355,12 +355,17 @@ fn eval(args: EvalArgs) -> Result<()> {
             )),
             Err(_) => {
                 degenerate += 1;
-                out.push_str(&format!("{u},{v},{},{},{},nan,nan,nan,nan,nan\n", p.x, p.y, p.z));
+                out.push_str(&format!(
+                    "{u},{v},{},{},{},nan,nan,nan,nan,nan\n",
+                    p.x, p.y, p.z
+                ));
             }
         }
     }
     if degenerate > 0 {
-        eprintln!("warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan");
+        eprintln!(
+            "warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan"
+        );
     }
     match &args.output_file {
         Some(path) => write_atomically(path, out.as_bytes())
@@ -375,9 +380,11 @@ fn eval(args: EvalArgs) -> Result<()> {
 
 fn plot(args: PlotArgs) -> Result<()> {
     let surface = load_surface(&args.surface)?;
-    let title = args
-        .title
-        .unwrap_or_else(|| args.surface.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()));
+    let title = args.title.unwrap_or_else(|| {
+        args.surface
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    });
     let svg = plot_surface(
         &surface,
         args.curvature.map(|c| match c {
@@ -386,7 +393,8 @@ fn plot(args: PlotArgs) -> Result<()> {
         }),
         &title,
     );
-    write_atomically(&args.svg, svg.as_bytes()).with_context(|| format!("cannot write {}", args.svg.display()))
+    write_atomically(&args.svg, svg.as_bytes())
+        .with_context(|| format!("cannot write {}", args.svg.display()))
 }
 
 /// `wheel:radius=R,width=W`.
@@ -396,9 +404,17 @@ fn parse_wheel(text: &str) -> Result<Wheel> {
     let (mut radius, mut width) = (None, None);
     for part in rest.split(',') {
         let (k, v) = part.split_once('=').ok_or_else(usage)?;
-        let v: f64 = v.trim().parse().ok().filter(|v: &f64| v.is_finite() && *v > 0.0).ok_or_else(|| {
-            anyhow!("--tool `{text}`: `{}` must be a positive number of mm", part.trim())
-        })?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| {
+                anyhow!(
+                    "--tool `{text}`: `{}` must be a positive number of mm",
+                    part.trim()
+                )
+            })?;
         match k.trim() {
             "radius" | "r" => radius = Some(v),
             "width" | "w" => width = Some(v),
@@ -468,7 +484,9 @@ pub fn path(args: PathArgs) -> Result<()> {
                 .parse()
                 .ok()
                 .filter(|v: &f64| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| anyhow!("--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0"))?;
+                .ok_or_else(|| {
+                    anyhow!("--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0")
+                })?;
             let word = word.trim();
             if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric()) {
                 bail!("--pressure `{p}`: the word is letters and digits, e.g. H1");
@@ -494,12 +512,13 @@ pub fn path(args: PathArgs) -> Result<()> {
         region,
         placement: placement(&args.rotate, args.translate.as_deref())?,
     };
-    let toolpath = plan(&surface, &options).map_err(|e| anyhow!("{}: {e}", args.surface.display()))?;
+    let toolpath =
+        plan(&surface, &options).map_err(|e| anyhow!("{}: {e}", args.surface.display()))?;
     let r = &toolpath.report;
-    let stem = args
-        .surface
-        .file_stem()
-        .map_or_else(|| "GRIND".to_string(), |s| s.to_string_lossy().to_uppercase());
+    let stem = args.surface.file_stem().map_or_else(
+        || "GRIND".to_string(),
+        |s| s.to_string_lossy().to_uppercase(),
+    );
     let limit = match spacing {
         Spacing::Scallop(h) => format!(" (limit {h})"),
         _ => String::new(),
@@ -530,9 +549,11 @@ pub fn path(args: PathArgs) -> Result<()> {
     };
     match &args.output_file {
         Some(path) => {
-            let mut f = AtomicFile::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+            let mut f = AtomicFile::create(path)
+                .with_context(|| format!("cannot create {}", path.display()))?;
             write_cl(&toolpath, &options, &cl, &mut f)?;
-            f.commit().with_context(|| format!("cannot write {}", path.display()))?;
+            f.commit()
+                .with_context(|| format!("cannot write {}", path.display()))?;
         }
         None => {
             let mut buffer = Vec::new();
@@ -544,8 +565,11 @@ pub fn path(args: PathArgs) -> Result<()> {
     }
     if let Some(svg) = &args.svg {
         let title = format!("{}: grinding path", args.surface.display());
-        write_atomically(svg, plot_path(&surface, &toolpath, &options, &title).as_bytes())
-            .with_context(|| format!("cannot write {}", svg.display()))?;
+        write_atomically(
+            svg,
+            plot_path(&surface, &toolpath, &options, &title).as_bytes(),
+        )
+        .with_context(|| format!("cannot write {}", svg.display()))?;
     }
     if let Some(json) = &args.json {
         let report = serde_json::json!({
@@ -565,12 +589,17 @@ pub fn path(args: PathArgs) -> Result<()> {
             })).collect::<Vec<_>>(),
         });
         let text = serde_json::to_string_pretty(&report).expect("plain data") + "\n";
-        write_atomically(json, text.as_bytes()).with_context(|| format!("cannot write {}", json.display()))?;
+        write_atomically(json, text.as_bytes())
+            .with_context(|| format!("cannot write {}", json.display()))?;
     }
     eprintln!(
         "{} passes along {}, {} CL points, {:.1} mm of feed moves; step-over {:.4}–{:.4} mm; scallop max {:.5} mm{limit}; wheel-edge interference max {:.5} mm; chord error max {:.5} mm (tolerance {})",
         r.passes,
-        if options.direction == Direction::U { "u" } else { "v" },
+        if options.direction == Direction::U {
+            "u"
+        } else {
+            "v"
+        },
         r.points,
         r.length_mm,
         r.stepover_min,

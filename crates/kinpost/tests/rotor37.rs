@@ -47,7 +47,10 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
         &p("s.json"),
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("13 × 34 points → 15 × 36 control points"), "{err}");
+    assert!(
+        err.contains("13 × 34 points → 15 × 36 control points"),
+        "{err}"
+    );
     kinpost(&[
         "path",
         &p("s.json"),
@@ -117,8 +120,12 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let c = header.iter().position(|h| *h == "C").unwrap();
-    let cs: Vec<f64> = lines.map(|l| l.split(',').nth(c).unwrap().parse().unwrap()).collect();
-    let (lo, hi) = cs.iter().fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+    let cs: Vec<f64> = lines
+        .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+        .collect();
+    let (lo, hi) = cs
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
     assert!(hi - lo > 5.0, "C from {lo} to {hi}");
     assert_eq!(
         cs.len() as u64,

@@ -22,7 +22,8 @@ use nalgebra::{Vector3, Vector4};
 use seed002_paper::{PHI, R_S1, eq25, eq30_angles_deg, same_angle_within};
 
 fn cl_text(direction: Direction) -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/seed002/points.csv");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/seed002/points.csv");
     let grid = read_grid(&std::fs::read_to_string(&path).unwrap(), "points.csv").unwrap();
     let surface = Surface::fit(&grid, &FitOptions::default()).unwrap();
     let options = PathOptions {
@@ -57,7 +58,14 @@ fn posted_angles_are_those_of_eq_30() {
     for direction in [Direction::U, Direction::V] {
         let cl = cl_text(direction);
         let mut csv = Vec::new();
-        let summary = post(cl.as_bytes(), &machine, &dialect, &mut csv, &PostOptions::default()).unwrap();
+        let summary = post(
+            cl.as_bytes(),
+            &machine,
+            &dialect,
+            &mut csv,
+            &PostOptions::default(),
+        )
+        .unwrap();
         assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
         assert!(summary.max_position_error_mm <= summary.tolerance_mm);
         assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
@@ -76,7 +84,11 @@ fn posted_angles_are_those_of_eq_30() {
         let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
         let (cx, cy, cz, ca, cc) = (col("X"), col("Y"), col("Z"), col("A"), col("C"));
         let rows: Vec<Vec<f64>> = rows
-            .map(|r| r.split(',').map(|v| v.parse().unwrap_or(f64::NAN)).collect())
+            .map(|r| {
+                r.split(',')
+                    .map(|v| v.parse().unwrap_or(f64::NAN))
+                    .collect()
+            })
             .collect();
         assert_eq!(rows.len(), poses.len());
         assert!(rows.len() > 30);

@@ -268,13 +268,13 @@ mod tests {
                 a.set(i, i + 1, 1.0);
             }
         }
-        let x: Vec<[f64; 3]> = (0..n)
-            .map(|i| [i as f64, (i as f64).sin(), 1.0])
-            .collect();
+        let x: Vec<[f64; 3]> = (0..n).map(|i| [i as f64, (i as f64).sin(), 1.0]).collect();
         let cols: Vec<Vec<f64>> = (0..3)
             .map(|c| a.mul_vec(&x.iter().map(|v| v[c]).collect::<Vec<_>>()))
             .collect();
-        let b: Vec<[f64; 3]> = (0..n).map(|i| [cols[0][i], cols[1][i], cols[2][i]]).collect();
+        let b: Vec<[f64; 3]> = (0..n)
+            .map(|i| [cols[0][i], cols[1][i], cols[2][i]])
+            .collect();
         let mut y = b.clone();
         a.factor().unwrap().solve_in_place(&mut y);
         for (g, w) in y.iter().zip(&x) {

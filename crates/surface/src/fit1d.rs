@@ -72,7 +72,10 @@ impl std::fmt::Display for FitError {
                 "{asked} control points asked for, but only {points} data points: at most {points}"
             ),
             FitError::TooFewControlPoints { asked } => {
-                write!(f, "{asked} control points asked for: a cubic needs at least 4")
+                write!(
+                    f,
+                    "{asked} control points asked for: a cubic needs at least 4"
+                )
             }
             FitError::Singular => f.write_str("the fitting equations are singular"),
         }
@@ -90,10 +93,16 @@ pub struct Fit1d {
 
 #[derive(Debug, Clone)]
 enum Kind {
-    Interpolation { ends: Ends, lu: BandLu },
+    Interpolation {
+        ends: Ends,
+        lu: BandLu,
+    },
     /// Normal equations `AᵀA x = Aᵀ d`, factorised; `rows[i]` is the span
     /// and the four basis values of data parameter `i`.
-    Approximation { lu: BandLu, rows: Vec<(usize, [f64; 4])> },
+    Approximation {
+        lu: BandLu,
+        rows: Vec<(usize, [f64; 4])>,
+    },
 }
 
 fn check_params(params: &[f64], need: usize) -> Result<(), FitError> {
@@ -307,7 +316,10 @@ fn set_in_band(a: &mut BandMatrix, row: usize, col: usize, value: f64) {
     if inside {
         a.set(row, col, value);
     } else {
-        debug_assert!(value.abs() < 1e-9, "({row}, {col}) = {value} outside the band");
+        debug_assert!(
+            value.abs() < 1e-9,
+            "({row}, {col}) = {value} outside the band"
+        );
     }
 }
 

@@ -62,11 +62,7 @@ impl LocalGeometry {
         }
         let normal = cross / len;
         let (e, f, g) = (d.du.dot(&d.du), d.du.dot(&d.dv), d.dv.dot(&d.dv));
-        let (l, m, n) = (
-            d.duu.dot(&normal),
-            d.duv.dot(&normal),
-            d.dvv.dot(&normal),
-        );
+        let (l, m, n) = (d.duu.dot(&normal), d.duv.dot(&normal), d.dvv.dot(&normal));
         let det1 = e * g - f * f;
         let gaussian = (l * n - m * m) / det1;
         let mean = (e * n - 2.0 * f * m + g * l) / (2.0 * det1);
@@ -166,7 +162,9 @@ mod tests {
         assert!((g.k1 - a).abs() < 1e-15 && (g.k2 - b).abs() < 1e-15);
         assert!(g.dir1.cross(&Vector3::x()).norm() < 1e-12);
         assert!(g.dir2.cross(&Vector3::y()).norm() < 1e-12);
-        assert!((g.normal_curvature(&d, &Vector3::new(1.0, 1.0, 0.0)) - (a + b) / 2.0).abs() < 1e-15);
+        assert!(
+            (g.normal_curvature(&d, &Vector3::new(1.0, 1.0, 0.0)) - (a + b) / 2.0).abs() < 1e-15
+        );
     }
 
     #[test]

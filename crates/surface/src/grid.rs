@@ -78,7 +78,10 @@ fn char_column(line: &str, byte: usize) -> usize {
 fn split_csv(line: &str) -> Vec<Field<'_>> {
     let mut out = Vec::new();
     let mut start = 0;
-    for (k, c) in line.char_indices().chain(std::iter::once((line.len(), ','))) {
+    for (k, c) in line
+        .char_indices()
+        .chain(std::iter::once((line.len(), ',')))
+    {
         if c == ',' {
             let raw = &line[start..k];
             let lead = raw.len() - raw.trim_start().len();
@@ -95,7 +98,10 @@ fn split_csv(line: &str) -> Vec<Field<'_>> {
 fn split_ws(line: &str) -> Vec<Field<'_>> {
     let mut out = Vec::new();
     let mut start: Option<usize> = None;
-    for (k, c) in line.char_indices().chain(std::iter::once((line.len(), ' '))) {
+    for (k, c) in line
+        .char_indices()
+        .chain(std::iter::once((line.len(), ' ')))
+    {
         if c.is_whitespace() {
             if let Some(s) = start.take() {
                 out.push(Field {
@@ -141,9 +147,17 @@ impl Ctx<'_> {
     fn number(&self, line: &Line, field: Field, what: &str) -> Result<f64, Diagnostic> {
         match field.text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            Ok(_) => Err(self.at(line, field, format!("{what} `{}` is not finite", field.text))),
+            Ok(_) => Err(self.at(
+                line,
+                field,
+                format!("{what} `{}` is not finite", field.text),
+            )),
             Err(_) if field.text.is_empty() => Err(self.at(line, field, format!("{what} missing"))),
-            Err(_) => Err(self.at(line, field, format!("{what} `{}` is not a number", field.text))),
+            Err(_) => Err(self.at(
+                line,
+                field,
+                format!("{what} `{}` is not a number", field.text),
+            )),
         }
     }
 
@@ -157,7 +171,10 @@ impl Ctx<'_> {
                 self.at(
                     line,
                     field,
-                    format!("{what} `{}` is not a whole number from 0 to 1000000", field.text),
+                    format!(
+                        "{what} `{}` is not a whole number from 0 to 1000000",
+                        field.text
+                    ),
                 )
             })
     }
@@ -199,12 +216,17 @@ fn read_csv(text: &str, file: &str) -> Result<Grid, Diagnostics> {
             continue;
         }
         let fields = split_csv(line.text);
-        if !header_seen && points.is_empty() && fields.iter().any(|f| f.text.parse::<f64>().is_err())
+        if !header_seen
+            && points.is_empty()
+            && fields.iter().any(|f| f.text.parse::<f64>().is_err())
         {
             header_seen = true;
             let names = ["row", "col", "x", "y", "z"];
             for (slot, name) in columns.iter_mut().zip(names) {
-                match fields.iter().position(|f| f.text.eq_ignore_ascii_case(name)) {
+                match fields
+                    .iter()
+                    .position(|f| f.text.eq_ignore_ascii_case(name))
+                {
                     Some(k) => *slot = k,
                     None => {
                         errors.push(ctx.line(
@@ -375,8 +397,14 @@ fn assemble(points: Vec<Indexed>, file: &str) -> Result<Grid, Diagnostics> {
             .filter(|(_, s)| s.is_none())
             .take(5)
             .map(|(k, _)| {
-                let r = rows.iter().find(|(_, v)| **v == k / n).map_or(0, |(r, _)| *r);
-                let c = cols.iter().find(|(_, v)| **v == k % n).map_or(0, |(c, _)| *c);
+                let r = rows
+                    .iter()
+                    .find(|(_, v)| **v == k / n)
+                    .map_or(0, |(r, _)| *r);
+                let c = cols
+                    .iter()
+                    .find(|(_, v)| **v == k % n)
+                    .map_or(0, |(c, _)| *c);
                 format!("row {r} col {c}")
             })
             .collect();
@@ -391,7 +419,11 @@ fn assemble(points: Vec<Indexed>, file: &str) -> Result<Grid, Diagnostics> {
                 "the points do not fill a {m} × {n} grid: {} missing ({}{}) by the end of the file",
                 m * n - points.len(),
                 missing.join(", "),
-                if m * n - points.len() > 5 { ", …" } else { "" }
+                if m * n - points.len() > 5 {
+                    ", …"
+                } else {
+                    ""
+                }
             ),
         ));
     }
@@ -436,7 +468,9 @@ pub fn read_blade_table(text: &str, file: &str, side: BladeSide) -> Result<Grid,
     let mut errors = Vec::new();
     for line in lines(text) {
         let fields = split_ws(line.text);
-        let Some(first) = fields.first() else { continue };
+        let Some(first) = fields.first() else {
+            continue;
+        };
         if first.text.eq_ignore_ascii_case("SURFACE") {
             surfaces.push((Vec::new(), Vec::new(), line.number));
             continue;
@@ -548,7 +582,13 @@ mod tests {
         let e = read_grid("row,col,x,y,z\n0,0,1,2,3\n0,0,1,2,3\n", "g.csv").unwrap_err();
         assert!(e.0[0].message.contains("again (first on line 2)"));
         let e = read_grid("0,0,1,2,3\n1,1,1,2,3\n", "g.csv").unwrap_err();
-        assert!(e.0[0].message.contains("2 missing (row 0 col 1, row 1 col 0)"), "{}", e);
+        assert!(
+            e.0[0]
+                .message
+                .contains("2 missing (row 0 col 1, row 1 col 0)"),
+            "{}",
+            e
+        );
         let e = read_grid("row,col,x,y\n", "g.csv").unwrap_err();
         assert!(e.0[0].message.contains("no `z` column"));
     }
@@ -561,7 +601,10 @@ mod tests {
         let g = read_grid("1 0 0 0 5\n0 0 1 2 3\n0 1 0 0 0\n1 1 0 0 0\n", "t.txt").unwrap();
         assert_eq!(g.at(0, 0), [1.0, 2.0, 3.0]);
         let e = read_grid("0 0 0\n1 0\n", "t.txt").unwrap_err();
-        assert_eq!((e.0[0].line, e.0[0].message.as_str()), (2, "2 values, but line 1 has 3"));
+        assert_eq!(
+            (e.0[0].line, e.0[0].message.as_str()),
+            (2, "2 values, but line 1 has 3")
+        );
     }
 
     #[test]
@@ -571,7 +614,10 @@ mod tests {
         assert_eq!((g.rows, g.cols), (2, 2));
         assert_eq!(g.at(0, 0), [100.0, 0.0, 10.0]);
         let p = g.at(1, 1);
-        assert!((p[0] - 200.0 * 0.1f64.cos()).abs() < 1e-12 && (p[1] - 200.0 * 0.1f64.sin()).abs() < 1e-12);
+        assert!(
+            (p[0] - 200.0 * 0.1f64.cos()).abs() < 1e-12
+                && (p[1] - 200.0 * 0.1f64.sin()).abs() < 1e-12
+        );
         let bad = text.replace("2   2.0  20.0", "2   2.0  2O.0");
         let e = read_blade_table(&bad, "b.dat", BladeSide::Theta2).unwrap_err();
         assert_eq!(e.0[0].line, 11);

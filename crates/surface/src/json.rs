@@ -86,7 +86,9 @@ fn points(out: &mut String, pts: &[[f64; 3]], indent: &str) {
 pub fn to_json(s: &Surface) -> String {
     let mut o = String::with_capacity(128 + 80 * s.control.len());
     o.push_str("{\n");
-    o.push_str(&format!("  \"format\": \"{FORMAT}\",\n  \"version\": {VERSION},\n"));
+    o.push_str(&format!(
+        "  \"format\": \"{FORMAT}\",\n  \"version\": {VERSION},\n"
+    ));
     o.push_str("  \"degree\": [3, 3],\n");
     if let Some(m) = s.method {
         let (fit, ends) = match m {
@@ -163,7 +165,14 @@ pub fn from_json(src: &str, file: &str) -> Result<Surface, Diagnostic> {
             .rsplit_once(" at line ")
             .map_or(msg.as_str(), |(m, _)| m)
             .to_string();
-        Diagnostic::error(file, line, column, 1, text, format!("invalid surface file: {msg}"))
+        Diagnostic::error(
+            file,
+            line,
+            column,
+            1,
+            text,
+            format!("invalid surface file: {msg}"),
+        )
     })?;
     if f.format != FORMAT {
         return Err(at_key(
@@ -178,7 +187,10 @@ pub fn from_json(src: &str, file: &str) -> Result<Surface, Diagnostic> {
             src,
             file,
             "version",
-            format!("version {} is not supported (this kinpost reads {VERSION})", f.version),
+            format!(
+                "version {} is not supported (this kinpost reads {VERSION})",
+                f.version
+            ),
         ));
     }
     if f.degree != [3, 3] {
@@ -186,20 +198,33 @@ pub fn from_json(src: &str, file: &str) -> Result<Surface, Diagnostic> {
             src,
             file,
             "degree",
-            format!("degree {:?}: only cubic surfaces ([3, 3]) are supported", f.degree),
+            format!(
+                "degree {:?}: only cubic surfaces ([3, 3]) are supported",
+                f.degree
+            ),
         ));
     }
     let method = match (f.fit, f.ends) {
         (Some(FitKind::Interpolation), Some(e)) => Some(Method::Interpolation(e)),
         (Some(FitKind::Interpolation), None) => {
-            return Err(at_key(src, file, "fit", "an interpolation needs `ends`".into()));
+            return Err(at_key(
+                src,
+                file,
+                "fit",
+                "an interpolation needs `ends`".into(),
+            ));
         }
         (Some(FitKind::Approximation), None) => Some(Method::Approximation {
             rows: f.control_net[0],
             cols: f.control_net[1],
         }),
         (Some(FitKind::Approximation), Some(_)) => {
-            return Err(at_key(src, file, "ends", "an approximation has no `ends`".into()));
+            return Err(at_key(
+                src,
+                file,
+                "ends",
+                "an approximation has no `ends`".into(),
+            ));
         }
         (None, Some(_)) => return Err(at_key(src, file, "ends", "`ends` without `fit`".into())),
         (None, None) => None,

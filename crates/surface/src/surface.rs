@@ -162,7 +162,7 @@ impl Surface {
         let (m, n) = (grid.rows, grid.cols);
         let at = |i: usize, j: usize| grid.points[i * n + j];
         let pu = params_for(n, m, |line, k| at(k, line), options.parameterisation);
-        let pv = params_for(m, n, |line, k| at(line, k), options.parameterisation);
+        let pv = params_for(m, n, at, options.parameterisation);
         let err_u = |error| SurfaceFitError {
             direction: U_DIRECTION,
             error,
@@ -269,7 +269,9 @@ impl Surface {
             if !(knots[DEGREE] < knots[n]) {
                 return Err(format!("{name} give an empty parameter domain"));
             }
-            if let Some(k) = (0..knots.len() - DEGREE - 1).find(|&k| knots[k] == knots[k + DEGREE + 1]) {
+            if let Some(k) =
+                (0..knots.len() - DEGREE - 1).find(|&k| knots[k] == knots[k + DEGREE + 1])
+            {
                 return Err(format!(
                     "{name}: knot {} repeats more than {} times",
                     knots[k],

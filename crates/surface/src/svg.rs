@@ -60,7 +60,8 @@ impl Projection {
         let depth = (n * tilt.cos() - t2 * tilt.sin()).normalize();
         let x = (t1 - depth * t1.dot(&depth)).normalize();
         let y = depth.cross(&x);
-        let centre = points.iter().fold(Vector3::zeros(), |a, p| a + p) / points.len().max(1) as f64;
+        let centre =
+            points.iter().fold(Vector3::zeros(), |a, p| a + p) / points.len().max(1) as f64;
         let mut p = Projection {
             centre,
             x,
@@ -92,7 +93,10 @@ impl Projection {
     /// Screen position (SVG y grows downwards).
     pub fn screen(&self, q: &Vector3<f64>) -> (f64, f64) {
         let (a, b) = self.raw(q);
-        (self.offset.0 + a * self.scale, self.offset.1 - b * self.scale)
+        (
+            self.offset.0 + a * self.scale,
+            self.offset.1 - b * self.scale,
+        )
     }
 
     /// Distance towards the viewer.
@@ -223,7 +227,11 @@ pub fn diverging(t: f64) -> [f64; 3] {
     const MID: [f64; 3] = [0.865, 0.865, 0.865];
     const WARM: [f64; 3] = [0.706, 0.016, 0.150];
     let t = if t.is_nan() { 0.0 } else { t.clamp(-1.0, 1.0) };
-    let (a, b, s) = if t < 0.0 { (MID, COOL, -t) } else { (MID, WARM, t) };
+    let (a, b, s) = if t < 0.0 {
+        (MID, COOL, -t)
+    } else {
+        (MID, WARM, t)
+    };
     [
         a[0] + (b[0] - a[0]) * s,
         a[1] + (b[1] - a[1]) * s,
@@ -338,7 +346,11 @@ fn robust_range(values: impl Iterator<Item = f64>) -> f64 {
     }
     a.sort_by(f64::total_cmp);
     let r = a[((a.len() - 1) as f64 * 0.98).round() as usize];
-    if r > 0.0 { r } else { a[a.len() - 1].max(1e-300) }
+    if r > 0.0 {
+        r
+    } else {
+        a[a.len() - 1].max(1e-300)
+    }
 }
 
 /// The whole picture of a surface: shaded mesh (coloured by `curvature`

@@ -70,7 +70,7 @@ fn sample_points() -> Vec<(f64, f64)> {
     let mut uv = vec![(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0), (0.25, 0.5)];
     let mut x = 0.123_456_789f64;
     for _ in 0..60 {
-        x = (x * 7.3 + 0.318).fract();
+        x = (x * 7.3 + 0.327).fract();
         let u = x;
         x = (x * 5.7 + 0.571).fract();
         uv.push((u, x));

@@ -47,14 +47,25 @@ fn seed002_surface_passes_through_all_35_points() {
     // Natural ends: no second derivative across the boundary, all along it.
     for k in 0..=20 {
         let t = k as f64 / 20.0;
-        for (u, v, along_u) in [(0.0, t, true), (1.0, t, true), (t, 0.0, false), (t, 1.0, false)] {
+        for (u, v, along_u) in [
+            (0.0, t, true),
+            (1.0, t, true),
+            (t, 0.0, false),
+            (t, 1.0, false),
+        ] {
             let d = s.derivatives(u, v);
             let second = if along_u { d.duu } else { d.dvv };
-            assert!(second.norm() < 1e-8, "second derivative {second} at ({u}, {v})");
+            assert!(
+                second.norm() < 1e-8,
+                "second derivative {second} at ({u}, {v})"
+            );
         }
     }
     // The clamped knots of seed 002: open, uniform.
-    assert_eq!(s.knots_u(), &[0.0, 0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0, 1.0]);
+    assert_eq!(
+        s.knots_u(),
+        &[0.0, 0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0, 1.0]
+    );
 }
 
 /// Cylinder of radius R about z: u the angle (30°), v the height; outward
@@ -116,7 +127,11 @@ fn sphere_curvatures_match_the_analytic_ones() {
             let outward = geo.point / geo.point.norm();
             assert!((geo.normal - outward).norm() < 1e-6);
             assert!((geo.point.norm() - r).abs() < 1e-6);
-            assert!(rel(geo.gaussian, 1.0 / (r * r)) < 1e-6, "K {}", geo.gaussian);
+            assert!(
+                rel(geo.gaussian, 1.0 / (r * r)) < 1e-6,
+                "K {}",
+                geo.gaussian
+            );
             assert!(rel(geo.mean, -1.0 / r) < 1e-6, "H {}", geo.mean);
             assert!(rel(geo.k1, -1.0 / r) < 1e-6 && rel(geo.k2, -1.0 / r) < 1e-6);
         }
@@ -164,12 +179,18 @@ fn least_squares_smooths_a_noisy_scan() {
     let r = 40.0;
     let mut seed = 12345u64;
     let mut noise = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02 // ±0.01 mm
     };
     let g = grid(120, 90, |u, v| {
         let t = u * 0.8;
-        [r * t.cos() + noise(), r * t.sin() + noise(), 30.0 * v + noise()]
+        [
+            r * t.cos() + noise(),
+            r * t.sin() + noise(),
+            30.0 * v + noise(),
+        ]
     });
     let s = Surface::fit(
         &g,
@@ -238,7 +259,10 @@ fn bad_surface_files_are_located() {
     let broken = text.replacen("\"knots_u\": [0.0,", "\"knots_u\": [0.0, 0.0,", 1);
     let d = from_json(&broken, "s.json").unwrap_err();
     assert!(d.message.contains("knots_u has 12 knots"), "{d}");
-    assert_eq!(d.source_line.trim_start().split(':').next(), Some("\"knots_u\""));
+    assert_eq!(
+        d.source_line.trim_start().split(':').next(),
+        Some("\"knots_u\"")
+    );
     assert_eq!((d.line, d.column), (8, 3));
     let d = from_json(&text.replacen("\"format\"", "\"fromat\"", 1), "s.json").unwrap_err();
     assert!(d.message.contains("unknown field `fromat`"), "{d}");

@@ -58,7 +58,12 @@ impl<W: Write> Writer<W> {
     }
 
     /// `GOTO/x,y,z,i,j,k[,u,v,w]` in the part frame.
-    fn goto(&mut self, p: &Vector3<f64>, axis: &Vector3<f64>, reference: &Vector3<f64>) -> io::Result<()> {
+    fn goto(
+        &mut self,
+        p: &Vector3<f64>,
+        axis: &Vector3<f64>,
+        reference: &Vector3<f64>,
+    ) -> io::Result<()> {
         let p = self.placement.transform_point(&Point3::from(*p)).coords;
         let a = self.placement.transform_vector(axis);
         let r = self.placement.transform_vector(reference);
@@ -119,7 +124,9 @@ pub fn write_cl<W: Write>(
         d(2.0 * wheel.radius),
         d(wheel.width)
     ))?;
-    w.text("MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000")?;
+    w.text(
+        "MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000",
+    )?;
     for c in &cl.comments {
         w.text(&format!("$$ {}", c.replace(['\n', '\r'], " ")))?;
     }
@@ -136,15 +143,26 @@ pub fn write_cl<W: Write>(
             continue;
         };
         w.text("RAPID")?;
-        w.goto(&(first.point + first.axis * options.lead), &first.axis, &first.reference)?;
+        w.goto(
+            &(first.point + first.axis * options.lead),
+            &first.axis,
+            &first.reference,
+        )?;
         if !feed_written {
-            w.text(&format!("FEDRAT/MMPM,{}", fmt(4).format(cl.feed).unwrap_or_default()))?;
+            w.text(&format!(
+                "FEDRAT/MMPM,{}",
+                fmt(4).format(cl.feed).unwrap_or_default()
+            ))?;
             feed_written = true;
         }
         for p in &pass.points {
             w.goto(&p.point, &p.axis, &p.reference)?;
         }
-        w.goto(&(last.point + last.axis * options.lead), &last.axis, &last.reference)?;
+        w.goto(
+            &(last.point + last.axis * options.lead),
+            &last.axis,
+            &last.reference,
+        )?;
     }
     w.text("END-OF-PATH")?;
     w.out.flush()

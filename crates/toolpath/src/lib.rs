@@ -28,13 +28,19 @@
 //! rapids. [`cl::write_cl`] writes the NX-style CL file, [`plot::plot_path`]
 //! an SVG of the passes.
 
+
+// `!(a < b)` on floats is deliberate here: it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Band and basis arithmetic reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 pub mod cl;
 mod path;
 pub mod plot;
 pub mod scallop;
 
+pub use kinpost_surface::Surface;
 pub use path::{
     ContactPoint, Direction, Pass, PathError, PathOptions, Report, Side, Spacing, Toolpath, Wheel,
     plan,
 };
-pub use kinpost_surface::Surface;

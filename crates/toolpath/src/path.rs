@@ -166,14 +166,26 @@ fn positive(v: f64) -> bool {
 
 impl PathOptions {
     fn validate(&self) -> Result<(), PathError> {
-        check(positive(self.wheel.radius), "the wheel radius must be a positive number of mm")?;
-        check(positive(self.wheel.width), "the wheel width must be a positive number of mm")?;
-        check(positive(self.chord_tolerance), "the chord tolerance must be a positive number of mm")?;
+        check(
+            positive(self.wheel.radius),
+            "the wheel radius must be a positive number of mm",
+        )?;
+        check(
+            positive(self.wheel.width),
+            "the wheel width must be a positive number of mm",
+        )?;
+        check(
+            positive(self.chord_tolerance),
+            "the chord tolerance must be a positive number of mm",
+        )?;
         check(
             positive(self.max_angle_deg) && self.max_angle_deg <= 90.0,
             "the largest tool-axis turn must be between 0 and 90 degrees",
         )?;
-        check(self.lead.is_finite() && self.lead >= 0.0, "the lead must be a number of mm ≥ 0")?;
+        check(
+            self.lead.is_finite() && self.lead >= 0.0,
+            "the lead must be a number of mm ≥ 0",
+        )?;
         check(
             (0.0..1.0).contains(&self.overlap),
             "the overlap must be a fraction from 0 to below 1",
@@ -186,7 +198,10 @@ impl PathOptions {
                     "the step-over is larger than the wheel width: strips between the passes would not be ground",
                 )?;
             }
-            Spacing::Scallop(h) => check(positive(h), "the scallop height must be a positive number of mm")?,
+            Spacing::Scallop(h) => check(
+                positive(h),
+                "the scallop height must be a positive number of mm",
+            )?,
             Spacing::Overlap(o) => check(
                 (0.0..1.0).contains(&o),
                 "the overlap must be a fraction from 0 to below 1",
@@ -278,7 +293,9 @@ pub fn plan(surface: &Surface, options: &PathOptions) -> Result<Toolpath, PathEr
         }
         crosses.push(lo);
         if crosses.len() > 100_000 {
-            return Err(PathError::Options("more than 100000 passes: the step-over is too small".into()));
+            return Err(PathError::Options(
+                "more than 100000 passes: the step-over is too small".into(),
+            ));
         }
     }
 
@@ -361,7 +378,14 @@ fn build(
         at.dedup();
         let mids: Vec<f64> = at.windows(2).map(|p| 0.5 * (p[0] + p[1])).collect();
         at.extend(mids);
-        gaps.push(gap(surface, wheel, &curve(w[0]), &curve(w[1]), &at, REPORT_BETWEEN));
+        gaps.push(gap(
+            surface,
+            wheel,
+            &curve(w[0]),
+            &curve(w[1]),
+            &at,
+            REPORT_BETWEEN,
+        ));
     }
     let points = passes.iter().map(|p| p.points.len()).sum();
     let length_mm = passes
@@ -458,7 +482,9 @@ fn sample_pass(
         f = if e == pc.s1 { frame(e)? } else { fe };
         out.push(s);
         if out.len() > 10_000_000 {
-            return Err(PathError::Options("more than 10 million CL points on one pass".into()));
+            return Err(PathError::Options(
+                "more than 10 million CL points on one pass".into(),
+            ));
         }
     }
     Ok((out, worst))

@@ -36,7 +36,9 @@ pub fn plot_path(surface: &Surface, path: &Toolpath, options: &PathOptions, titl
     mesh.draw(&mut o, &view, |_| [0.80, 0.80, 0.80]);
     let xy = |p: &Vector3<f64>| view.screen(p);
     // Leads and rapids.
-    o.push_str("<g fill=\"none\" stroke=\"#666666\" stroke-width=\"1\" stroke-dasharray=\"4 3\">\n");
+    o.push_str(
+        "<g fill=\"none\" stroke=\"#666666\" stroke-width=\"1\" stroke-dasharray=\"4 3\">\n",
+    );
     let mut previous: Option<Vector3<f64>> = None;
     for p in &path.passes {
         let (Some(a), Some(b)) = (p.points.first(), p.points.last()) else {

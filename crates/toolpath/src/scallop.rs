@@ -94,7 +94,12 @@ impl PassFrame {
 /// cylindrical surface, negative when `x` lies inside the wheel (then the
 /// distance back out along −n). `None` where that line misses the wheel or
 /// meets it outside its width.
-pub fn clearance(wheel: WheelShape, at: &PassFrame, x: &Vector3<f64>, n: &Vector3<f64>) -> Option<f64> {
+pub fn clearance(
+    wheel: WheelShape,
+    at: &PassFrame,
+    x: &Vector3<f64>,
+    n: &Vector3<f64>,
+) -> Option<f64> {
     let a = at.tangent().cross(&at.normal);
     let an = a.norm();
     if !(an > 1e-12) {
@@ -134,7 +139,12 @@ pub fn clearance(wheel: WheelShape, at: &PassFrame, x: &Vector3<f64>, n: &Vector
 
 /// The foot point of `x` on the pass: the parameter where x − P(s) is
 /// normal to the pass, from the start value `s`, kept inside the pass.
-pub fn foot_point(surface: &Surface, pass: &PassCurve, x: &Vector3<f64>, mut s: f64) -> Option<PassFrame> {
+pub fn foot_point(
+    surface: &Surface,
+    pass: &PassCurve,
+    x: &Vector3<f64>,
+    mut s: f64,
+) -> Option<PassFrame> {
     let mut frame = pass.frame(surface, s)?;
     for _ in 0..12 {
         let r = x - frame.point;

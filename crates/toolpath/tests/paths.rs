@@ -22,7 +22,11 @@ fn cylinder() -> Surface {
     for i in 0..m {
         for j in 0..n {
             let t = ARC * i as f64 / (m - 1) as f64;
-            points.push([RHO * t.cos(), RHO * t.sin(), 100.0 * j as f64 / (n - 1) as f64]);
+            points.push([
+                RHO * t.cos(),
+                RHO * t.sin(),
+                100.0 * j as f64 / (n - 1) as f64,
+            ]);
         }
     }
     Surface::fit(
@@ -62,8 +66,16 @@ fn scallop_on_a_cylinder_is_the_analytic_cusp() {
         let path = plan(&s, &options).unwrap();
         let r = &path.report;
         assert!(r.scallop_max <= h, "scallop {} over {h}", r.scallop_max);
-        assert!(r.scallop_max > 0.5 * h, "scallop {} far under {h}", r.scallop_max);
-        assert!(r.interference_max < 1e-6, "interference {}", r.interference_max);
+        assert!(
+            r.scallop_max > 0.5 * h,
+            "scallop {} far under {h}",
+            r.scallop_max
+        );
+        assert!(
+            r.interference_max < 1e-6,
+            "interference {}",
+            r.interference_max
+        );
         // Every gap against the analytic cusp of its own angle.
         for (k, g) in r.gaps.iter().enumerate() {
             let a = angle_of(&path.passes[k].points[0].point);
@@ -76,7 +88,11 @@ fn scallop_on_a_cylinder_is_the_analytic_cusp() {
                 g.scallop
             );
             let chord = 2.0 * RHO * half.sin();
-            assert!((g.stepover - chord).abs() < 1e-6, "{} vs {chord}", g.stepover);
+            assert!(
+                (g.stepover - chord).abs() < 1e-6,
+                "{} vs {chord}",
+                g.stepover
+            );
         }
         // The passes lie along the axis (straight): five CL points each
         // (a pass has at least four segments),
@@ -155,7 +171,11 @@ fn concave_section_reports_wheel_edge_interference() {
     // The deepest point sampled lies within the half width; the bound is
     // the sagitta of the full half width, along the normal.
     let bound = RHO - (RHO * RHO - 100.0f64).sqrt();
-    assert!(r.interference_max > 0.5 * bound && r.interference_max <= bound * 1.05, "{} vs {bound}", r.interference_max);
+    assert!(
+        r.interference_max > 0.5 * bound && r.interference_max <= bound * 1.05,
+        "{} vs {bound}",
+        r.interference_max
+    );
 }
 
 #[test]
@@ -182,7 +202,9 @@ fn cl_file_reads_back_with_leads_rapids_references_and_pressure() {
     let mut out = Vec::new();
     write_cl(&path, &options, &cl_options, &mut out).unwrap();
     let text = String::from_utf8(out).unwrap();
-    assert!(text.starts_with("TOOL PATH/CYL,TOOL,WHEEL_R50.000_W20.000\nTLDATA/MILL,100.0000,0.0000,20.0000"));
+    assert!(text.starts_with(
+        "TOOL PATH/CYL,TOOL,WHEEL_R50.000_W20.000\nTLDATA/MILL,100.0000,0.0000,20.0000"
+    ));
     assert!(text.contains("\nPRESSURE/H1,3000.000\n"));
     let mut reader = ClReader::new(text.as_bytes(), "cyl.cls");
     let mut gotos = Vec::new();
@@ -234,22 +256,28 @@ fn cl_file_reads_back_with_leads_rapids_references_and_pressure() {
 fn bad_options_are_errors() {
     let s = cylinder();
     let bad = |o: PathOptions| plan(&s, &o).unwrap_err().to_string();
-    assert!(bad(PathOptions {
-        spacing: Spacing::Stepover(30.0),
-        ..PathOptions::default()
-    })
-    .contains("larger than the wheel width"));
-    assert!(bad(PathOptions {
-        wheel: Wheel {
-            radius: -1.0,
-            width: 10.0
-        },
-        ..PathOptions::default()
-    })
-    .contains("radius"));
-    assert!(bad(PathOptions {
-        region: [0.5, 0.4, 0.0, 1.0],
-        ..PathOptions::default()
-    })
-    .contains("region"));
+    assert!(
+        bad(PathOptions {
+            spacing: Spacing::Stepover(30.0),
+            ..PathOptions::default()
+        })
+        .contains("larger than the wheel width")
+    );
+    assert!(
+        bad(PathOptions {
+            wheel: Wheel {
+                radius: -1.0,
+                width: 10.0
+            },
+            ..PathOptions::default()
+        })
+        .contains("radius")
+    );
+    assert!(
+        bad(PathOptions {
+            region: [0.5, 0.4, 0.0, 1.0],
+            ..PathOptions::default()
+        })
+        .contains("region")
+    );
 }

@@ -94,7 +94,6 @@ pub fn eq30_residual(n: &Vector3<f64>, ta: f64, tc: f64) -> f64 {
     -n.x * ta.sin() * tc.sin() - n.y * ta.cos() * tc.sin() + n.z * tc.cos()
 }
 
-
 /// Eq. 30's own angles in degrees, (θa, θc) with θc or θc + 180°, whichever
 /// gives C0 > 0 (both solve the second line), and the other orientation
 /// branch (θa + 180°, 180° − θc).
