@@ -266,14 +266,11 @@ fn read_csv(text: &str, file: &str) -> Result<Grid, Diagnostics> {
             }),
             Err(d) => errors.push(d),
         }
-        if errors.len() >= 20 {
+        if errors.len() >= MAX_ERRORS {
             break;
         }
     }
-    if !errors.is_empty() {
-        return Err(Diagnostics(errors));
-    }
-    assemble(points, file)
+    assemble(points, errors, file)
 }
 
 fn read_table(text: &str, file: &str) -> Result<Grid, Diagnostics> {
@@ -345,19 +342,27 @@ fn read_table(text: &str, file: &str) -> Result<Grid, Diagnostics> {
             }
             Err(d) => errors.push(d),
         }
-        if errors.len() >= 20 {
+        if errors.len() >= MAX_ERRORS {
             break;
         }
     }
+    assemble(points, errors, file)
+}
+
+/// Errors reported from one file at most (the first ones).
+const MAX_ERRORS: usize = 20;
+
+/// Puts indexed points on their grid, unless reading found errors: the
+/// distinct row and column indices in increasing order; every combination
+/// must be there exactly once.
+fn assemble(
+    points: Vec<Indexed>,
+    errors: Vec<Diagnostic>,
+    file: &str,
+) -> Result<Grid, Diagnostics> {
     if !errors.is_empty() {
         return Err(Diagnostics(errors));
     }
-    assemble(points, file)
-}
-
-/// Puts indexed points on their grid: the distinct row and column indices
-/// in increasing order; every combination must be there exactly once.
-fn assemble(points: Vec<Indexed>, file: &str) -> Result<Grid, Diagnostics> {
     if points.is_empty() {
         return Err(Diagnostic::error(file, 0, 0, 1, "", "no points in the file").into());
     }
@@ -515,7 +520,7 @@ pub fn read_blade_table(text: &str, file: &str, side: BladeSide) -> Result<Grid,
             }
             Err(d) => errors.push(d),
         }
-        if errors.len() >= 20 {
+        if errors.len() >= MAX_ERRORS {
             break;
         }
     }
