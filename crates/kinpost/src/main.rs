@@ -14,6 +14,8 @@ use kinpost::output::{AtomicFile, write_atomically};
 use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
+mod cmd_surface;
+
 #[derive(Parser)]
 #[command(
     name = "kinpost",
@@ -64,6 +66,11 @@ enum Command {
         #[arg(long, allow_hyphen_values = true)]
         reference: Option<String>,
     },
+    /// B-spline surfaces from measured points: fit, evaluate, plot.
+    #[command(subcommand)]
+    Surface(cmd_surface::SurfaceCommand),
+    /// Belt-grinding path on a surface, as an NX-style CL file.
+    Path(Box<cmd_surface::PathArgs>),
 }
 
 #[derive(clap::Args)]
@@ -252,6 +259,8 @@ fn run(cli: Cli) -> Result<()> {
             axis,
             reference,
         } => ik(&machine, &point, &axis, reference.as_deref()),
+        Command::Surface(c) => cmd_surface::surface(c),
+        Command::Path(a) => cmd_surface::path(*a),
     }
 }
 

@@ -83,14 +83,16 @@ fn sinumerik_writes_c_only_in_six_axis_programs() {
         five.contains("X=459.000 Y=8.700 Z366.530 B0.000 A=DC(0.000)\n"),
         "{five}"
     );
-    let six = run("RAPID\nGOTO/-416,70.5,16.53,0,0,1,0.5,0.8660254038,0\n");
+    // The reference at home is the feed direction +Y; C60 turns it to
+    // (−sin 60°, cos 60°, 0).
+    let six = run("RAPID\nGOTO/-416,70.5,16.53,0,0,1,-0.8660254038,0.5,0\n");
     assert!(six.contains("B0.000 A=DC(0.000) C60.000"), "{six}");
 }
 
 #[test]
 fn mixing_five_and_six_axis_points_is_an_error_naming_the_line() {
     // A 6-value GOTO keeps the reference of the last 9-value one (CL reader).
-    let csv = post_csv("FEDRAT/250\nGOTO/-416,70.5,16.53,0,0,1,0,1,0\nGOTO/-416,70.5,10,0,0,1\n")
+    let csv = post_csv("FEDRAT/250\nGOTO/-416,70.5,16.53,0,0,1,-1,0,0\nGOTO/-416,70.5,10,0,0,1\n")
         .unwrap();
     let c: Vec<&str> = csv
         .lines()

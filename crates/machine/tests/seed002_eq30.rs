@@ -21,97 +21,13 @@
 //! assumed values stated in `machines/ac-grinder.toml`.
 
 use kinpost_machine::{Kinematics, Pose, builtin};
-use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
+use nalgebra::{Vector3, Vector4};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-const L_X: f64 = 12.0;
-const L_Y: f64 = 40.0;
-const L_Z: f64 = 120.0;
-const R_S1: f64 = 50.0;
-const PHI: f64 = 0.0;
+mod seed002_paper;
 
-fn translation(x: f64, y: f64, z: f64) -> Matrix4<f64> {
-    Matrix4::new(
-        1.0, 0.0, 0.0, x, //
-        0.0, 1.0, 0.0, y, //
-        0.0, 0.0, 1.0, z, //
-        0.0, 0.0, 0.0, 1.0,
-    )
-}
-
-/// Eq. 18 (T2) and eq. 23 (T7): the matrix printed as
-/// [cos t, sin t; −sin t, cos t] in the xy block.
-fn about_z_printed(t: f64) -> Matrix4<f64> {
-    let (s, c) = t.sin_cos();
-    Matrix4::new(
-        c, s, 0.0, 0.0, //
-        -s, c, 0.0, 0.0, //
-        0.0, 0.0, 1.0, 0.0, //
-        0.0, 0.0, 0.0, 1.0,
-    )
-}
-
-/// Eq. 24 (T8): [cos t, −sin t; sin t, cos t] in the xy block.
-fn t8(t: f64) -> Matrix4<f64> {
-    let (s, c) = t.sin_cos();
-    Matrix4::new(
-        c, -s, 0.0, 0.0, //
-        s, c, 0.0, 0.0, //
-        0.0, 0.0, 1.0, 0.0, //
-        0.0, 0.0, 0.0, 1.0,
-    )
-}
-
-/// Eq. 22 (T6) with the angle π/2 as printed.
-fn t6() -> Matrix4<f64> {
-    let (s, c) = std::f64::consts::FRAC_PI_2.sin_cos();
-    Matrix4::new(
-        c, 0.0, s, 0.0, //
-        0.0, 1.0, 0.0, 0.0, //
-        -s, 0.0, c, 0.0, //
-        0.0, 0.0, 0.0, 1.0,
-    )
-}
-
-/// Eq. 25: the transformation from the part frame S_g to the wheel frame S_s
-/// for axis motions l_x, l_y, l_z and angles θa, θc (radians).
-fn eq25(lx: f64, ly: f64, lz: f64, ta: f64, tc: f64) -> Matrix4<f64> {
-    let t1 = translation(0.0, -L_Y, 0.0); // eq. 17
-    let t2 = about_z_printed(tc); // eq. 18
-    let t3 = translation(0.0, 0.0, -(L_Z + lz)); // eq. 19
-    let t4 = translation(L_X, 0.0, 0.0); // eq. 20
-    let t5 = translation(lx, L_Y + ly, 0.0); // eq. 21
-    let t7 = about_z_printed(std::f64::consts::PI); // eq. 23
-    t1 * t2 * t3 * t4 * t5 * t6() * t7 * t8(ta)
-}
-
-/// Eq. 26: the normal of the part in wheel coordinates.
-fn eq26(n: &Vector3<f64>, ta: f64, tc: f64) -> Vector3<f64> {
-    let m = about_z_printed(tc) * t6() * about_z_printed(std::f64::consts::PI) * t8(ta);
-    let r: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into();
-    r * n
-}
-
-/// Eq. 30, solved as printed: θa = arctan(n_x/n_y), and θc from the second
-/// line, tan θc = n_z / (n_x sin θa + n_y cos θa). Principal values,
-/// radians.
-fn eq30(n: &Vector3<f64>) -> (f64, f64) {
-    let ta = (n.x / n.y).atan();
-    let tc = (n.z / (n.x * ta.sin() + n.y * ta.cos())).atan();
-    (ta, tc)
-}
-
-/// The left side of eq. 30's second line.
-fn eq30_residual(n: &Vector3<f64>, ta: f64, tc: f64) -> f64 {
-    -n.x * ta.sin() * tc.sin() - n.y * ta.cos() * tc.sin() + n.z * tc.cos()
-}
-
-/// Whether two angles in degrees differ by a whole number of `period`s.
-fn same_angle(a: f64, b: f64, period: f64) -> bool {
-    let d = (a - b) / period;
-    (d - d.round()).abs() * period < 1e-9
-}
+use seed002_paper::{PHI, R_S1, eq25, eq26, eq30, eq30_angles_deg, eq30_residual, same_angle};
 
 /// A unit normal from two uniform numbers (uniform on the sphere), and a
 /// point near the measured points of seed 002 (Tables 1-5).
@@ -152,7 +68,7 @@ fn posting_a_normal_gives_the_angles_of_eq_30() {
             // Every solution kinpost gives (inside the travel or not: the
             // angles do not depend on it) satisfies eq. 30 and eq. 26 with
             // C0 = +1, and eq. 25 puts the CL point on the grinding point.
-            let (ta, tc) = eq30(&n);
+            let (ta, _) = eq30(&n);
             let mut pairs: Vec<(f64, f64)> = Vec::new();
             for s in &sols {
                 let j = &s.joints;
@@ -186,13 +102,7 @@ fn posting_a_normal_gives_the_angles_of_eq_30() {
             // Eq. 30's own angles (θc or θc + 180°, whichever gives C0 > 0:
             // both solve the second line) are among them, and so is the
             // other branch (θa + 180°, 180° − θc): exactly two orientations.
-            let tc = if eq26(&n, ta, tc).y < 0.0 {
-                tc
-            } else {
-                tc + std::f64::consts::PI
-            };
-            let (ta, tc) = (ta.to_degrees(), tc.to_degrees());
-            for (a, c) in [(ta, tc), (ta + 180.0, 180.0 - tc)] {
+            for (a, c) in eq30_angles_deg(&n) {
                 prop_assert!(
                     pairs
                         .iter()

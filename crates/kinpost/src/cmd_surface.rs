@@ -1,0 +1,627 @@
+//! `kinpost surface fit|eval|plot` and `kinpost path`: measured points to a
+//! B-spline surface, and a belt-grinding path on it as an NX-style CL file
+//! (issue 6, seed 002, DESIGN.md §5).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use kinpost::output::{AtomicFile, write_atomically};
+use kinpost_surface::grid::{BladeSide, Grid, read_blade_table, read_grid};
+use kinpost_surface::json::{from_json, to_json};
+use kinpost_surface::svg::{Curvature, plot_surface};
+use kinpost_surface::{Ends, FitOptions, Method, Parameterisation, Surface};
+use kinpost_toolpath::cl::{ClOptions, write_cl};
+use kinpost_toolpath::plot::plot_path;
+use kinpost_toolpath::{Direction, PathOptions, Side, Spacing, Wheel, plan};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+
+use crate::report;
+
+#[derive(clap::Subcommand)]
+pub enum SurfaceCommand {
+    /// Fit a cubic B-spline surface to a grid of points and save it as JSON;
+    /// prints the residual at the data points.
+    Fit(FitArgs),
+    /// Evaluate a surface: CSV `u,v,x,y,z,nx,ny,nz,gaussian,mean`.
+    Eval(EvalArgs),
+    /// Draw a surface as SVG (shaded, optionally coloured by curvature),
+    /// with its data points.
+    Plot(PlotArgs),
+}
+
+#[derive(clap::Args)]
+pub struct FitArgs {
+    /// Points: CSV `row,col,x,y,z`, a whitespace table (`x y z` rows
+    /// separated by blank lines, or `row col x y z`), or with --blade-side a
+    /// NASA blade table (Rotor 37 / 67: Z, R in cm, θ1, θ2 per stream surface).
+    points: PathBuf,
+    /// Output surface file (JSON).
+    #[arg(short = 'o', long = "output-file", value_name = "FILE")]
+    output_file: PathBuf,
+    /// End conditions of the interpolation.
+    #[arg(long, value_enum, default_value = "natural")]
+    ends: EndsArg,
+    /// Data parameters: uniform (DESIGN.md §5), chord-length or centripetal.
+    #[arg(long, value_enum, default_value = "uniform")]
+    params: ParamsArg,
+    /// Least-squares approximation with an NU×NV control net instead of
+    /// interpolation (for dense, noisy scans).
+    #[arg(long, value_name = "NU,NV")]
+    approx: Option<String>,
+    /// Read POINTS as a NASA blade table and take blade side 1 (THETA 1) or
+    /// 2 (THETA 2): rows are the stream surfaces (hub to tip), columns the
+    /// points from leading to trailing edge; x = 10·R·cos θ, y = 10·R·sin θ,
+    /// z = 10·Z (mm; z along the rotor axis).
+    #[arg(long, value_name = "1|2")]
+    blade_side: Option<u8>,
+    /// Keep every I-th grid row and J-th column (and the last ones): a
+    /// reduced grid over the same area.
+    #[arg(long, value_name = "I,J")]
+    every: Option<String>,
+    /// Also write the grid that was fitted as CSV `row,col,x,y,z`.
+    #[arg(long, value_name = "FILE")]
+    write_grid: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum EndsArg {
+    Natural,
+    NotAKnot,
+    ClampedTangent,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ParamsArg {
+    Uniform,
+    ChordLength,
+    Centripetal,
+}
+
+#[derive(clap::Args)]
+pub struct EvalArgs {
+    /// Surface file (JSON, from `kinpost surface fit`).
+    surface: PathBuf,
+    /// A parameter pair to evaluate (repeatable).
+    #[arg(long, value_name = "U,V", allow_hyphen_values = true)]
+    uv: Vec<String>,
+    /// An NU×NV grid of parameters over the whole domain, ends included.
+    #[arg(long, value_name = "NU,NV", conflicts_with = "uv")]
+    grid: Option<String>,
+    /// Output CSV file; default: standard output.
+    #[arg(short = 'o', long = "output-file", value_name = "FILE")]
+    output_file: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct PlotArgs {
+    /// Surface file (JSON).
+    surface: PathBuf,
+    /// Output SVG file.
+    #[arg(long, value_name = "FILE")]
+    svg: PathBuf,
+    /// Colour the surface by curvature.
+    #[arg(long, value_enum)]
+    curvature: Option<CurvatureArg>,
+    /// Title of the picture (default: the file name).
+    #[arg(long)]
+    title: Option<String>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum CurvatureArg {
+    Gaussian,
+    Mean,
+}
+
+#[derive(clap::Args)]
+pub struct PathArgs {
+    /// Surface file (JSON, from `kinpost surface fit`).
+    surface: PathBuf,
+    /// The contact wheel: `wheel:radius=R,width=W` (mm).
+    #[arg(long)]
+    tool: String,
+    /// Passes run along u (stepping across in v) or along v.
+    #[arg(long, value_enum, default_value = "u")]
+    direction: DirectionArg,
+    /// Largest distance between neighbouring passes, mm (at most the wheel
+    /// width). Default: the wheel width times (1 − overlap).
+    #[arg(long, value_name = "MM", conflicts_with = "scallop")]
+    stepover: Option<f64>,
+    /// Largest scallop height between passes, mm: the step-over is the
+    /// largest that keeps it (and at most the wheel width × (1 − overlap)).
+    #[arg(long, value_name = "MM")]
+    scallop: Option<f64>,
+    /// Fraction of the wheel width neighbouring passes share.
+    #[arg(long, default_value_t = 0.5)]
+    overlap: f64,
+    /// Largest deviation of a CL segment from the surface, mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.01)]
+    chordtol: f64,
+    /// Largest turn of the tool axis between CL points, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 2.0)]
+    max_angle: f64,
+    /// Feed rate, mm/min.
+    #[arg(long, default_value_t = 1000.0)]
+    feed: f64,
+    /// Grinding pressure written as `PRESSURE/H1,value`: `VALUE` or
+    /// `WORD=VALUE` (e.g. `H1=3000`).
+    #[arg(long, value_name = "[WORD=]VALUE")]
+    pressure: Option<String>,
+    /// Wheel on the side of r_u × r_v (+) or the other (-).
+    #[arg(long, default_value = "+", allow_hyphen_values = true)]
+    side: String,
+    /// Lead-in / lead-out distance along the normal, mm.
+    #[arg(long, value_name = "MM", default_value_t = 5.0)]
+    lead: f64,
+    /// Part of the surface to grind: U0,U1,V0,V1 as fractions of the
+    /// parameter domain.
+    #[arg(long, value_name = "U0,U1,V0,V1")]
+    region: Option<String>,
+    /// Place the surface in the part frame: rotate about a part axis
+    /// through the origin, `x:DEG`, `y:DEG` or `z:DEG`; repeatable, applied
+    /// in order, before --translate.
+    #[arg(long, value_name = "AXIS:DEG", allow_hyphen_values = true)]
+    rotate: Vec<String>,
+    /// Place the surface in the part frame: translate by X,Y,Z mm (after
+    /// the rotations): a work offset for the machine's travel.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    translate: Option<String>,
+    /// Tool reference in the CL: the feed direction of the passes (nine-value
+    /// GOTOs, for 6-axis machines) or none (six values).
+    #[arg(long, value_enum, default_value = "feed")]
+    reference: ReferenceArg,
+    /// TOOL PATH name (default: the surface file's name).
+    #[arg(long)]
+    name: Option<String>,
+    /// Output CL file; default: standard output.
+    #[arg(short = 'o', long = "output-file", value_name = "FILE")]
+    output_file: Option<PathBuf>,
+    /// Also draw the passes on the surface as SVG.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
+    /// Write the path report (passes, step-over, scallop per gap, …) as JSON.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum DirectionArg {
+    U,
+    V,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ReferenceArg {
+    Feed,
+    None,
+}
+
+fn numbers(text: &str, count: usize, what: &str) -> Result<Vec<f64>> {
+    let values: Option<Vec<f64>> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect();
+    match values {
+        Some(v) if v.len() == count => Ok(v),
+        _ => bail!("{what} `{text}`: expected {count} numbers separated by commas"),
+    }
+}
+
+fn counts(text: &str, what: &str) -> Result<(usize, usize)> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    match parts.as_slice() {
+        [a, b] => match (a.parse::<usize>(), b.parse::<usize>()) {
+            (Ok(a), Ok(b)) => Ok((a, b)),
+            _ => bail!("{what} `{text}`: expected two whole numbers, e.g. 20,30"),
+        },
+        _ => bail!("{what} `{text}`: expected two whole numbers, e.g. 20,30"),
+    }
+}
+
+fn read_text(path: &Path, what: &str) -> Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {what} {}", path.display()))
+}
+
+/// Loads a surface file, with located diagnostics.
+pub fn load_surface(path: &Path) -> Result<Surface> {
+    let text = read_text(path, "surface file")?;
+    from_json(&text, &path.to_string_lossy()).map_err(report)
+}
+
+pub fn surface(command: SurfaceCommand) -> Result<()> {
+    match command {
+        SurfaceCommand::Fit(a) => fit(a),
+        SurfaceCommand::Eval(a) => eval(a),
+        SurfaceCommand::Plot(a) => plot(a),
+    }
+}
+
+fn fit(args: FitArgs) -> Result<()> {
+    let text = read_text(&args.points, "points file")?;
+    let name = args.points.to_string_lossy();
+    let grid = match args.blade_side {
+        None => read_grid(&text, &name).map_err(report)?,
+        Some(1) => read_blade_table(&text, &name, BladeSide::Theta1).map_err(report)?,
+        Some(2) => read_blade_table(&text, &name, BladeSide::Theta2).map_err(report)?,
+        Some(n) => bail!("--blade-side {n}: a blade table has sides 1 and 2"),
+    };
+    let grid = match &args.every {
+        None => grid,
+        Some(t) => {
+            let (i, j) = counts(t, "--every")?;
+            if i == 0 || j == 0 {
+                bail!("--every {t}: steps start at 1");
+            }
+            grid.reduced(i, j)
+        }
+    };
+    let method = match &args.approx {
+        None => Method::Interpolation(match args.ends {
+            EndsArg::Natural => Ends::Natural,
+            EndsArg::NotAKnot => Ends::NotAKnot,
+            EndsArg::ClampedTangent => Ends::ClampedTangent,
+        }),
+        Some(t) => {
+            let (rows, cols) = counts(t, "--approx")?;
+            Method::Approximation { rows, cols }
+        }
+    };
+    let options = FitOptions {
+        method,
+        parameterisation: match args.params {
+            ParamsArg::Uniform => Parameterisation::Uniform,
+            ParamsArg::ChordLength => Parameterisation::ChordLength,
+            ParamsArg::Centripetal => Parameterisation::Centripetal,
+        },
+    };
+    let surface = Surface::fit(&grid, &options)
+        .map_err(|e| anyhow!("{name}: {} × {} grid: {e}", grid.rows, grid.cols))?;
+    if let Some(path) = &args.write_grid {
+        write_atomically(path, grid_csv(&grid).as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    write_atomically(&args.output_file, to_json(&surface).as_bytes())
+        .with_context(|| format!("cannot write {}", args.output_file.display()))?;
+    let (rows, cols) = surface.net_size();
+    let kind = match method {
+        Method::Interpolation(e) => format!("interpolation, {} ends", e.name()),
+        Method::Approximation { .. } => "least-squares approximation".to_string(),
+    };
+    let r = surface.residual().expect("a fitted surface keeps its data");
+    eprintln!(
+        "{}: {} × {} points → {rows} × {cols} control points ({kind}, {} parameters); residual at the data points: max {:.3e} mm (row {}, col {}), rms {:.3e} mm",
+        args.output_file.display(),
+        grid.rows,
+        grid.cols,
+        options.parameterisation.name(),
+        r.max,
+        r.at.0,
+        r.at.1,
+        r.rms
+    );
+    Ok(())
+}
+
+fn grid_csv(grid: &Grid) -> String {
+    let mut o = String::from("row,col,x,y,z\n");
+    for i in 0..grid.rows {
+        for j in 0..grid.cols {
+            let p = grid.at(i, j);
+            o.push_str(&format!("{i},{j},{},{},{}\n", p[0], p[1], p[2]));
+        }
+    }
+    o
+}
+
+fn eval(args: EvalArgs) -> Result<()> {
+    let surface = load_surface(&args.surface)?;
+    let (u0, u1) = surface.u_range();
+    let (v0, v1) = surface.v_range();
+    let mut uv = Vec::new();
+    if let Some(g) = &args.grid {
+        let (nu, nv) = counts(g, "--grid")?;
+        if nu < 2 || nv < 2 || nu * nv > 10_000_000 {
+            bail!("--grid {g}: between 2 and a few thousand values per direction");
+        }
+        for i in 0..nu {
+            for j in 0..nv {
+                uv.push((
+                    u0 + (u1 - u0) * i as f64 / (nu - 1) as f64,
+                    v0 + (v1 - v0) * j as f64 / (nv - 1) as f64,
+                ));
+            }
+        }
+    }
+    for t in &args.uv {
+        let v = numbers(t, 2, "--uv")?;
+        let eps = 1e-12;
+        if v[0] < u0 - eps || v[0] > u1 + eps || v[1] < v0 - eps || v[1] > v1 + eps {
+            bail!("--uv {t}: outside the surface's domain u {u0}..{u1}, v {v0}..{v1}");
+        }
+        uv.push((v[0], v[1]));
+    }
+    if uv.is_empty() {
+        bail!("nothing to evaluate: give --uv U,V or --grid NU,NV");
+    }
+    let mut out = String::from("u,v,x,y,z,nx,ny,nz,gaussian,mean\n");
+    let mut degenerate = 0;
+    for (u, v) in uv {
+        let p = surface.point(u, v);
+        match surface.geometry(u, v) {
+            Ok(g) => out.push_str(&format!(
+                "{u},{v},{},{},{},{},{},{},{:e},{:e}\n",
+                p.x, p.y, p.z, g.normal.x, g.normal.y, g.normal.z, g.gaussian, g.mean
+            )),
+            Err(_) => {
+                degenerate += 1;
+                out.push_str(&format!(
+                    "{u},{v},{},{},{},nan,nan,nan,nan,nan\n",
+                    p.x, p.y, p.z
+                ));
+            }
+        }
+    }
+    if degenerate > 0 {
+        eprintln!(
+            "warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan"
+        );
+    }
+    match &args.output_file {
+        Some(path) => write_atomically(path, out.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display())),
+        None => {
+            let mut o = std::io::stdout().lock();
+            o.write_all(out.as_bytes())?;
+            Ok(o.flush()?)
+        }
+    }
+}
+
+fn plot(args: PlotArgs) -> Result<()> {
+    let surface = load_surface(&args.surface)?;
+    let title = args.title.unwrap_or_else(|| {
+        args.surface
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    });
+    let svg = plot_surface(
+        &surface,
+        args.curvature.map(|c| match c {
+            CurvatureArg::Gaussian => Curvature::Gaussian,
+            CurvatureArg::Mean => Curvature::Mean,
+        }),
+        &title,
+    );
+    write_atomically(&args.svg, svg.as_bytes())
+        .with_context(|| format!("cannot write {}", args.svg.display()))
+}
+
+/// `wheel:radius=R,width=W`.
+fn parse_wheel(text: &str) -> Result<Wheel> {
+    let usage = || anyhow!("--tool `{text}`: expected wheel:radius=R,width=W (mm)");
+    let rest = text.strip_prefix("wheel:").ok_or_else(usage)?;
+    let (mut radius, mut width) = (None, None);
+    for part in rest.split(',') {
+        let (k, v) = part.split_once('=').ok_or_else(usage)?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| {
+                anyhow!(
+                    "--tool `{text}`: `{}` must be a positive number of mm",
+                    part.trim()
+                )
+            })?;
+        match k.trim() {
+            "radius" | "r" => radius = Some(v),
+            "width" | "w" => width = Some(v),
+            other => bail!("--tool `{text}`: unknown wheel setting `{other}` (radius, width)"),
+        }
+    }
+    Ok(Wheel {
+        radius: radius.ok_or_else(usage)?,
+        width: width.ok_or_else(usage)?,
+    })
+}
+
+/// The placement of the surface in the part frame.
+fn placement(rotate: &[String], translate: Option<&str>) -> Result<Isometry3<f64>> {
+    let mut rotation = UnitQuaternion::identity();
+    for r in rotate {
+        let (axis, deg) = r
+            .split_once(':')
+            .ok_or_else(|| anyhow!("--rotate `{r}`: expected AXIS:DEG, e.g. x:90"))?;
+        let axis = match axis.trim().to_ascii_lowercase().as_str() {
+            "x" => Vector3::x_axis(),
+            "y" => Vector3::y_axis(),
+            "z" => Vector3::z_axis(),
+            _ => bail!("--rotate `{r}`: the axis is x, y or z"),
+        };
+        let deg: f64 = deg
+            .trim()
+            .parse()
+            .ok()
+            .filter(|d: &f64| d.is_finite())
+            .ok_or_else(|| anyhow!("--rotate `{r}`: `{deg}` is not a number of degrees"))?;
+        rotation = UnitQuaternion::from_axis_angle(&axis, deg.to_radians()) * rotation;
+    }
+    let t = match translate {
+        None => Vector3::zeros(),
+        Some(t) => Vector3::from_vec(numbers(t, 3, "--translate")?),
+    };
+    Ok(Isometry3::from_parts(Translation3::from(t), rotation))
+}
+
+pub fn path(args: PathArgs) -> Result<()> {
+    let surface = load_surface(&args.surface)?;
+    let wheel = parse_wheel(&args.tool)?;
+    let spacing = match (args.stepover, args.scallop) {
+        (Some(s), _) => Spacing::Stepover(s),
+        (None, Some(h)) => Spacing::Scallop(h),
+        (None, None) => Spacing::Overlap(args.overlap),
+    };
+    let side = match args.side.trim() {
+        "+" | "plus" => Side::Plus,
+        "-" | "minus" => Side::Minus,
+        s => bail!("--side `{s}`: + or -"),
+    };
+    let region = match &args.region {
+        None => [0.0, 1.0, 0.0, 1.0],
+        Some(r) => {
+            let v = numbers(r, 4, "--region")?;
+            [v[0], v[1], v[2], v[3]]
+        }
+    };
+    let pressure = match &args.pressure {
+        None => None,
+        Some(p) => {
+            let (word, value) = p.split_once('=').unwrap_or(("H1", p.as_str()));
+            let value: f64 = value
+                .trim()
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    anyhow!("--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0")
+                })?;
+            let word = word.trim();
+            if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric()) {
+                bail!("--pressure `{p}`: the word is letters and digits, e.g. H1");
+            }
+            Some((word.to_string(), value))
+        }
+    };
+    if !(args.feed.is_finite() && args.feed > 0.0) {
+        bail!("--feed must be a positive number of mm/min");
+    }
+    let options = PathOptions {
+        wheel,
+        direction: match args.direction {
+            DirectionArg::U => Direction::U,
+            DirectionArg::V => Direction::V,
+        },
+        side,
+        spacing,
+        overlap: args.overlap,
+        chord_tolerance: args.chordtol,
+        max_angle_deg: args.max_angle,
+        lead: args.lead,
+        region,
+        placement: placement(&args.rotate, args.translate.as_deref())?,
+    };
+    let toolpath =
+        plan(&surface, &options).map_err(|e| anyhow!("{}: {e}", args.surface.display()))?;
+    let r = &toolpath.report;
+    let stem = args.surface.file_stem().map_or_else(
+        || "GRIND".to_string(),
+        |s| s.to_string_lossy().to_uppercase(),
+    );
+    let limit = match spacing {
+        Spacing::Scallop(h) => format!(" (limit {h})"),
+        _ => String::new(),
+    };
+    let comments = vec![
+        format!("kinpost path on {}", args.surface.display()),
+        format!(
+            "wheel radius {} mm, width {} mm; tool axis = surface normal ({} side); reference = {}",
+            wheel.radius,
+            wheel.width,
+            if side == Side::Plus { "+" } else { "-" },
+            match args.reference {
+                ReferenceArg::Feed => "feed direction of the passes",
+                ReferenceArg::None => "none",
+            }
+        ),
+        format!(
+            "{} passes, step-over {:.4}-{:.4} mm, scallop max {:.5} mm{limit}, chord error max {:.5} mm",
+            r.passes, r.stepover_min, r.stepover_max, r.scallop_max, r.chord_error_max
+        ),
+    ];
+    let cl = ClOptions {
+        name: args.name.clone().unwrap_or(stem),
+        feed: args.feed,
+        pressure,
+        reference: matches!(args.reference, ReferenceArg::Feed),
+        comments,
+    };
+    match &args.output_file {
+        Some(path) => {
+            let mut f = AtomicFile::create(path)
+                .with_context(|| format!("cannot create {}", path.display()))?;
+            write_cl(&toolpath, &options, &cl, &mut f)?;
+            f.commit()
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+        None => {
+            let mut buffer = Vec::new();
+            write_cl(&toolpath, &options, &cl, &mut buffer)?;
+            let mut o = std::io::stdout().lock();
+            o.write_all(&buffer)?;
+            o.flush()?;
+        }
+    }
+    if let Some(svg) = &args.svg {
+        let title = format!("{}: grinding path", args.surface.display());
+        write_atomically(
+            svg,
+            plot_path(&surface, &toolpath, &options, &title).as_bytes(),
+        )
+        .with_context(|| format!("cannot write {}", svg.display()))?;
+    }
+    if let Some(json) = &args.json {
+        let report = serde_json::json!({
+            "passes": r.passes,
+            "cl_points": r.points,
+            "feed_length_mm": r.length_mm,
+            "stepover_min_mm": r.stepover_min,
+            "stepover_max_mm": r.stepover_max,
+            "scallop_max_mm": r.scallop_max,
+            "scallop_limit_mm": match spacing { Spacing::Scallop(h) => Some(h), _ => None },
+            "wheel_edge_interference_max_mm": r.interference_max,
+            "chord_error_max_mm": r.chord_error_max,
+            "chord_tolerance_mm": options.chord_tolerance,
+            "concave_feed_radius_min_mm": r.concave_feed_radius_min,
+            "gaps": r.gaps.iter().map(|g| serde_json::json!({
+                "stepover_mm": g.stepover, "scallop_mm": g.scallop, "interference_mm": g.interference
+            })).collect::<Vec<_>>(),
+        });
+        let text = serde_json::to_string_pretty(&report).expect("plain data") + "\n";
+        write_atomically(json, text.as_bytes())
+            .with_context(|| format!("cannot write {}", json.display()))?;
+    }
+    eprintln!(
+        "{} passes along {}, {} CL points, {:.1} mm of feed moves; step-over {:.4}–{:.4} mm; scallop max {:.5} mm{limit}; wheel-edge interference max {:.5} mm; chord error max {:.5} mm (tolerance {})",
+        r.passes,
+        if options.direction == Direction::U {
+            "u"
+        } else {
+            "v"
+        },
+        r.points,
+        r.length_mm,
+        r.stepover_min,
+        r.stepover_max,
+        r.scallop_max,
+        r.interference_max,
+        r.chord_error_max,
+        options.chord_tolerance
+    );
+    if let Some(rc) = r.concave_feed_radius_min
+        && rc < wheel.radius
+    {
+        eprintln!(
+            "warning: the surface is concave along the feed with radius {rc:.3} mm, less than the wheel radius {} mm: the wheel cuts in there",
+            wheel.radius
+        );
+    }
+    if r.interference_max > options.chord_tolerance {
+        eprintln!(
+            "warning: the wheel's edge reaches {:.4} mm under the surface between passes (a concave section across the pass): a narrower wheel or passes the other way reduce it",
+            r.interference_max
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,135 @@
+//! examples/rotor37 end to end on a reduced grid (every 3rd point along the
+//! chord): the commands of `examples/rotor37/run.sh`, run by the built
+//! binary. The blade fits, the path keeps the requested scallop, and the
+//! program posts on the mts1600 as a 6-axis program whose closed-loop check
+//! holds.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn kinpost(args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_kinpost"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run kinpost");
+    assert!(
+        o.status.success(),
+        "kinpost {args:?}:\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn rotor37_side1_reduced_grid_posts_on_mts1600() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let o = kinpost(&[
+        "surface",
+        "fit",
+        "../shared/data/nasa-rotors/rotor37geometry.dat",
+        "--blade-side",
+        "1",
+        "--params",
+        "chord-length",
+        "--every",
+        "1,3",
+        "-o",
+        &p("s.json"),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("13 × 34 points → 15 × 36 control points"),
+        "{err}"
+    );
+    kinpost(&[
+        "path",
+        &p("s.json"),
+        "--tool",
+        "wheel:radius=20,width=6",
+        "--direction",
+        "v",
+        "--side",
+        "-",
+        "--scallop",
+        "0.01",
+        "--region",
+        "0,0.9,0.05,0.95",
+        "--feed",
+        "1200",
+        "--pressure",
+        "H1=3000",
+        "--rotate",
+        "z:180",
+        "--translate",
+        "-400,-10,20",
+        "-o",
+        &p("s.cls"),
+        "--svg",
+        &p("path.svg"),
+        "--json",
+        &p("path.json"),
+    ]);
+    let report = json(&dir.path().join("path.json"));
+    let scallop = report["scallop_max_mm"].as_f64().unwrap();
+    assert!(scallop > 0.0 && scallop <= 0.01, "scallop {scallop}");
+    for g in report["gaps"].as_array().unwrap() {
+        assert!(g["scallop_mm"].as_f64().unwrap() <= 0.01);
+    }
+    assert!(report["chord_error_max_mm"].as_f64().unwrap() <= 0.01);
+    assert!(report["passes"].as_u64().unwrap() > 5);
+    let cl = std::fs::read_to_string(dir.path().join("s.cls")).unwrap();
+    assert!(cl.contains("\nPRESSURE/H1,3000.000\n"));
+
+    kinpost(&[
+        "post",
+        &p("s.cls"),
+        "--machine",
+        "mts1600",
+        "--dialect",
+        "csv",
+        "-o",
+        &p("s.csv"),
+        "--json",
+        &p("post.json"),
+    ]);
+    let summary = json(&dir.path().join("post.json"));
+    let max = summary["max_position_error_mm"].as_f64().unwrap();
+    let tol = summary["tolerance_mm"].as_f64().unwrap();
+    assert!(max <= tol, "closed loop {max} > {tol}");
+    assert!(
+        summary["max_axis_error_rad"].as_f64().unwrap()
+            <= summary["tolerance_rad"].as_f64().unwrap()
+    );
+    // The only tolerated warning is about PRESSURE while the machine has no
+    // pressure axis.
+    for w in summary["warnings"].as_array().unwrap() {
+        assert!(w["message"].as_str().unwrap().contains("PRESSURE"), "{w}");
+    }
+    // A 6-axis program: C follows the feed direction.
+    let csv = std::fs::read_to_string(dir.path().join("s.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let c = header.iter().position(|h| *h == "C").unwrap();
+    let cs: Vec<f64> = lines
+        .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+        .collect();
+    let (lo, hi) = cs
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(*v), b.max(*v)));
+    assert!(hi - lo > 5.0, "C from {lo} to {hi}");
+    assert_eq!(
+        cs.len() as u64,
+        summary["cl_points"].as_u64().unwrap(),
+        "one block per CL point"
+    );
+}

@@ -1,0 +1,22 @@
+//! Shared by the surface tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use kinpost_surface::grid::{Grid, read_grid};
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The 35 measured points of seed 002 (Tables 1–5).
+pub fn seed002_path() -> PathBuf {
+    root().join("../shared/data/seed002/points.csv")
+}
+
+pub fn seed002() -> Grid {
+    let path = seed002_path();
+    let text = std::fs::read_to_string(&path).expect("../shared/data/seed002/points.csv");
+    read_grid(&text, &path.to_string_lossy()).expect("valid grid")
+}
