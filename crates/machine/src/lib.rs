@@ -17,8 +17,10 @@ pub mod builtin;
 mod file;
 mod kinematics;
 mod model;
+mod pressure;
 pub mod subproblems;
 
 pub use file::machine_from_toml;
 pub use kinematics::{IkError, Joints, Kinematics, Solution, Violation, wrap180};
 pub use model::{Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Side, Tool};
+pub use pressure::{Clamp, PressureAxis, WheelModel, interpolate};
