@@ -22,7 +22,9 @@
 pub mod check;
 pub mod output;
 mod post;
+mod pressure;
 pub mod summary;
+pub mod wheel;
 
 pub use kinpost_cl as cl;
 pub use kinpost_diag as diag;

@@ -18,6 +18,7 @@ use kinpost_plan::{NearestPlanner, Planner, Rejection};
 use nalgebra::Vector3;
 
 use crate::check::{CheckStats, Tolerance, pose_error};
+use crate::pressure::{Wheel, check_pressure, pressure_spec};
 use crate::summary::Summary;
 
 /// Settings of one post run.
@@ -40,6 +41,13 @@ pub struct PostOptions {
     pub output: Option<OutputMode>,
     /// How feed words are written.
     pub feed_mode: FeedMode,
+    /// The pressure for CL points before any `PRESSURE` statement (machines
+    /// with a pressure axis); without it and without `PRESSURE`, none is
+    /// written and the reference pressure applies.
+    pub pressure: Option<f64>,
+    /// Write the pressure words but solve every block at the reference
+    /// pressure, as the machine maker's post does (for comparison).
+    pub no_pressure_compensation: bool,
 }
 
 /// What the feed word of a feed block means.
@@ -115,6 +123,10 @@ struct Setup<W: Write> {
     tcp: Option<[usize; 3]>,
     /// Feed words are inverse time.
     inverse_time: bool,
+    /// The pressure axis, whose kinematics `kin` is in force.
+    wheel: Option<Wheel>,
+    /// The values of a block: axis values, then the pressure column.
+    row: [f64; kinpost_machine::MAX_AXES + 1],
 }
 
 /// State of the program being written.
@@ -130,6 +142,8 @@ struct Job<'a, W: Write> {
     /// Scale from CL units to mm.
     scale: f64,
     cl_points: u64,
+    /// Pressures already warned about as not compensated (bits).
+    uncompensated: Vec<u64>,
 }
 
 /// What the work on one CL point reads and updates besides the setup.
@@ -142,6 +156,8 @@ struct PointState {
     stats: CheckStats,
     feed: Option<f64>,
     blocks: u64,
+    /// The pressure programmed for the following points, if any.
+    pressure: Option<f64>,
 }
 
 /// Posts the CL text read from `input` for `machine` in `dialect`, writing
@@ -187,13 +203,29 @@ pub fn post<R: BufRead, W: Write>(
             stats: CheckStats::default(),
             feed: None,
             blocks: 0,
+            pressure: None,
         },
         scale: 1.0,
         cl_points: 0,
+        uncompensated: Vec::new(),
     };
+    let mut warnings = Vec::new();
+    if let Some(value) = options.pressure {
+        let check = job.check_pressure(value).map_err(PostError::Setup)?;
+        warnings.extend(check.into_iter().map(|message| {
+            Diagnostic::warning(
+                &options.cl_file,
+                0,
+                0,
+                0,
+                "",
+                format!("--pressure: {message}"),
+            )
+        }));
+        job.point.pressure = Some(value);
+    }
     let mut named = options.program_name.is_some();
     let mut tool_loaded = false;
-    let mut warnings = Vec::new();
 
     while let Some(statement) = reader.next_statement()? {
         let line = statement.line;
@@ -269,10 +301,32 @@ pub fn post<R: BufRead, W: Write>(
             ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
             ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,
             ClEvent::EndOfPath => job.break_segment(),
-            ClEvent::Pressure { .. } => warnings.push(reader.statement_diagnostic(
-                Severity::Warning,
-                "PRESSURE ignored: this machine has no pressure axis",
-            )),
+            ClEvent::Pressure { word, value } => match &machine.pressure {
+                None => warnings.push(reader.statement_diagnostic(
+                    Severity::Warning,
+                    "PRESSURE ignored: this machine has no pressure axis",
+                )),
+                Some(p) => {
+                    if let Some(w) = word.filter(|w| !w.eq_ignore_ascii_case(&p.name)) {
+                        return Err(reader
+                            .statement_diagnostic(
+                                Severity::Error,
+                                format!(
+                                    "PRESSURE names `{w}`, but the pressure word of machine `{}` is `{}`",
+                                    machine.name, p.name
+                                ),
+                            )
+                            .into());
+                    }
+                    let check = job.check_pressure(value).map_err(|message| {
+                        PostError::from(reader.statement_diagnostic(Severity::Error, message))
+                    })?;
+                    for message in check {
+                        warnings.push(reader.statement_diagnostic(Severity::Warning, message));
+                    }
+                    job.point.pressure = Some(value);
+                }
+            },
             ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
             ClEvent::Fini => break,
         }
@@ -310,6 +364,27 @@ pub fn post<R: BufRead, W: Write>(
 }
 
 impl<W: Write> Job<'_, W> {
+    /// Checks a pressure about to be programmed: the warnings to give (each
+    /// uncompensated pressure once), or why it cannot be.
+    fn check_pressure(&mut self, value: f64) -> Result<Vec<String>, String> {
+        let output = self
+            .options
+            .output
+            .or(self.machine.post.output)
+            .unwrap_or_default();
+        let compensate = !self.options.no_pressure_compensation;
+        let check = check_pressure(self.machine, self.dialect, output, compensate, value)?;
+        let mut warnings = check.warnings;
+        if check.uncompensated.is_some() {
+            if self.uncompensated.contains(&value.to_bits()) {
+                warnings.pop();
+            } else {
+                self.uncompensated.push(value.to_bits());
+            }
+        }
+        Ok(warnings)
+    }
+
     /// Sets the machine up for the program (once) and writes the header and
     /// whatever waited for it.
     fn open(&mut self, six_axis: bool) -> Result<(), PostError> {
@@ -367,6 +442,7 @@ impl<W: Write> Job<'_, W> {
             }
             self.setup = Some(Setup {
                 kin: Kinematics::new(&machine),
+                wheel: Wheel::new(&machine, !self.options.no_pressure_compensation),
                 planner: NearestPlanner::new(&machine),
                 machine,
                 six_axis,
@@ -375,6 +451,7 @@ impl<W: Write> Job<'_, W> {
                 tolerance,
                 tcp,
                 inverse_time,
+                row: [f64::NAN; kinpost_machine::MAX_AXES + 1],
             });
         }
         Ok(())
@@ -415,6 +492,17 @@ impl<W: Write> Job<'_, W> {
         let Some(setup) = self.setup.as_mut() else {
             unreachable!("`open` sets the job up")
         };
+        // The block's pressure as written, and the kinematics of the wheel
+        // there (seed 001 eq. 3.4–3.7).
+        if let Some(wheel) = &mut setup.wheel {
+            let n = setup.machine.axes.len();
+            let written = self
+                .point
+                .pressure
+                .map_or(f64::NAN, |p| setup.writer.quantized(n, p));
+            wheel.select(&mut setup.kin, written);
+            setup.row[n] = written;
+        }
         drive(
             setup,
             &mut self.point,
@@ -522,13 +610,16 @@ fn drive<W: Write>(
     };
     // Unwrapped axis values (not the modulo ones written for `DC`).
     st.previous = Some((pose.point, values));
+    // The pressure column, if any, follows the axes (set by `Job::motion`).
+    s.row[..n].copy_from_slice(&values[..n]);
+    let width = n + usize::from(s.wheel.is_some());
     s.writer.block(&Block {
         cl_line: Some(line),
         motion: match motion {
             Motion::Rapid => kinpost_nc::Motion::Rapid,
             Motion::Feed => kinpost_nc::Motion::Feed,
         },
-        axes: &values[..n],
+        axes: &s.row[..width],
         feed,
     })?;
     st.blocks += 1;
@@ -564,7 +655,8 @@ fn inverse_time(
     }
 }
 
-/// The machine's axes as a dialect writes them.
+/// The machine's axes as a dialect writes them, then its pressure word, if
+/// it has a pressure axis.
 pub fn axis_specs(machine: &Machine) -> Vec<AxisSpec> {
     machine
         .axes
@@ -574,7 +666,9 @@ pub fn axis_specs(machine: &Machine) -> Vec<AxisSpec> {
             rotary: a.is_rotary(),
             fixed: a.fixed.is_some(),
             endless: a.is_endless(),
+            pressure: false,
         })
+        .chain(pressure_spec(machine))
         .collect()
 }
 

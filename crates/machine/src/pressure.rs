@@ -125,12 +125,13 @@ impl PressureAxis {
                 // cancellation near the reference, exactly 0 at it.
                 let (mean, half) = ((a + r) / 2.0, (a - r) / 2.0);
                 let s = 2.0 * link_length * half.sin();
-                [-s * mean.sin(), s * mean.cos()]
+                // `0.0 -` and `+ 0.0`: +0, never −0, at the reference.
+                [0.0 - s * mean.sin(), s * mean.cos() + 0.0]
             }
             WheelModel::Offsets(rows) => {
                 let at = interpolate(rows, pressure);
                 let reference = interpolate(rows, self.reference);
-                [at[1] - reference[1], at[2] - reference[2]]
+                [at[1] - reference[1] + 0.0, at[2] - reference[2] + 0.0]
             }
         }
     }
