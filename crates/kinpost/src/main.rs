@@ -221,8 +221,15 @@ fn run(cli: Cli) -> Result<()> {
                 .filter(|a| a.is_free())
                 .map(|a| a.name.as_str())
                 .collect();
+            let pressure = m.pressure.as_ref().map_or(String::new(), |p| {
+                let [lo, hi] = p.range();
+                format!(
+                    "; pressure {} (reference {}, calibration {lo} .. {hi}; `kinpost wheel` shows it)",
+                    p.name, p.reference
+                )
+            });
             println!(
-                "{}: machine `{}` is valid: {} axes ({} free: {})",
+                "{}: machine `{}` is valid: {} axes ({} free: {}){pressure}",
                 file.display(),
                 m.name,
                 m.axes.len(),

@@ -9,7 +9,7 @@
 //! [`Kinematics`] is compiled per wheel offset and kept in a small cache.
 
 use kinpost_machine::{Clamp, Kinematics, Machine, OutputMode, PressureAxis};
-use kinpost_nc::{AxisSpec, Dialect, DialectKind};
+use kinpost_nc::{AxisSpec, Dialect};
 use nalgebra::Vector3;
 
 /// Kinematics compiled for this many wheel offsets at most (the oldest is
@@ -142,7 +142,7 @@ pub(crate) fn check_pressure(
     }
     let offset = p.offset(written);
     let moved = offset.norm() > 0.0;
-    if moved && compensate && output == OutputMode::Tcp && dialect.kind() != DialectKind::Csv {
+    if moved && compensate && output == OutputMode::Tcp {
         return Err(format!(
             "tool-centre-point output cannot compensate the wheel offset at {} = {} ({:.3} mm): \
              the controller puts the tool point where its own tool data says; use joint output \

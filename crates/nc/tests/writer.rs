@@ -778,3 +778,45 @@ fn sinumerik_dc_only_for_endless_axes() {
     let out = text(w);
     assert!(out.contains("X=1.000 A-30.000 C=DC(270.000) F100"), "{out}");
 }
+
+/// The `[pressure]` examples of DIALECTS.md, added to the built-ins that
+/// have none: written on their own line, read back by the same dialect.
+#[test]
+fn documented_pressure_tables() {
+    for (name, table, line) in [
+        (
+            "fanuc",
+            "prefix = \"#500=\"\ntrailing_zeros = \"point\"\n",
+            "#500=3100.",
+        ),
+        (
+            "heidenhain",
+            "prefix = \"FN 0: Q100 = \"\nplus_sign = true\n",
+            " FN 0: Q100 = +3100\n",
+        ),
+        ("linuxcnc", "prefix = \"M68 E0 Q\"\n", "\nM68 E0 Q3100\n"),
+    ] {
+        let source = format!(
+            "{}\n[pressure]\n{table}",
+            Dialect::builtin_source(name).unwrap()
+        );
+        let dialect = Dialect::from_toml(&source, &format!("{name}-pressure.toml"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(dialect.writes_pressure());
+        let axes = mts_axes_with_pressure();
+        let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+        w.header(&ProgramInfo::default(), None).unwrap();
+        for (x, h1) in [(1.0, f64::NAN), (2.0, 3000.0), (3.0, 3000.0), (4.0, 3100.0)] {
+            pressure_block(&mut w, x, h1);
+        }
+        let out = text(w);
+        assert!(out.contains(line), "{name}:\n{out}");
+        let blocks = read_program(&dialect, &axes, "p", &out).unwrap();
+        let pressures: Vec<Option<f64>> = blocks.iter().map(|b| b.axes[6]).collect();
+        assert_eq!(
+            pressures,
+            [None, Some(3000.0), Some(3000.0), Some(3100.0)],
+            "{name}:\n{out}"
+        );
+    }
+}
