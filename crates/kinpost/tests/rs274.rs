@@ -660,9 +660,9 @@ fn pressure_word_as_an_analog_output() {
         // line, motion, X A Y Z B C H1 feed; rs274: X Y Z A B C.
         let v = |k: usize| row[k].parse::<f64>().unwrap();
         let want = [v(2), v(4), v(5), v(3), v(6), 0.0];
-        for k in 0..6 {
+        for (got, want) in m.at.iter().zip(want) {
             assert!(
-                (m.at[k] - want[k]).abs() <= 0.5e-4 + 0.5e-6 + 1e-9,
+                (got - want).abs() <= 0.5e-4 + 0.5e-6 + 1e-9,
                 "{m:?} vs {row:?}"
             );
         }
