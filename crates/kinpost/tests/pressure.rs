@@ -292,7 +292,7 @@ fn random_machine(rng: &mut Rng) -> Generated {
         ),
         tool_axis: rng.unit(),
         word: ["H1", "P", "Q7"][(rng.next() * 3.0) as usize].to_string(),
-        reference: rng.half(lo - 200.0, hi + 200.0),
+        reference: rng.half(lo, hi).clamp(lo, hi),
         plane: [e1, e2],
         plane_names: [names[slots[0]].to_string(), names[slots[1]].to_string()],
         model,

@@ -561,6 +561,32 @@ fn check_pressure(
             None
         }
     };
+    // The tool point was measured at the reference: it must lie on the
+    // calibration (a reference beyond a stop is ambiguous; a row on the stop
+    // says what is meant).
+    fn ends<const N: usize>(rows: &[[f64; N]]) -> Option<(f64, f64)> {
+        (rows.len() >= 2).then(|| (rows[0][0], rows[rows.len() - 1][0]))
+    }
+    let ends = match &model {
+        Some(WheelModel::Linkage { alpha_deg, .. }) => ends(alpha_deg),
+        Some(WheelModel::Offsets(rows)) => ends(rows),
+        None => None,
+    };
+    if let Some((lo, hi)) = ends
+        && reference.is_finite()
+        && (reference < lo || reference > hi)
+    {
+        c.error(
+            p.reference.span(),
+            format!(
+                "reference {} is outside the calibration ({} .. {}); if the wheel is on a stop there, add a row at {} with the stop's value",
+                short(reference, 9),
+                short(lo, 9),
+                short(hi, 9),
+                short(reference, 9)
+            ),
+        );
+    }
     if c.errors.len() > errors_before {
         return None;
     }
@@ -933,12 +959,18 @@ axis = [0, 0, 1]
                 alpha_deg: vec![[3000.0, -6.73], [3600.0, 5.0]]
             }
         );
-        // A reference outside the table is the offset of the stop: allowed.
+        // Measured offsets, the reference on the upper stop.
         let src = format!("{GOOD}{PRESSURE}offsets = [[3000, -1.12, -51.075], [3600, 0, 0]]\n")
-            .replace("3475", "4000");
+            .replace("3475", "3600");
         let p = machine_from_toml(&src, "m.toml").unwrap().pressure.unwrap();
         assert_eq!(p.plane_offset(4000.0), [0.0, 0.0]);
         assert_eq!(p.plane_offset(3000.0), [-1.12, -51.075]);
+        // A reference beyond the calibration is ambiguous: an error.
+        let e = err(&src.replace("= 3600", "= 4000"));
+        assert!(
+            e.contains("reference 4000 is outside the calibration (3000 .. 3600)"),
+            "{e}"
+        );
     }
 
     #[test]
