@@ -14,11 +14,16 @@ fuzz_target!(|data: &[u8]| {
     let Ok(dialect) = Dialect::from_toml(&text, "fuzz.toml") else {
         return;
     };
-    let axes = [AxisSpec::linear("X"), AxisSpec::endless("A"), AxisSpec::rotary("B")];
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::endless("A"),
+        AxisSpec::rotary("B"),
+        AxisSpec::pressure_word("H1"),
+    ];
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
     let _ = w.header(&ProgramInfo::default(), None);
     for (k, motion) in [Motion::Rapid, Motion::Feed, Motion::Feed].into_iter().enumerate() {
-        let v = [k as f64 * 1.5, -400.0 + k as f64, 12.25];
+        let v = [k as f64 * 1.5, -400.0 + k as f64, 12.25, 3000.0 + 10.0 * k as f64];
         let _ = w.block(&Block { cl_line: Some(k + 1), motion, axes: &v, feed: Some(250.0) });
     }
     let _ = w.comment("fuzz (comment)");

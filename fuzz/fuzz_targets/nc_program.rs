@@ -18,6 +18,7 @@ fuzz_target!(|data: &[u8]| {
         AxisSpec::linear("Z"),
         AxisSpec::rotary("B"),
         AxisSpec::rotary("C").fixed(),
+        AxisSpec::pressure_word("H1"),
     ];
     for name in Dialect::builtin_names() {
         let dialect = Dialect::builtin(name).expect("listed");

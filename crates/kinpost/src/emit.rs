@@ -40,6 +40,9 @@ pub(crate) struct Target<'a> {
     pub line: usize,
     /// CL feed rate, mm/min.
     pub feed: Option<f64>,
+    /// The pressure as written (NaN: none); the caller has put the
+    /// kinematics of the wheel there in force.
+    pub pressure: f64,
     /// The move into it is continuous (else: retract and reconfigure).
     pub continuous: bool,
     /// The move into it is part of a cut (not the start of a segment).
@@ -52,6 +55,8 @@ pub(crate) struct Target<'a> {
 #[derive(Debug, Clone, Copy)]
 struct Last {
     node: Node,
+    /// The pressure it was written at (NaN: none).
+    pressure: f64,
     line: usize,
     /// Values as handed to the writer (tool point on X, Y, Z in TCP output).
     values: Joints,
@@ -85,6 +90,10 @@ pub(crate) struct Emitter<W: Write> {
     /// Axes with a maximum velocity (index, units per minute).
     vmax: Vec<(usize, f64)>,
     names: Vec<String>,
+    /// The machine has a pressure axis: its column follows the axes.
+    has_pressure: bool,
+    /// The pressure of the blocks being written.
+    pressure: f64,
     last: Option<Last>,
     written: Joints,
     solutions: Vec<Solution>,
@@ -109,6 +118,8 @@ impl<W: Write> Emitter<W> {
                 .filter_map(|i| axes[i].max_velocity.map(|v| (i, v)))
                 .collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
+            has_pressure: machine.pressure.is_some(),
+            pressure: f64::NAN,
             last: None,
             written: [0.0; MAX_AXES],
             solutions: Vec::with_capacity(16),
@@ -126,6 +137,20 @@ impl<W: Write> Emitter<W> {
         kin: &Kinematics,
         t: &Target,
     ) -> Result<(), PostError> {
+        self.pressure = t.pressure;
+        if let Some(mut last) = self.last
+            && last.pressure.to_bits() != t.pressure.to_bits()
+        {
+            // The wheel moved with the pressure: the last block's axes put
+            // the contact point elsewhere now, and the move starts there.
+            let n = self.n;
+            let here = kin.fk(&last.node.joints[..n]);
+            last.node.pose = Pose {
+                reference: last.node.pose.reference.and(here.reference),
+                ..here
+            };
+            self.last = Some(last);
+        }
         if let Some(last) = self.last
             && t.motion == Motion::Feed
         {
@@ -399,13 +424,18 @@ impl<W: Write> Emitter<W> {
         }
         self.last = Some(Last {
             node: *node,
+            pressure: self.pressure,
             line,
             values,
         });
+        // The pressure column, if any, follows the axes.
+        let mut row = [f64::NAN; MAX_AXES + 1];
+        row[..n].copy_from_slice(&values[..n]);
+        row[n] = self.pressure;
         self.writer.block(&Block {
             cl_line,
             motion,
-            axes: &values[..n],
+            axes: &row[..n + usize::from(self.has_pressure)],
             feed,
         })?;
         self.blocks += 1;

@@ -24,8 +24,10 @@ mod emit;
 pub mod output;
 mod path;
 mod post;
+mod pressure;
 mod solve;
 pub mod summary;
+pub mod wheel;
 
 pub use kinpost_cl as cl;
 pub use kinpost_diag as diag;

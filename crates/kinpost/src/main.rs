@@ -48,8 +48,12 @@ enum Command {
         #[arg(long, short)]
         machine: String,
         /// Axis values as NAME=VALUE (mm, degrees); axes not given are 0.
+        /// The machine's pressure word (H1=3000) sets the pressure.
         #[arg(value_name = "AXIS=VALUE")]
         values: Vec<String>,
+        /// Pressure of the machine's pressure axis (default: its reference).
+        #[arg(long, value_name = "VALUE")]
+        pressure: Option<f64>,
     },
     /// Inverse kinematics: every solution for a tool point and axis.
     Ik {
@@ -65,12 +69,34 @@ enum Command {
         /// Reference direction u,v,w (machines with three free rotary axes).
         #[arg(long, allow_hyphen_values = true)]
         reference: Option<String>,
+        /// Pressure of the machine's pressure axis (default: its reference).
+        #[arg(long, value_name = "VALUE")]
+        pressure: Option<f64>,
     },
     /// B-spline surfaces from measured points: fit, evaluate, plot.
     #[command(subcommand)]
     Surface(cmd_surface::SurfaceCommand),
     /// Belt-grinding path on a surface, as an NX-style CL file.
     Path(Box<cmd_surface::PathArgs>),
+    /// Grinding-pressure axis: input-link angle, wheel offset and axis
+    /// correction per pressure, and the wheel-centre trajectory as SVG.
+    Wheel(WheelArgs),
+}
+
+#[derive(clap::Args)]
+struct WheelArgs {
+    /// Built-in machine name or machine file (with a [pressure] section).
+    #[arg(long, short)]
+    machine: String,
+    /// Pressures to show (default: the calibration rows and the reference).
+    #[arg(long, value_name = "VALUE", num_args = 1..)]
+    pressure: Vec<f64>,
+    /// Pressures FROM, FROM+STEP, ... up to TO, e.g. 3000:3600:100.
+    #[arg(long, value_name = "FROM:TO:STEP")]
+    table: Option<String>,
+    /// Write the wheel-centre trajectory to this SVG file.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -139,6 +165,16 @@ struct PostArgs {
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
+    /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
+    /// points before any PRESSURE statement. Without it and without
+    /// PRESSURE, no pressure word is written and the wheel is where it is
+    /// at the machine's reference pressure.
+    #[arg(long, value_name = "VALUE")]
+    pressure: Option<f64>,
+    /// Write the pressure words but solve every block at the reference
+    /// pressure, as the machine maker's post does (for comparison).
+    #[arg(long)]
+    no_pressure_compensation: bool,
     /// Print no summary on standard error.
     #[arg(long, short)]
     quiet: bool,
@@ -225,8 +261,15 @@ fn run(cli: Cli) -> Result<()> {
                 .filter(|a| a.is_free())
                 .map(|a| a.name.as_str())
                 .collect();
+            let pressure = m.pressure.as_ref().map_or(String::new(), |p| {
+                let [lo, hi] = p.range();
+                format!(
+                    "; pressure {} (reference {}, calibration {lo} .. {hi}; `kinpost wheel` shows it)",
+                    p.name, p.reference
+                )
+            });
             println!(
-                "{}: machine `{}` is valid: {} axes ({} free: {})",
+                "{}: machine `{}` is valid: {} axes ({} free: {}){pressure}",
                 file.display(),
                 m.name,
                 m.axes.len(),
@@ -252,13 +295,19 @@ fn run(cli: Cli) -> Result<()> {
             print!("{src}");
             Ok(())
         }
-        Command::Fk { machine, values } => fk(&machine, &values),
+        Command::Fk {
+            machine,
+            values,
+            pressure,
+        } => fk(&machine, &values, pressure),
         Command::Ik {
             machine,
             point,
             axis,
             reference,
-        } => ik(&machine, &point, &axis, reference.as_deref()),
+            pressure,
+        } => ik(&machine, &point, &axis, reference.as_deref(), pressure),
+        Command::Wheel(args) => wheel(&args),
         Command::Surface(c) => cmd_surface::surface(c),
         Command::Path(a) => cmd_surface::path(*a),
     }
@@ -370,6 +419,8 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        pressure: args.pressure.map(check_pressure_value).transpose()?,
+        no_pressure_compensation: args.no_pressure_compensation,
     };
     if !(args.lintol.is_finite() && args.lintol >= 0.0) {
         return Err(anyhow!("--lintol must be a distance of 0 or more (mm)"));
@@ -492,22 +543,56 @@ impl<R: io::Read> io::Read for Progress<R> {
     }
 }
 
-fn fk(machine: &str, values: &[String]) -> Result<()> {
+/// A pressure from the command line: a number not below 0.
+fn check_pressure_value(v: f64) -> Result<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(anyhow!("--pressure must be a number not below 0"))
+    }
+}
+
+/// The machine with its wheel at `pressure` (given: the machine must have a
+/// pressure axis; a value outside the calibration is clamped, with a warning).
+fn machine_at_pressure(m: &Machine, pressure: Option<f64>) -> Result<Machine> {
+    let Some(h) = pressure else {
+        return Ok(m.clone());
+    };
+    let h = check_pressure_value(h)?;
+    let p = kinpost::wheel::pressure_axis(m).map_err(|e| anyhow!("{e}"))?;
+    if p.clamp(h) != kinpost::machine::Clamp::Inside {
+        let [lo, hi] = p.range();
+        eprintln!(
+            "warning: {} = {h} is outside the calibration ({lo} .. {hi}): the wheel sits on its stop",
+            p.name
+        );
+    }
+    Ok(m.at_pressure(h))
+}
+
+fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
     let m = load_machine(machine)?;
     let mut q = m.home_joints();
+    let mut pressure = pressure;
     for v in values {
         let (name, value) = v
             .split_once('=')
             .ok_or_else(|| anyhow!("`{v}`: expected AXIS=VALUE, e.g. X=459"))?;
-        let i = m
-            .axis_index(name.trim())
-            .ok_or_else(|| anyhow!("machine `{}` has no axis `{name}`", m.name))?;
         let value: f64 = value
             .trim()
             .parse()
             .ok()
             .filter(|x: &f64| x.is_finite())
             .ok_or_else(|| anyhow!("`{v}`: `{value}` is not a number"))?;
+        if let Some(p) = &m.pressure
+            && p.name.eq_ignore_ascii_case(name.trim())
+        {
+            pressure = Some(value);
+            continue;
+        }
+        let i = m
+            .axis_index(name.trim())
+            .ok_or_else(|| anyhow!("machine `{}` has no axis `{name}`", m.name))?;
         if m.axes[i].fixed.is_some_and(|f| f != value) {
             eprintln!(
                 "warning: axis {} is fixed at {} in this machine file; using {value}",
@@ -520,7 +605,7 @@ fn fk(machine: &str, values: &[String]) -> Result<()> {
         }
         q[i] = value;
     }
-    let pose = Kinematics::new(&m).fk(&q);
+    let pose = Kinematics::new(&machine_at_pressure(&m, pressure)?).fk(&q);
     let p = pose.point;
     let a = pose.axis;
     println!("point     {:.6} {:.6} {:.6}", p.x, p.y, p.z);
@@ -531,14 +616,20 @@ fn fk(machine: &str, values: &[String]) -> Result<()> {
     Ok(())
 }
 
-fn ik(machine: &str, point: &str, axis: &str, reference: Option<&str>) -> Result<()> {
+fn ik(
+    machine: &str,
+    point: &str,
+    axis: &str,
+    reference: Option<&str>,
+    pressure: Option<f64>,
+) -> Result<()> {
     let m = load_machine(machine)?;
     let pose = Pose {
         point: Vector3::from(parse_vector(point, "point")?),
         axis: unit_vector(axis, "axis")?,
         reference: reference.map(|r| unit_vector(r, "reference")).transpose()?,
     };
-    let kin = Kinematics::new(&m);
+    let kin = Kinematics::new(&machine_at_pressure(&m, pressure)?);
     let mut sols = Vec::new();
     kin.ik_all_branches(&pose, None, &mut sols)
         .map_err(|e| anyhow!("no solution: {e}"))?;
@@ -554,6 +645,33 @@ fn ik(machine: &str, point: &str, axis: &str, reference: Option<&str>) -> Result
             Some(v) => format!("outside travel: {}", m.axes[v.axis].name),
         };
         println!("{:>6} {}  {status}", s.branch, values.join(""));
+    }
+    Ok(())
+}
+
+fn wheel(args: &WheelArgs) -> Result<()> {
+    let m = load_machine(&args.machine)?;
+    let p = kinpost::wheel::pressure_axis(&m).map_err(|e| anyhow!("{e}"))?;
+    let mut pressures = args
+        .pressure
+        .iter()
+        .map(|&v| check_pressure_value(v))
+        .collect::<Result<Vec<f64>>>()?;
+    if let Some(t) = &args.table {
+        pressures.extend(kinpost::wheel::parse_table(t).map_err(|e| anyhow!("{e}"))?);
+    }
+    if pressures.is_empty() {
+        pressures = kinpost::wheel::default_pressures(p);
+    }
+    let rows = kinpost::wheel::rows(&m, &pressures).map_err(|e| anyhow!("{e}"))?;
+    print!(
+        "{}",
+        kinpost::wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?
+    );
+    if let Some(path) = &args.svg {
+        let svg = kinpost::wheel::svg(&m, &rows).map_err(|e| anyhow!("{e}"))?;
+        write_atomically(path, svg.as_bytes())
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }

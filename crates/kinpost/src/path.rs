@@ -17,7 +17,8 @@ use kinpost_plan::{Choice, Link, Trellis, rejection};
 
 use crate::check::angle_between;
 use crate::emit::{Emitter, Node, Target};
-use crate::post::{Pending, PostError, write_pending};
+use crate::post::{Pending, PostError, select, write_pending};
+use crate::pressure::Wheel;
 use crate::solve::{Hold, solve_near};
 use crate::summary::SingularStretch;
 
@@ -32,6 +33,8 @@ pub(crate) struct PlanPoint {
     pub source: Range<usize>,
     /// In the singular cone: not in the trellis.
     pub singular: bool,
+    /// The pressure as written (NaN: none).
+    pub pressure: f64,
     /// Segment number (a new one at every rapid and break).
     pub segment: u64,
     /// First point of its segment.
@@ -68,6 +71,9 @@ pub(crate) struct PathPlan {
     free: bool,
     /// Tool axis and reference of the last point.
     previous_axes: Option<(nalgebra::Vector3<f64>, Option<nalgebra::Vector3<f64>>)>,
+    /// Angle between the tool axis of the last point in the trellis and the
+    /// singular direction, degrees.
+    planned_pole_deg: f64,
     segment: u64,
     break_pending: bool,
     /// The last point written: its node and segment.
@@ -101,6 +107,7 @@ impl PathPlan {
             across: false,
             free: true,
             previous_axes: None,
+            planned_pole_deg: f64::INFINITY,
             segment: 0,
             break_pending: true,
             last: None,
@@ -136,6 +143,7 @@ impl PathPlan {
         motion: Motion,
         line: usize,
         feed: Option<f64>,
+        pressure: f64,
         source_line: &[u8],
     ) -> Result<(), PointError> {
         if motion == Motion::Rapid {
@@ -170,6 +178,17 @@ impl PathPlan {
             }
             self.across = true;
         } else {
+            // The tool axis swept past the pole between the two points (its
+            // distances to the pole add up to the turn): the branches meet
+            // there, as across singular points.
+            let pole_deg = self
+                .singularity
+                .map_or(f64::INFINITY, |s| s.distance(&pose.axis).to_degrees());
+            let cone_deg = self.cone_rad.to_degrees();
+            if self.planned_pole_deg + pole_deg <= self.turn + 2.0 * cone_deg + 1e-9 {
+                self.across = true;
+            }
+            self.planned_pole_deg = pole_deg;
             let link = if self.free {
                 Link::Free
             } else {
@@ -192,6 +211,7 @@ impl PathPlan {
             line,
             motion,
             feed,
+            pressure,
             source: start..self.source.len(),
             singular,
             segment: self.segment,
@@ -211,7 +231,8 @@ impl PathPlan {
     pub fn flush<W: Write>(
         &mut self,
         machine: &Machine,
-        kin: &Kinematics,
+        kin: &mut Kinematics,
+        wheel: &mut Option<Wheel>,
         emitter: &mut Emitter<W>,
         all: bool,
     ) -> Result<(), PostError> {
@@ -227,7 +248,7 @@ impl PathPlan {
         };
         let mut items = std::mem::take(&mut self.items);
         self.items = items.split_off(end);
-        let decided = self.decide(kin, &items)?;
+        let decided = self.decide(kin, wheel, &items)?;
         let mut k = 0;
         for item in items {
             match item {
@@ -236,6 +257,7 @@ impl PathPlan {
                     let d = decided[k];
                     k += 1;
                     let at = |message: String| self.error_at(&p, message);
+                    select(kin, wheel, p.pressure);
                     emitter.emit(
                         machine,
                         kin,
@@ -244,6 +266,7 @@ impl PathPlan {
                             motion: p.motion,
                             line: p.line,
                             feed: p.feed,
+                            pressure: p.pressure,
                             continuous: d.continuous,
                             cut: !p.starts_segment,
                             at: &at,
@@ -277,7 +300,12 @@ impl PathPlan {
     }
 
     /// The configuration of each point among `items`, in order.
-    fn decide(&mut self, kin: &Kinematics, items: &[Item]) -> Result<Vec<Decided>, PostError> {
+    fn decide(
+        &mut self,
+        kin: &mut Kinematics,
+        wheel: &mut Option<Wheel>,
+        items: &[Item],
+    ) -> Result<Vec<Decided>, PostError> {
         let points: Vec<&PlanPoint> = items
             .iter()
             .filter_map(|i| match i {
@@ -314,7 +342,7 @@ impl PathPlan {
             while e < points.len() && points[e].singular && points[e].segment == seg {
                 e += 1;
             }
-            self.fill_run(kin, &points, k..e, &mut out)?;
+            self.fill_run(kin, wheel, &points, k..e, &mut out)?;
             k = e;
         }
         Ok(out
@@ -326,7 +354,8 @@ impl PathPlan {
     /// Holds the singular angle over `run` and solves its points.
     fn fill_run(
         &mut self,
-        kin: &Kinematics,
+        kin: &mut Kinematics,
+        wheel: &mut Option<Wheel>,
         points: &[&PlanPoint],
         run: Range<usize>,
         out: &mut [Option<Decided>],
@@ -392,6 +421,8 @@ impl PathPlan {
                 axis: i,
                 value: from + (to - from) * t,
             });
+            select(kin, wheel, p.pressure);
+            let kin = &*kin;
             let solved = solve_near(
                 kin,
                 &p.pose,

@@ -20,6 +20,7 @@ use nalgebra::Vector3;
 use crate::check::Tolerance;
 use crate::emit::{EmitSettings, Emitter};
 use crate::path::{PathPlan, PointError};
+use crate::pressure::{Wheel, check_pressure, pressure_spec};
 use crate::summary::Summary;
 
 /// Settings of one post run.
@@ -54,6 +55,13 @@ pub struct PostOptions {
     pub retract_mm: Option<f64>,
     /// Fail instead of retracting and reconfiguring.
     pub no_reconfigure: bool,
+    /// The pressure for CL points before any `PRESSURE` statement (machines
+    /// with a pressure axis); without it and without `PRESSURE`, none is
+    /// written and the reference pressure applies.
+    pub pressure: Option<f64>,
+    /// Write the pressure words but solve every block at the reference
+    /// pressure, as the machine maker's post does (for comparison).
+    pub no_pressure_compensation: bool,
 }
 
 /// Default linearization tolerance, mm.
@@ -157,6 +165,8 @@ struct Setup<W: Write> {
     path: PathPlan,
     emitter: Emitter<W>,
     inverse_time: bool,
+    /// The pressure axis, whose kinematics `kin` is in force.
+    wheel: Option<Wheel>,
 }
 
 /// State of the program being written.
@@ -172,6 +182,10 @@ struct Job<'a, W: Write> {
     scale: f64,
     feed: Option<f64>,
     cl_points: u64,
+    /// Pressures already warned about as not compensated (bits).
+    uncompensated: Vec<u64>,
+    /// The pressure programmed for the following points, if any.
+    pressure: Option<f64>,
 }
 
 /// Posts the CL text read from `input` for `machine` in `dialect`, writing
@@ -213,10 +227,26 @@ pub fn post<R: BufRead, W: Write>(
         scale: 1.0,
         feed: None,
         cl_points: 0,
+        uncompensated: Vec::new(),
+        pressure: None,
     };
+    let mut warnings = Vec::new();
+    if let Some(value) = options.pressure {
+        let check = job.check_pressure(value).map_err(PostError::Setup)?;
+        warnings.extend(check.into_iter().map(|message| {
+            Diagnostic::warning(
+                &options.cl_file,
+                0,
+                0,
+                0,
+                "",
+                format!("--pressure: {message}"),
+            )
+        }));
+        job.pressure = Some(value);
+    }
     let mut named = options.program_name.is_some();
     let mut tool_loaded = false;
-    let mut warnings = Vec::new();
 
     while let Some(statement) = reader.next_statement()? {
         let line = statement.line;
@@ -292,10 +322,32 @@ pub fn post<R: BufRead, W: Write>(
             ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
             ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,
             ClEvent::EndOfPath => job.break_segment(),
-            ClEvent::Pressure { .. } => warnings.push(reader.statement_diagnostic(
-                Severity::Warning,
-                "PRESSURE ignored: this machine has no pressure axis",
-            )),
+            ClEvent::Pressure { word, value } => match &machine.pressure {
+                None => warnings.push(reader.statement_diagnostic(
+                    Severity::Warning,
+                    "PRESSURE ignored: this machine has no pressure axis",
+                )),
+                Some(p) => {
+                    if let Some(w) = word.filter(|w| !w.eq_ignore_ascii_case(&p.name)) {
+                        return Err(reader
+                            .statement_diagnostic(
+                                Severity::Error,
+                                format!(
+                                    "PRESSURE names `{w}`, but the pressure word of machine `{}` is `{}`",
+                                    machine.name, p.name
+                                ),
+                            )
+                            .into());
+                    }
+                    let check = job.check_pressure(value).map_err(|message| {
+                        PostError::from(reader.statement_diagnostic(Severity::Error, message))
+                    })?;
+                    for message in check {
+                        warnings.push(reader.statement_diagnostic(Severity::Warning, message));
+                    }
+                    job.pressure = Some(value);
+                }
+            },
             ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
             ClEvent::Fini => break,
         }
@@ -304,9 +356,13 @@ pub fn post<R: BufRead, W: Write>(
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
     };
-    setup
-        .path
-        .flush(&setup.machine, &setup.kin, &mut setup.emitter, true)?;
+    setup.path.flush(
+        &setup.machine,
+        &mut setup.kin,
+        &mut setup.wheel,
+        &mut setup.emitter,
+        true,
+    )?;
     let emitter = setup.emitter;
     let mut writer = emitter.writer;
     if setup.inverse_time {
@@ -341,6 +397,27 @@ pub fn post<R: BufRead, W: Write>(
 }
 
 impl<W: Write> Job<'_, W> {
+    /// Checks a pressure about to be programmed: the warnings to give (each
+    /// uncompensated pressure once), or why it cannot be.
+    fn check_pressure(&mut self, value: f64) -> Result<Vec<String>, String> {
+        let output = self
+            .options
+            .output
+            .or(self.machine.post.output)
+            .unwrap_or_default();
+        let compensate = !self.options.no_pressure_compensation;
+        let check = check_pressure(self.machine, self.dialect, output, compensate, value)?;
+        let mut warnings = check.warnings;
+        if check.uncompensated.is_some() {
+            if self.uncompensated.contains(&value.to_bits()) {
+                warnings.pop();
+            } else {
+                self.uncompensated.push(value.to_bits());
+            }
+        }
+        Ok(warnings)
+    }
+
     /// Sets the machine up for the program (once) and writes the header and
     /// whatever waited for it.
     fn open(&mut self, six_axis: bool) -> Result<(), PostError> {
@@ -448,6 +525,7 @@ impl<W: Write> Job<'_, W> {
                 emitter: Emitter::new(&machine, writer, settings),
                 kin,
                 path,
+                wheel: Wheel::new(&planned, !self.options.no_pressure_compensation),
                 machine,
                 six_axis,
                 inverse_time,
@@ -517,10 +595,21 @@ impl<W: Write> Job<'_, W> {
             Motion::Rapid => kinpost_nc::Motion::Rapid,
             Motion::Feed => kinpost_nc::Motion::Feed,
         };
+        // The block's pressure as written (NaN: none programmed), and the
+        // kinematics of the wheel there (seed 001 eq. 3.4–3.7).
+        let pressure = match &s.wheel {
+            Some(_) => {
+                let n = s.machine.axes.len();
+                self.pressure
+                    .map_or(f64::NAN, |p| s.emitter.writer.quantized(n, p))
+            }
+            None => f64::NAN,
+        };
+        select(&mut s.kin, &mut s.wheel, pressure);
         let (_, source) = reader.statement_line();
         if let Err(e) = s
             .path
-            .push_point(&s.kin, *pose, nc_motion, line, self.feed, source)
+            .push_point(&s.kin, *pose, nc_motion, line, self.feed, pressure, source)
         {
             return Err(at(match e {
                 PointError::Ik(e) => format!("{e}: {}", describe(pose)),
@@ -540,13 +629,15 @@ impl<W: Write> Job<'_, W> {
             }));
         }
         if s.path.is_full() {
-            s.path.flush(&s.machine, &s.kin, &mut s.emitter, false)?;
+            s.path
+                .flush(&s.machine, &mut s.kin, &mut s.wheel, &mut s.emitter, false)?;
         }
         Ok(())
     }
 }
 
-/// The machine's axes as a dialect writes them.
+/// The machine's axes as a dialect writes them, then its pressure word, if
+/// it has a pressure axis.
 pub fn axis_specs(machine: &Machine) -> Vec<AxisSpec> {
     machine
         .axes
@@ -556,7 +647,9 @@ pub fn axis_specs(machine: &Machine) -> Vec<AxisSpec> {
             rotary: a.is_rotary(),
             fixed: a.fixed.is_some(),
             endless: a.is_endless(),
+            pressure: false,
         })
+        .chain(pressure_spec(machine))
         .collect()
 }
 
@@ -611,6 +704,14 @@ pub(crate) fn write_pending<W: Write>(
         Pending::Insert(text) => writer.insert(&text)?,
     }
     Ok(())
+}
+
+/// Puts the kinematics of the written pressure `pressure` (NaN: none) in
+/// `kin`, on a machine with a pressure axis.
+pub(crate) fn select(kin: &mut Kinematics, wheel: &mut Option<Wheel>, pressure: f64) {
+    if let Some(w) = wheel {
+        w.select(kin, pressure);
+    }
 }
 
 /// The pose as a user reads it in a message.

@@ -441,10 +441,233 @@ fn csv_dialect() {
     assert_exit(&o, 0);
     let out = stdout(&o);
     let mut lines = out.lines();
-    assert_eq!(lines.next(), Some("line,motion,X,A,Y,Z,B,C,feed"));
-    // One row per block, every row with all nine columns.
+    // The mts1600 has a pressure axis: its H1 column is empty while no
+    // pressure is programmed.
+    assert_eq!(lines.next(), Some("line,motion,X,A,Y,Z,B,C,H1,feed"));
+    // One row per block, every row with all ten columns.
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 14, "{out}");
-    assert!(rows.iter().all(|r| r.split(',').count() == 9), "{out}");
+    assert!(rows.iter().all(|r| r.split(',').count() == 10), "{out}");
+    assert!(
+        rows.iter().all(|r| r.split(',').nth(8) == Some("")),
+        "{out}"
+    );
     assert!(rows[2].starts_with("15,feed,459.000000,"), "{out}");
+}
+
+/// The numeric rows of a `kinpost wheel` table.
+fn wheel_rows(out: &str) -> Vec<Vec<f64>> {
+    out.lines()
+        .filter_map(|l| {
+            let v: Option<Vec<f64>> = l
+                .split_whitespace()
+                .map(|w| w.trim_end_matches('*').parse().ok())
+                .collect();
+            v.filter(|v| v.len() >= 4)
+        })
+        .collect()
+}
+
+#[test]
+fn wheel_table_has_the_stroke_and_the_arc_of_seed_001() {
+    let o = run(&["wheel", "--machine", "mts1600", "--table", "3000:3600:100"]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    let rows = wheel_rows(&out);
+    // H1, alpha, offset Y, offset Z, correction X, Y, Z.
+    assert_eq!(rows.len(), 7, "{out}");
+    assert!(rows.iter().all(|r| r.len() == 7), "{out}");
+    assert_eq!(rows[0][0], 3000.0);
+    assert_eq!(rows[6][0], 3600.0);
+    assert_eq!((rows[0][1], rows[6][1]), (-6.73, 5.0));
+    // Seed 001 §2.7: 51.075 mm in Z between the stops.
+    let stroke = (rows[6][3] - rows[0][3]).abs();
+    assert!((stroke - 51.1).abs() <= 0.1, "{stroke}\n{out}");
+    // The Y offset first grows, then shrinks (the arc of Figure 2.23).
+    let y: Vec<f64> = rows.iter().map(|r| r[2]).collect();
+    let top = y
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap()
+        .0;
+    assert!(top > 0 && top < y.len() - 1, "{y:?}");
+    assert!(y[..=top].windows(2).all(|w| w[0] < w[1]), "{y:?}");
+    assert!(y[top..].windows(2).all(|w| w[0] > w[1]), "{y:?}");
+    // The correction puts the wheel back: Y and Z carry the head.
+    for r in &rows {
+        assert!(r[4].abs() < 1e-4 && (r[5] + r[2]).abs() < 2e-4 && (r[6] + r[3]).abs() < 2e-4);
+    }
+    assert!(out.contains("51.0866 mm along Z"), "{out}");
+}
+
+#[test]
+fn wheel_svg_pressures_and_mistakes() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("wheel.svg");
+    let o = run(&[
+        "wheel",
+        "-m",
+        "mts1600",
+        "--pressure",
+        "2500",
+        "3475",
+        "--pressure",
+        "3300",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_exit(&o, 0);
+    let rows = wheel_rows(&stdout(&o));
+    assert_eq!(
+        rows.iter().map(|r| r[0]).collect::<Vec<_>>(),
+        [2500.0, 3475.0, 3300.0]
+    );
+    assert!(stdout(&o).contains("2500*"), "{}", stdout(&o));
+    assert_eq!(rows[1][2..4], [0.0, 0.0]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.ends_with("</svg>\n"));
+    assert!(text.contains("H1=2500") && text.contains("<polyline"));
+    // Written all or nothing: no temporary file is left behind.
+    assert_eq!(listing(dir.path()), ["wheel.svg"]);
+
+    // Without pressures: the calibration rows and the reference.
+    let o = run(&["wheel", "-m", "mts1600"]);
+    assert_exit(&o, 0);
+    let rows = wheel_rows(&stdout(&o));
+    assert_eq!(
+        rows.iter().map(|r| r[0]).collect::<Vec<_>>(),
+        [3000.0, 3250.0, 3475.0, 3600.0]
+    );
+
+    // A machine file of measured offsets, not one of the built-ins.
+    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let cut = src.find("link_length = 250").unwrap();
+    let file = dir.path().join("measured.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "{}offsets = [[3000, -1.12, -51.075], [3600, 0, 0]]\n",
+            &src[..cut]
+        ),
+    )
+    .unwrap();
+    let o = run(&["wheel", "-m", file.to_str().unwrap(), "--pressure", "3000"]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("1.1200 mm along Y, 51.0750 mm along Z"));
+
+    for (args, message) in [
+        (&["wheel", "-m", "trunnion-ac"][..], "has no pressure axis"),
+        (
+            &["wheel", "-m", "mts1600", "--table", "3600:3000:100"][..],
+            "STEP must be positive",
+        ),
+    ] {
+        let o = run(args);
+        assert_exit(&o, 1);
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    }
+}
+
+#[test]
+fn post_with_pressure_and_without_compensation() {
+    let post = |extra: &[&str]| {
+        let mut args = vec!["post", "examples/flat-part.cls", "-m", "mts1600"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    // Compensated: the wheel is 35.5 mm lower at H1 = 3000, Z goes up.
+    let o = post(&["--pressure", "3000"]);
+    assert_exit(&o, 0);
+    let out = stdout(&o);
+    assert!(out.contains("\nH1=3000\n"), "{out}");
+    assert!(!out.contains(FIGURE_28_BLOCK), "{out}");
+    assert!(out.contains("X=459.000 Y=10.452 Z396.899"), "{out}");
+    // Not compensated: the maker's program, with its pressure word, and a
+    // warning saying by how much the wheel is off.
+    let o = post(&["--pressure", "3000", "--no-pressure-compensation"]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains(FIGURE_28_BLOCK), "{}", stdout(&o));
+    assert!(stdout(&o).contains("\nH1=3000\n"));
+    assert!(stderr(&o).contains("not compensated"), "{}", stderr(&o));
+    // A dialect without a pressure word: bad input, nothing written.
+    let o = post(&["--pressure", "3000", "--dialect", "fanuc"]);
+    assert_exit(&o, 1);
+    assert!(stdout(&o).is_empty());
+    assert!(
+        stderr(&o).contains("cannot write the pressure word `H1`"),
+        "{}",
+        stderr(&o)
+    );
+    let o = post(&["--pressure", "nan"]);
+    assert_exit(&o, 1);
+}
+
+#[test]
+fn kinematics_at_a_pressure() {
+    let reference = triple(
+        &stdout(&run(&[
+            "fk",
+            "-m",
+            "mts1600",
+            "X=459",
+            "Y=8.807",
+            "Z=361.368",
+        ])),
+        "point",
+    );
+    for args in [
+        &[
+            "fk",
+            "-m",
+            "mts1600",
+            "X=459",
+            "Y=8.807",
+            "Z=361.368",
+            "H1=3000",
+        ][..],
+        &[
+            "fk",
+            "-m",
+            "mts1600",
+            "--pressure",
+            "3000",
+            "X=459",
+            "Y=8.807",
+            "Z=361.368",
+        ][..],
+    ] {
+        let o = run(args);
+        assert_exit(&o, 0);
+        let p = triple(&stdout(&o), "point");
+        // The wheel offset at the lower stop, from H1 = 3475: −y·dY + z·dZ.
+        let alpha = |a: f64| a.to_radians();
+        let r = alpha(-5.0 + 10.0 * 225.0 / 350.0);
+        let (dy, dz) = (
+            250.0 * (alpha(-6.73).cos() - r.cos()),
+            250.0 * (alpha(-6.73).sin() - r.sin()),
+        );
+        assert!((p[1] - (reference[1] - dy)).abs() < 1e-5, "{p:?}");
+        assert!((p[2] - (reference[2] + dz)).abs() < 1e-5, "{p:?}");
+    }
+    let o = run(&[
+        "ik",
+        "-m",
+        "mts1600",
+        "--pressure",
+        "3000",
+        "--point",
+        "-416,70.3931,11.3684",
+        "--axis",
+        "0,0,1",
+    ]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("396.898"), "{}", stdout(&o));
+    let o = run(&["fk", "-m", "trunnion-ac", "--pressure", "3000"]);
+    assert_exit(&o, 1);
+    assert!(
+        stderr(&o).contains("has no pressure axis"),
+        "{}",
+        stderr(&o)
+    );
 }

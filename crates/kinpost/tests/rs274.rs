@@ -86,6 +86,8 @@ struct Move {
     at: [f64; 6],
     /// Feed rate in force.
     rate: f64,
+    /// Value of analog output 0 (`M68 E0 Q…`) in force, if set.
+    aux: Option<f64>,
 }
 
 /// Runs rs274 on `program`; panics unless it parses cleanly.
@@ -133,6 +135,7 @@ fn run(rs274: &Path, program: &str, label: &str) -> Result<Vec<Move>, String> {
     }
     let mut moves = Vec::new();
     let mut rate = 0.0;
+    let mut aux = None;
     for line in stdout.lines() {
         // `   33 N..... NAME(args)`
         let Some(call) = line.split_whitespace().nth(2) else {
@@ -154,6 +157,12 @@ fn run(rs274: &Path, program: &str, label: &str) -> Result<Vec<Move>, String> {
         };
         match name {
             "SET_FEED_RATE" => rate = numbers()[0],
+            "SET_AUX_OUTPUT_VALUE" => {
+                let v = numbers();
+                if v[0] == 0.0 {
+                    aux = Some(v[1]);
+                }
+            }
             "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" => {
                 let v = numbers();
                 assert!(v.len() >= 6, "rs274 line: {line}");
@@ -161,6 +170,7 @@ fn run(rs274: &Path, program: &str, label: &str) -> Result<Vec<Move>, String> {
                     feed: name == "STRAIGHT_FEED",
                     at: [v[0], v[1], v[2], v[3], v[4], v[5]],
                     rate,
+                    aux,
                 });
             }
             "ARC_FEED" | "STRAIGHT_PROBE" | "RIGID_TAP" => {
@@ -621,4 +631,68 @@ fn inverse_time_block_times_are_the_cl_times() {
         time = 0.0;
     }
     assert!(checked > 20, "{checked}");
+}
+
+/// The grinding pressure through an analog output (the `[pressure]` example
+/// of DIALECTS.md for LinuxCNC, `M68 E0 Q…`): rs274 sets the output before
+/// the moves that grind at that pressure, and the moves are the CSV rows of
+/// the compensated program.
+#[test]
+fn pressure_word_as_an_analog_output() {
+    let Some(rs274) = interpreter("pressure_word_as_an_analog_output") else {
+        return;
+    };
+    let machine = mts1600();
+    let mut cl = String::new();
+    let mut gotos = 0;
+    for line in example("five-axis.cls").lines() {
+        if line.starts_with("GOTO/") {
+            match gotos {
+                0 => cl.push_str("PRESSURE/H1,3600\n"),
+                10 => cl.push_str("PRESSURE/3400\n"),
+                20 => cl.push_str("PRESSURE/H1,3500\n"),
+                _ => {}
+            }
+            gotos += 1;
+        }
+        cl.push_str(line);
+        cl.push('\n');
+    }
+    let source = format!(
+        "{}\n[pressure]\nprefix = \"M68 E0 Q\"\n",
+        Dialect::builtin_source("linuxcnc").unwrap()
+    );
+    let linuxcnc = Dialect::from_toml(&source, "linuxcnc-pressure.toml").unwrap();
+    let mut ngc = Vec::new();
+    post(
+        cl.as_bytes(),
+        &machine,
+        &linuxcnc,
+        &mut ngc,
+        &PostOptions::default(),
+    )
+    .unwrap();
+    let ngc = String::from_utf8(ngc).unwrap();
+    let csv = post_text(&machine, "csv", &cl, "pressure.cls");
+    let moves = interpret(&rs274, &ngc, "pressure through M68");
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // Every block moves (the path never stands still): one move per row.
+    assert_eq!(moves.len(), rows.len(), "{ngc}");
+    for (m, row) in moves.iter().zip(&rows) {
+        // line, motion, X A Y Z B C H1 feed; rs274: X Y Z A B C.
+        let v = |k: usize| row[k].parse::<f64>().unwrap();
+        let want = [v(2), v(4), v(5), v(3), v(6), 0.0];
+        for (got, want) in m.at.iter().zip(want) {
+            assert!(
+                (got - want).abs() <= 0.5e-4 + 0.5e-6 + 1e-9,
+                "{m:?} vs {row:?}"
+            );
+        }
+        assert_eq!(m.aux, Some(v(8)), "{m:?} vs {row:?}");
+    }
+    assert_eq!(ngc.matches("M68 E0 Q").count(), 3, "{ngc}");
 }

@@ -13,6 +13,7 @@ use toml::Spanned;
 use crate::model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, PostSettings, Prefer, Side, Tool, Wrap,
 };
+use crate::pressure::{PressureAxis, WheelModel};
 
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;
@@ -34,6 +35,7 @@ struct RawMachine {
     axis: Vec<RawAxis>,
     workpiece: Option<RawWorkpiece>,
     tool: Option<Spanned<RawTool>>,
+    pressure: Option<Spanned<RawPressure>>,
 }
 
 #[derive(Deserialize, Default)]
@@ -121,6 +123,21 @@ struct RawTool {
     axis: Spanned<Nums<3>>,
     reference: Option<Spanned<Nums<3>>>,
 }
+
+/// `[pressure]`: the grinding-pressure axis (DESIGN.md §2.2).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPressure {
+    name: Spanned<String>,
+    reference: Spanned<f64>,
+    plane: Spanned<Vec<Spanned<String>>>,
+    link_length: Option<Spanned<f64>>,
+    alpha_deg: Option<Table>,
+    offsets: Option<Table>,
+}
+
+/// A table of numbers, each row with its place in the file.
+type Table = Spanned<Vec<Spanned<Vec<f64>>>>;
 
 /// Exactly `N` numbers (serde's own arrays accept longer lists).
 #[derive(Clone, Copy)]
@@ -428,6 +445,10 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         }
         v
     });
+    let pressure = raw
+        .pressure
+        .as_ref()
+        .and_then(|p| check_pressure(&mut c, p, &axes));
 
     if !c.errors.is_empty() {
         return Err(Diagnostics(c.errors));
@@ -454,7 +475,219 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
             retract,
             singular_cone_deg,
         },
+        pressure,
     })
+}
+
+/// Checks the `[pressure]` table against the axes.
+fn check_pressure(
+    c: &mut Checker,
+    raw: &Spanned<RawPressure>,
+    axes: &[Axis],
+) -> Option<PressureAxis> {
+    let p = raw.get_ref();
+    let errors_before = c.errors.len();
+    let name = p.name.get_ref().trim().to_string();
+    if !name.starts_with(|ch: char| ch.is_ascii_alphabetic())
+        || !name.chars().all(|ch| ch.is_ascii_alphanumeric())
+    {
+        c.error(
+            p.name.span(),
+            "pressure name must be a letter followed by letters and digits (the NC word, e.g. \"H1\")",
+        );
+    } else if let Some(a) = axes.iter().find(|a| a.name.eq_ignore_ascii_case(&name)) {
+        c.error(
+            p.name.span(),
+            format!(
+                "pressure name `{name}` is also the name of axis `{}`",
+                a.name
+            ),
+        );
+    }
+    let reference = *p.reference.get_ref();
+    if !reference.is_finite() {
+        c.error(p.reference.span(), "reference must be a finite number");
+    }
+
+    // The linkage plane: two perpendicular linear axes.
+    let mut plane = [usize::MAX; 2];
+    let names = p.plane.get_ref();
+    if names.len() != 2 {
+        c.error(
+            p.plane.span(),
+            format!(
+                "plane names the two linear axes that span the linkage plane, e.g. [\"Y\", \"Z\"]; found {} names",
+                names.len()
+            ),
+        );
+    } else {
+        for (k, n) in names.iter().enumerate() {
+            let wanted = n.get_ref().trim();
+            match axes
+                .iter()
+                .position(|a| a.name.eq_ignore_ascii_case(wanted))
+            {
+                None => c.error(n.span(), format!("the machine has no axis `{wanted}`")),
+                Some(i) if axes[i].is_rotary() => c.error(
+                    n.span(),
+                    format!(
+                        "plane axis `{}` is rotary; the plane is spanned by linear axes",
+                        axes[i].name
+                    ),
+                ),
+                Some(i) => plane[k] = i,
+            }
+        }
+        if plane[0] != usize::MAX && plane[0] == plane[1] {
+            c.error(p.plane.span(), "plane names the same axis twice");
+            plane[1] = usize::MAX;
+        }
+        if plane.iter().all(|&i| i != usize::MAX) {
+            let (a, b) = (&axes[plane[0]], &axes[plane[1]]);
+            let cos = a.direction.dot(&b.direction);
+            if cos.abs() > UNIT_TOLERANCE {
+                c.error(
+                    p.plane.span(),
+                    format!(
+                        "plane axes `{}` and `{}` must be perpendicular (they are {}° apart)",
+                        a.name,
+                        b.name,
+                        short(a.direction.angle(&b.direction).to_degrees(), 3)
+                    ),
+                );
+            }
+        }
+    }
+
+    let model = match (&p.link_length, &p.alpha_deg, &p.offsets) {
+        (Some(l), Some(t), None) => {
+            let length = *l.get_ref();
+            if !(length.is_finite() && length > 0.0) {
+                c.error(l.span(), "link_length must be a positive number of mm");
+            }
+            let rows = table::<2>(c, t, "alpha_deg", "[pressure, angle in degrees]");
+            if rows.iter().any(|r| r[1].abs() > 180.0) {
+                c.error(t.span(), "alpha_deg angles must lie within ±180°");
+            }
+            Some(WheelModel::Linkage {
+                link_length: length,
+                alpha_deg: rows,
+            })
+        }
+        (None, None, Some(t)) => Some(WheelModel::Offsets(table::<3>(
+            c,
+            t,
+            "offsets",
+            "[pressure, offset along the first plane axis, offset along the second]",
+        ))),
+        (_, _, Some(t)) => {
+            c.error(
+                t.span(),
+                "give either `link_length` with `alpha_deg` (the four-bar linkage) or `offsets` (measured offsets), not both",
+            );
+            None
+        }
+        (Some(l), None, None) => {
+            c.error(
+                l.span(),
+                "`link_length` needs `alpha_deg`, the calibration [[pressure, angle], ...]",
+            );
+            None
+        }
+        (None, Some(t), None) => {
+            c.error(
+                t.span(),
+                "`alpha_deg` needs `link_length`, the input link length in mm",
+            );
+            None
+        }
+        (None, None, None) => {
+            c.error(
+                raw.span(),
+                "[pressure] needs `link_length` with `alpha_deg` (the four-bar linkage) or `offsets` (measured offsets)",
+            );
+            None
+        }
+    };
+    // The tool point was measured at the reference: it must lie on the
+    // calibration (a reference beyond a stop is ambiguous; a row on the stop
+    // says what is meant).
+    fn ends<const N: usize>(rows: &[[f64; N]]) -> Option<(f64, f64)> {
+        (rows.len() >= 2).then(|| (rows[0][0], rows[rows.len() - 1][0]))
+    }
+    let ends = match &model {
+        Some(WheelModel::Linkage { alpha_deg, .. }) => ends(alpha_deg),
+        Some(WheelModel::Offsets(rows)) => ends(rows),
+        None => None,
+    };
+    if let Some((lo, hi)) = ends
+        && reference.is_finite()
+        && (reference < lo || reference > hi)
+    {
+        c.error(
+            p.reference.span(),
+            format!(
+                "reference {} is outside the calibration ({} .. {}); if the wheel is on a stop there, add a row at {} with the stop's value",
+                short(reference, 9),
+                short(lo, 9),
+                short(hi, 9),
+                short(reference, 9)
+            ),
+        );
+    }
+    if c.errors.len() > errors_before {
+        return None;
+    }
+    Some(PressureAxis {
+        name,
+        reference,
+        directions: [axes[plane[0]].direction, axes[plane[1]].direction],
+        plane,
+        model: model?,
+    })
+}
+
+/// The rows of a calibration table: `N` finite numbers each, at least two
+/// rows, strictly increasing in the first column (the pressure).
+fn table<const N: usize>(c: &mut Checker, t: &Table, key: &str, row: &str) -> Vec<[f64; N]> {
+    let mut rows: Vec<[f64; N]> = Vec::with_capacity(t.get_ref().len());
+    for r in t.get_ref() {
+        let Ok(values) = <[f64; N]>::try_from(r.get_ref().as_slice()) else {
+            c.error(
+                r.span(),
+                format!(
+                    "a row of `{key}` is {row}: expected {N} numbers, found {}",
+                    r.get_ref().len()
+                ),
+            );
+            continue;
+        };
+        if values.iter().any(|v| !v.is_finite()) {
+            c.error(r.span(), format!("a row of `{key}` must be finite numbers"));
+            continue;
+        }
+        if let Some(before) = rows.last()
+            && values[0] <= before[0]
+        {
+            c.error(
+                r.span(),
+                format!(
+                    "`{key}` must be sorted by pressure without repeats: {} follows {}",
+                    short(values[0], 9),
+                    short(before[0], 9)
+                ),
+            );
+            continue;
+        }
+        rows.push(values);
+    }
+    if t.get_ref().len() < 2 {
+        c.error(
+            t.span(),
+            format!("`{key}` needs at least two rows (the calibration between the stops)"),
+        );
+    }
+    rows
 }
 
 /// Checks one axis; also says whether its direction is usable.
@@ -784,6 +1017,67 @@ axis = [0, 0, 1]
             e.contains("three free rotary axes need a tool `reference`"),
             "{e}"
         );
+    }
+
+    const PRESSURE: &str = "[pressure]\nname = \"H1\"\nreference = 3475\nplane = [\"Y\", \"z\"]\n";
+
+    #[test]
+    fn pressure_section_loads() {
+        let m = machine_from_toml(GOOD, "m.toml").unwrap();
+        assert!(m.pressure.is_none());
+        let src =
+            format!("{GOOD}{PRESSURE}link_length = 250\nalpha_deg = [[3000, -6.73], [3600, 5]]\n");
+        let p = machine_from_toml(&src, "m.toml").unwrap().pressure.unwrap();
+        assert_eq!(
+            (p.name.as_str(), p.reference, p.plane),
+            ("H1", 3475.0, [1, 2])
+        );
+        assert_eq!(p.directions, [Vector3::y(), Vector3::z()]);
+        assert_eq!(
+            p.model,
+            WheelModel::Linkage {
+                link_length: 250.0,
+                alpha_deg: vec![[3000.0, -6.73], [3600.0, 5.0]]
+            }
+        );
+        // Measured offsets, the reference on the upper stop.
+        let src = format!("{GOOD}{PRESSURE}offsets = [[3000, -1.12, -51.075], [3600, 0, 0]]\n")
+            .replace("3475", "3600");
+        let p = machine_from_toml(&src, "m.toml").unwrap().pressure.unwrap();
+        assert_eq!(p.plane_offset(4000.0), [0.0, 0.0]);
+        assert_eq!(p.plane_offset(3000.0), [-1.12, -51.075]);
+        // A reference beyond the calibration is ambiguous: an error.
+        let e = err(&src.replace("= 3600", "= 4000"));
+        assert!(
+            e.contains("reference 4000 is outside the calibration (3000 .. 3600)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn pressure_mistakes() {
+        let linkage = "link_length = 250\nalpha_deg = [[3000, -6.73], [3600, 5]]\n";
+        let e = err(&format!("{GOOD}{PRESSURE}"));
+        assert!(e.contains("[pressure] needs `link_length`"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("\"z\"]", "\"Q\"]"));
+        assert!(e.contains("the machine has no axis `Q`"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("[\"Y\", \"z\"]", "[\"Y\"]"));
+        assert!(e.contains("found 1 names"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("\"z\"]", "\"y\"]"));
+        assert!(e.contains("plane names the same axis twice"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("250", "-1"));
+        assert!(e.contains("link_length must be a positive"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("\"H1\"", "\"1H\""));
+        assert!(e.contains("pressure name must be a letter"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("5]]", "500]]"));
+        assert!(e.contains("within ±180°"), "{e}");
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}").replace("3600", "3000"));
+        assert!(
+            e.contains("sorted by pressure without repeats: 3000 follows 3000"),
+            "{e}"
+        );
+        let e = err(&format!("{GOOD}{PRESSURE}{linkage}speed = 1\n"));
+        assert!(e.contains("unknown key `speed`"), "{e}");
     }
 
     #[test]

@@ -17,6 +17,7 @@ pub mod builtin;
 mod file;
 mod kinematics;
 mod model;
+mod pressure;
 pub mod subproblems;
 
 pub use file::machine_from_toml;
@@ -24,3 +25,4 @@ pub use kinematics::{IkError, Joints, Kinematics, Singularity, Solution, Violati
 pub use model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,
 };
+pub use pressure::{Clamp, PressureAxis, WheelModel, interpolate};

@@ -170,6 +170,9 @@ pub struct Machine {
     pub workpiece_origin: Vector3<f64>,
     pub tool: Tool,
     pub post: PostSettings,
+    /// A process axis that moves the tool point (the grinding pressure H1),
+    /// if the machine has one; see [`Machine::at_pressure`].
+    pub pressure: Option<crate::PressureAxis>,
 }
 
 /// A tool pose in the part frame: what one CL point asks for.

@@ -21,6 +21,15 @@ fn test_machines() -> Vec<Machine> {
         .collect();
     assert!(!six.is_empty());
     out.extend(six);
+    // Built-ins with a pressure axis, with the wheel held at both ends of
+    // its calibration (the tool point moved by the wheel offset).
+    let pressed: Vec<Machine> = out
+        .iter()
+        .filter_map(|m| m.pressure.as_ref().map(|p| (m, p.range())))
+        .flat_map(|(m, [lo, hi])| [m.at_pressure(lo), m.at_pressure(hi)])
+        .collect();
+    assert!(!pressed.is_empty());
+    out.extend(pressed);
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/machines");
     let mut files: Vec<_> = std::fs::read_dir(dir)
         .unwrap()

@@ -225,6 +225,8 @@ pub struct Dialect {
     /// Over `rotary`, for rotary axes that turn without end.
     endless: PartialWord,
     axis: BTreeMap<String, PartialWord>,
+    /// The pressure word (`[pressure]`), when the dialect can write one.
+    pressure: Option<PartialWord>,
     pub(crate) feed: FeedFormat,
     pub(crate) motion: MotionWords,
     pub(crate) numbering: Numbering,
@@ -338,6 +340,30 @@ impl Dialect {
         for w in raw.axis.values() {
             check_word(w, &mut err);
         }
+        if let Some(p) = &raw.pressure {
+            let w = p.get_ref();
+            check_word(w, &mut err);
+            if w.modal == Some(false) {
+                err(
+                    p.span(),
+                    "the pressure word is always modal (written when its value changes): leave `modal` out".into(),
+                );
+            }
+            if let Some(m) = &w.modulo {
+                err(
+                    m.span(),
+                    "`modulo` does not apply to the pressure word".into(),
+                );
+            }
+            if kind == DialectKind::Words
+                && w.prefix.as_ref().is_some_and(|p| p.get_ref().is_empty())
+            {
+                err(
+                    w.prefix.as_ref().map_or(p.span(), |p| p.span()),
+                    "the pressure word needs a `prefix` (e.g. \"{name}=\" for `H1=3000`)".into(),
+                );
+            }
+        }
         let raw_feed_word = raw.feed.as_word();
         check_word(&raw_feed_word, &mut err);
 
@@ -375,6 +401,13 @@ impl Dialect {
                 w,
                 &[linear.over(&o).resolve(name), rotary.over(&o).resolve(name)],
             );
+        }
+        let pressure = raw
+            .pressure
+            .as_ref()
+            .map(|p| PartialWord::pressure_base(kind).over(&PartialWord::from(p.get_ref())));
+        if let (Some(p), Some(w)) = (&pressure, &raw.pressure) {
+            whole(w.get_ref(), &[p.resolve("H1")]);
         }
         let feed_word = PartialWord::feed_base()
             .over(&PartialWord::from(&raw_feed_word))
@@ -497,6 +530,13 @@ impl Dialect {
             rotary,
             endless,
             axis,
+            pressure: match kind {
+                // A table always has the pressure column.
+                DialectKind::Csv => {
+                    Some(pressure.unwrap_or_else(|| PartialWord::pressure_base(kind)))
+                }
+                DialectKind::Words => pressure,
+            },
             feed: FeedFormat {
                 word: feed_word,
                 rapid: raw.feed.rapid,
@@ -571,9 +611,25 @@ impl Dialect {
         self.templates.get(&kind).map(String::as_str)
     }
 
+    /// Whether the dialect can write a pressure word (`[pressure]`; a CSV
+    /// table always can: it is a column).
+    pub fn writes_pressure(&self) -> bool {
+        self.pressure.is_some()
+    }
+
     /// The word format of one machine axis: built-in default, then
-    /// `[linear]` or `[rotary]`, then `[axis.NAME]`.
+    /// `[linear]` or `[rotary]`, then `[axis.NAME]`. For the pressure word
+    /// ([`AxisSpec::pressure`]): the `[pressure]` table over the defaults
+    /// `{name}=`, no decimals (whatever a dialect without `[pressure]`
+    /// would write; see [`Dialect::writes_pressure`]).
     pub fn word_format(&self, axis: &AxisSpec) -> WordFormat {
+        if axis.pressure {
+            return self
+                .pressure
+                .clone()
+                .unwrap_or_else(|| PartialWord::pressure_base(self.kind))
+                .resolve(&axis.name);
+        }
         let kind_default = match (axis.rotary, axis.endless) {
             (true, true) => self.rotary.over(&self.endless),
             (true, false) => self.rotary.clone(),
@@ -632,6 +688,24 @@ impl PartialWord {
             plus_sign: Some(false),
             modulo: None,
             modal: Some(false),
+        }
+    }
+
+    /// Defaults of the pressure word: `H1=3000` (a CSV column: `3000`).
+    fn pressure_base(kind: DialectKind) -> PartialWord {
+        match kind {
+            DialectKind::Words => PartialWord {
+                prefix: Some("{name}=".into()),
+                decimals: Some(0),
+                trailing_zeros: Some(TrailingZeros::Trim),
+                modal: Some(true),
+                ..PartialWord::base(kind)
+            },
+            DialectKind::Csv => PartialWord {
+                decimals: Some(3),
+                trailing_zeros: Some(TrailingZeros::Trim),
+                ..PartialWord::base(kind)
+            },
         }
     }
 
@@ -714,6 +788,7 @@ struct RawDialect {
     endless: RawWord,
     #[serde(default)]
     axis: BTreeMap<String, RawWord>,
+    pressure: Option<Spanned<RawWord>>,
     #[serde(default)]
     feed: RawFeed,
     #[serde(default)]

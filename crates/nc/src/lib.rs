@@ -51,6 +51,12 @@ pub struct AxisSpec {
     /// controller): dialects may write it with shortest-path words such as
     /// Sinumerik's `DC(…)` (the `[endless]` word format).
     pub endless: bool,
+    /// Not an axis but the process pressure of the machine (belt grinding
+    /// `H1`): formatted by the dialect's `[pressure]` table, written on a
+    /// line of its own before the first motion block that has a new value,
+    /// read back as a modal word. A block value of NaN means no pressure
+    /// is programmed: nothing is written (an empty CSV field).
+    pub pressure: bool,
 }
 
 impl AxisSpec {
@@ -61,6 +67,7 @@ impl AxisSpec {
             rotary: false,
             fixed: false,
             endless: false,
+            pressure: false,
         }
     }
 
@@ -71,6 +78,7 @@ impl AxisSpec {
             rotary: true,
             fixed: false,
             endless: false,
+            pressure: false,
         }
     }
 
@@ -79,6 +87,14 @@ impl AxisSpec {
         AxisSpec {
             endless: true,
             ..AxisSpec::rotary(name)
+        }
+    }
+
+    /// The process pressure word (e.g. `H1`; see the field `pressure`).
+    pub fn pressure_word(name: &str) -> AxisSpec {
+        AxisSpec {
+            pressure: true,
+            ..AxisSpec::linear(name)
         }
     }
 

@@ -17,7 +17,9 @@ pub struct ReadBlock {
     /// Rapid or feed.
     pub motion: Motion,
     /// Axis values in machine order, with modal values carried over;
-    /// `None` for an axis not programmed so far (e.g. a fixed axis).
+    /// `None` for an axis not programmed so far (e.g. a fixed axis). The
+    /// pressure word ([`AxisSpec::pressure`]) is read like a modal axis
+    /// word, also from a line of its own.
     pub axes: Vec<Option<f64>>,
     /// Feed in force (the last feed word), `None` before the first.
     pub feed: Option<f64>,
@@ -68,6 +70,8 @@ pub fn read_program_full(
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Token {
     Axis(usize),
+    /// The pressure word: modal, not a motion by itself.
+    Pressure(usize),
     Feed,
     Motion(Motion),
     /// Rapid-feed literal (`FMAX`): this block is rapid.
@@ -100,12 +104,19 @@ impl WordsReader {
     fn new(dialect: &Dialect, axes: &[AxisSpec]) -> WordsReader {
         let mut candidates = Vec::new();
         for (i, a) in axes.iter().enumerate() {
+            if a.pressure && !dialect.writes_pressure() {
+                continue;
+            }
             let wf = dialect.word_format(a);
             candidates.push(Candidate {
                 text: wf.prefix,
                 suffix: wf.suffix,
                 numeric: true,
-                token: Token::Axis(i),
+                token: if a.pressure {
+                    Token::Pressure(i)
+                } else {
+                    Token::Axis(i)
+                },
             });
         }
         let feed = &dialect.feed;
@@ -209,6 +220,7 @@ impl WordsReader {
                         state[i] = Some(v);
                         has_axis = true;
                     }
+                    Token::Pressure(i) => state[i] = Some(v),
                     Token::Feed => feed = Some(v),
                     Token::Motion(m) => motion = m,
                     Token::RapidLiteral => block_motion = Some(Motion::Rapid),

@@ -147,6 +147,9 @@ pub struct NcWriter<W: Write> {
     formats: Vec<Formatter>,
     /// Words written in a block, in output order.
     words: Vec<Word>,
+    /// The pressure word of an NC dialect, written on its own line (see
+    /// [`AxisSpec::pressure`]).
+    pressure: Option<PressureWord>,
     feed: Word,
     /// Whether the dialect's feed word is modal (feed per minute).
     feed_modal: bool,
@@ -167,6 +170,14 @@ pub struct NcWriter<W: Write> {
     vars: BTreeMap<String, Value>,
     blocks: u64,
     csv_header_done: bool,
+}
+
+/// The pressure word: its format and state (modal), and whether the
+/// dialect can write it at all.
+struct PressureWord {
+    word: Word,
+    name: String,
+    writable: bool,
 }
 
 fn bytes(s: &str) -> Box<[u8]> {
@@ -199,8 +210,20 @@ impl<W: Write> NcWriter<W> {
             }
         }
         let sep = &dialect.block.separator;
+        // In an NC program the pressure word has a line of its own; in a
+        // table it is a column.
+        let pressure = axes
+            .iter()
+            .position(|a| a.pressure)
+            .filter(|_| words_kind)
+            .map(|i| PressureWord {
+                word: Word::new(i, sep, &dialect.word_format(&axes[i]), true),
+                name: axes[i].name.clone(),
+                writable: dialect.writes_pressure(),
+            });
         let words = order
             .into_iter()
+            .filter(|&i| !(words_kind && axes[i].pressure))
             .filter(|&i| !words_kind || dialect.block.write_fixed || !axes[i].fixed)
             .map(|i| {
                 let wf = dialect.word_format(&axes[i]);
@@ -236,6 +259,7 @@ impl<W: Write> NcWriter<W> {
             axis_specs: axes.to_vec(),
             formats,
             words,
+            pressure,
             feed_modal: feed.modal,
             feed,
             last_feed: None,
@@ -371,14 +395,6 @@ impl<W: Write> NcWriter<W> {
         self.feed.modal = self.feed_modal && !on;
         self.last_feed = None;
         Ok(())
-    }
-
-    /// Process pressure (template `pressure` with `pressure`).
-    pub fn pressure(&mut self, value: f64) -> Result<(), NcError> {
-        self.command(
-            TemplateKind::Pressure,
-            vec![("pressure", Value::from(value))],
-        )
     }
 
     /// Renders a template source with the program variables plus `vars`
@@ -537,6 +553,9 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv {
             return self.csv_block(block);
         }
+        if self.pressure.is_some() {
+            self.pressure_line(block.axes)?;
+        }
         // Pass 1: quantize, decide what is written.
         let mut any = false;
         for (k, w) in self.words.iter().enumerate() {
@@ -626,6 +645,61 @@ impl<W: Write> NcWriter<W> {
         self.out.write_all(line.as_slice())
     }
 
+    /// The pressure word on its own line, when the block's pressure differs
+    /// from the last one written (then the `pressure` template, if any, e.g.
+    /// a dwell while the wheel settles). NaN: no pressure programmed.
+    fn pressure_line(&mut self, axes: &[f64]) -> io::Result<()> {
+        let Some(p) = &self.pressure else {
+            return Ok(());
+        };
+        let (index, value) = (p.word.index, axes[p.word.index]);
+        if value.is_nan() {
+            return Ok(());
+        }
+        if !p.writable {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "dialect `{}` cannot write the pressure word `{}`: it has no [pressure] table",
+                    self.dialect_name, p.name
+                ),
+            ));
+        }
+        let n = match p.word.fmt.units(value) {
+            Ok(n) => n,
+            Err(e) => return Err(self.bad_value(index, value, e)),
+        };
+        if p.word.known && p.word.last == n {
+            return Ok(());
+        }
+        let mut number = std::mem::take(&mut self.buf);
+        number.clear();
+        if self.numbering.enabled && self.numbering.commands {
+            self.number_into(&mut number);
+        }
+        self.line.len = 0;
+        self.line.put(&number);
+        self.buf = number;
+        let Some(p) = &mut self.pressure else {
+            unreachable!("checked above")
+        };
+        p.word.last = n;
+        p.word.known = true;
+        self.line.put_word(&p.word, n, true);
+        self.line.put(&self.eol);
+        self.out.write_all(self.line.as_slice())?;
+        let written = p.word.fmt.quantize(value);
+        let name = Value::from(p.name.as_str());
+        self.command(
+            TemplateKind::Pressure,
+            vec![("pressure", Value::from(written)), ("pressure_word", name)],
+        )
+        .map_err(|e| match e {
+            NcError::Io(e) => e,
+            other => io::Error::other(other.to_string()),
+        })
+    }
+
     fn csv_header(&mut self) -> io::Result<()> {
         if self.csv_header_done {
             return Ok(());
@@ -660,6 +734,11 @@ impl<W: Write> NcWriter<W> {
         line.put(block.motion.as_str().as_bytes());
         for w in &self.words {
             let v = block.axes[w.index];
+            if v.is_nan() && self.axis_specs[w.index].pressure {
+                // No pressure programmed: an empty field.
+                line.put(&self.sep);
+                continue;
+            }
             let n = match w.fmt.units(v) {
                 Ok(n) => n,
                 Err(e) => {

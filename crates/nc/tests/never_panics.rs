@@ -6,12 +6,13 @@
 use kinpost_nc::{AxisSpec, Block, Dialect, Motion, NcWriter, ProgramInfo, read_program};
 use proptest::prelude::*;
 
-fn axes() -> [AxisSpec; 4] {
+fn axes() -> [AxisSpec; 5] {
     [
         AxisSpec::linear("X"),
         AxisSpec::endless("A"),
         AxisSpec::rotary("B"),
         AxisSpec::rotary("C").fixed(),
+        AxisSpec::pressure_word("H1"),
     ]
 }
 
@@ -21,7 +22,13 @@ fn program(name: &str) -> String {
     let mut w = NcWriter::new(&d, &axes(), Vec::new());
     w.header(&ProgramInfo::default(), None).unwrap();
     for k in 0..4 {
-        let v = [k as f64 * 1.25, 350.0 + k as f64 * 7.0, -12.5, 0.0];
+        // The pressure: none, then changing, where the dialect writes one.
+        let h1 = if k == 0 || !d.writes_pressure() {
+            f64::NAN
+        } else {
+            3000.0 + 125.0 * (k / 2) as f64
+        };
+        let v = [k as f64 * 1.25, 350.0 + k as f64 * 7.0, -12.5, 0.0, h1];
         let motion = if k == 0 { Motion::Rapid } else { Motion::Feed };
         w.block(&Block {
             cl_line: Some(k + 1),
@@ -66,7 +73,7 @@ fn mutated(text: &str, edits: &[(usize, u8, u8)]) -> String {
 fn exercise(dialect: &Dialect) {
     let mut w = NcWriter::new(dialect, &axes(), Vec::new());
     let _ = w.header(&ProgramInfo::default(), None);
-    let v = [1.0, -400.0, 12.25, 0.0];
+    let v = [1.0, -400.0, 12.25, 0.0, 3000.0];
     let _ = w.block(&Block {
         cl_line: None,
         motion: Motion::Feed,

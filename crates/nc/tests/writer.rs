@@ -1,8 +1,8 @@
 use std::collections::BTreeMap;
 
 use kinpost_nc::{
-    AxisSpec, Block, Dialect, Motion, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
-    check_template, read_program, read_program_full,
+    AxisSpec, Block, Dialect, Motion, NcError, NcWriter, ProgramInfo, Spindle, check_template,
+    read_program, read_program_full,
 };
 
 /// Machine axes of the MTS1600-500-6NC in chain order (DESIGN §2.1).
@@ -246,7 +246,7 @@ fn seed_header_as_machine_override() {
 }
 
 #[test]
-fn commands_tool_spindle_coolant_pressure() {
+fn commands_tool_spindle_coolant() {
     let dialect = Dialect::builtin("sinumerik").unwrap();
     let axes = mts_axes();
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
@@ -256,15 +256,163 @@ fn commands_tool_spindle_coolant_pressure() {
     w.coolant(Some("flood")).unwrap();
     w.coolant(Some("mist")).unwrap();
     w.coolant(None).unwrap();
-    w.pressure(3000.0).unwrap();
     w.spindle(Spindle::Off).unwrap();
     w.comment("posted by (kinpost)\nline two").unwrap();
     w.insert("G642 U1030").unwrap();
     assert_eq!(
         text(w),
-        "T3\nM6\nS3013 M03\nS3000 M04\nM08\nM07\nM09\nH1=3000\nM05\n; posted by (kinpost) line two\nG642 U1030\n"
+        "T3\nM6\nS3013 M03\nS3000 M04\nM08\nM07\nM09\nM05\n; posted by (kinpost) line two\nG642 U1030\n"
     );
-    assert!(dialect.template(TemplateKind::Pressure).is_some());
+}
+
+/// The MTS1600 axes and its grinding-pressure word.
+fn mts_axes_with_pressure() -> Vec<AxisSpec> {
+    let mut axes = mts_axes();
+    axes.push(AxisSpec::pressure_word("H1"));
+    axes
+}
+
+/// One feed block at X = `x` with pressure `h1` (NaN: none programmed).
+fn pressure_block<W: std::io::Write>(w: &mut NcWriter<W>, x: f64, h1: f64) {
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[x, 0.0, 8.807, 361.368, 0.0, 0.0, h1],
+        feed: Some(250.0),
+    })
+    .unwrap();
+}
+
+#[test]
+fn pressure_word_on_its_own_line_when_it_changes() {
+    let dialect = Dialect::builtin("sinumerik").unwrap();
+    assert!(dialect.writes_pressure());
+    let axes = mts_axes_with_pressure();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    for (x, h1) in [
+        (1.0, f64::NAN),
+        (2.0, 3000.0),
+        (3.0, 3000.0),
+        (4.0, 3000.4), // written as 3000: no change
+        (5.0, 3250.0),
+    ] {
+        pressure_block(&mut w, x, h1);
+    }
+    let out = text(w);
+    let body = |x: u8| format!("X={x}.000 Y=8.807 Z361.368 B0.000 A=DC(0.000)");
+    assert_eq!(
+        out,
+        format!(
+            "{} F250\nH1=3000\n{}\n{}\n{}\nH1=3250\n{}\n",
+            body(1),
+            body(2),
+            body(3),
+            body(4),
+            body(5)
+        )
+    );
+    assert_eq!(w_quantized_pressure(&dialect, 3000.4), 3000.0);
+    // Read back: the pressure is modal, and its own line is not a block.
+    let blocks = read_program(&dialect, &axes, "p.mpf", &out).unwrap();
+    let pressures: Vec<Option<f64>> = blocks.iter().map(|b| b.axes[6]).collect();
+    assert_eq!(
+        pressures,
+        vec![None, Some(3000.0), Some(3000.0), Some(3000.0), Some(3250.0)]
+    );
+}
+
+fn w_quantized_pressure(dialect: &Dialect, v: f64) -> f64 {
+    let w = NcWriter::new(dialect, &mts_axes_with_pressure(), Vec::new());
+    assert_eq!(
+        w.quantized(6, v),
+        dialect.quantize(&AxisSpec::pressure_word("H1"), v)
+    );
+    w.quantized(6, v)
+}
+
+#[test]
+fn pressure_word_numbering_template_and_dialects_without_it() {
+    let src = r##"
+name = "numbered"
+extension = "nc"
+[numbering]
+enabled = true
+[pressure]
+prefix = "#{name}="
+decimals = 1
+[templates]
+pressure = "G04 F2 ; {{ pressure_word }} {{ pressure }}"
+"##;
+    let dialect = Dialect::from_toml(src, "numbered.toml").unwrap();
+    let mut axes = mts_axes_with_pressure();
+    axes[6] = AxisSpec::pressure_word("P");
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    pressure_block(&mut w, 1.0, 2.25);
+    let out = text(w);
+    assert!(
+        out.starts_with("N10 #P=2.2\nN20 G04 F2 ; P 2.2\nN30 G1 X1.000"),
+        "{out}"
+    );
+    let blocks = read_program(&dialect, &axes, "n.nc", &out).unwrap();
+    assert_eq!(blocks.len(), 1);
+    assert_eq!(blocks[0].axes[6], Some(2.2));
+
+    // Fanuc has no pressure word: fine while none is programmed, an error
+    // naming the dialect and the word as soon as one is.
+    let fanuc = Dialect::builtin("fanuc").unwrap();
+    assert!(!fanuc.writes_pressure());
+    let axes = mts_axes_with_pressure();
+    let mut w = NcWriter::new(&fanuc, &axes, Vec::new());
+    pressure_block(&mut w, 1.0, f64::NAN);
+    let e = w
+        .block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &[1.0, 0.0, 8.807, 361.368, 0.0, 0.0, 3000.0],
+            feed: None,
+        })
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("dialect `fanuc` cannot write the pressure word `H1`"),
+        "{e}"
+    );
+    assert!(text(w).starts_with("G01 X1.000 Y8.807"));
+}
+
+#[test]
+fn pressure_table_mistakes() {
+    let base = "name = \"d\"\nextension = \"nc\"\n[pressure]\n";
+    let e = Dialect::from_toml(&format!("{base}modal = false\n"), "d.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("always modal"), "{e}");
+    let e = Dialect::from_toml(&format!("{base}prefix = \"\"\n"), "d.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the pressure word needs a `prefix`"), "{e}");
+    let e = Dialect::from_toml(&format!("{base}modulo = 360.0\n"), "d.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`modulo` does not apply"), "{e}");
+}
+
+#[test]
+fn csv_pressure_column() {
+    let dialect = Dialect::builtin("csv").unwrap();
+    assert!(dialect.writes_pressure());
+    let axes = mts_axes_with_pressure();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    pressure_block(&mut w, 1.0, f64::NAN);
+    pressure_block(&mut w, 2.0, 3000.25);
+    let out = text(w);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "line,motion,X,A,Y,Z,B,C,H1,feed");
+    assert!(lines[1].ends_with(",0.000000,,250.000000"), "{out}");
+    assert!(lines[2].ends_with(",0.000000,3000.25,250.000000"), "{out}");
+    let blocks = read_program(&dialect, &axes, "p.csv", &out).unwrap();
+    assert_eq!(blocks[0].axes[6], None);
+    assert_eq!(blocks[1].axes[6], Some(3000.25));
 }
 
 #[test]
@@ -629,4 +777,46 @@ fn sinumerik_dc_only_for_endless_axes() {
     assert_eq!(w.quantized(2, -90.0), 270.0);
     let out = text(w);
     assert!(out.contains("X=1.000 A-30.000 C=DC(270.000) F100"), "{out}");
+}
+
+/// The `[pressure]` examples of DIALECTS.md, added to the built-ins that
+/// have none: written on their own line, read back by the same dialect.
+#[test]
+fn documented_pressure_tables() {
+    for (name, table, line) in [
+        (
+            "fanuc",
+            "prefix = \"#500=\"\ntrailing_zeros = \"point\"\n",
+            "#500=3100.",
+        ),
+        (
+            "heidenhain",
+            "prefix = \"FN 0: Q100 = \"\nplus_sign = true\n",
+            " FN 0: Q100 = +3100\n",
+        ),
+        ("linuxcnc", "prefix = \"M68 E0 Q\"\n", "\nM68 E0 Q3100\n"),
+    ] {
+        let source = format!(
+            "{}\n[pressure]\n{table}",
+            Dialect::builtin_source(name).unwrap()
+        );
+        let dialect = Dialect::from_toml(&source, &format!("{name}-pressure.toml"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(dialect.writes_pressure());
+        let axes = mts_axes_with_pressure();
+        let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+        w.header(&ProgramInfo::default(), None).unwrap();
+        for (x, h1) in [(1.0, f64::NAN), (2.0, 3000.0), (3.0, 3000.0), (4.0, 3100.0)] {
+            pressure_block(&mut w, x, h1);
+        }
+        let out = text(w);
+        assert!(out.contains(line), "{name}:\n{out}");
+        let blocks = read_program(&dialect, &axes, "p", &out).unwrap();
+        let pressures: Vec<Option<f64>> = blocks.iter().map(|b| b.axes[6]).collect();
+        assert_eq!(
+            pressures,
+            [None, Some(3000.0), Some(3000.0), Some(3100.0)],
+            "{name}:\n{out}"
+        );
+    }
 }

@@ -22,11 +22,6 @@ const UNWIND: f64 = 1e4;
 const STEP_FLOOR_DEG: f64 = 1.0;
 /// No rotary axis turns by half a turn or more between two points of a cut.
 const STEP_CEILING_DEG: f64 = 179.0;
-/// Largest step of the rotary axis that is not singular, per degree of
-/// tool-axis turn. With perpendicular axes it sets the angle between the tool
-/// axis and the singular direction, so its step is at most the turn; the
-/// factor leaves room for axes at other angles.
-const TILT_RATE: f64 = 4.0;
 
 /// How two consecutive points are connected.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -162,14 +157,21 @@ impl Costs {
                 turn_deg,
                 across_singular,
             } => {
-                let bound = |rate: f64| (turn_deg * rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
+                // Along one branch of the closed form a rotary angle turns at
+                // most 1/sin(cone) times as fast as the tool axis outside the
+                // singular cone; whole turns (360° equivalents) never pass.
+                // The branches meet only at the singular direction (and at
+                // the edge of the reachable directions of axes at other
+                // angles than 90°, where the steps are small): a switch
+                // elsewhere is a flip.
+                let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
+                let switch = ba != bb;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();
                     let limit = match self.singular_axis {
                         Some(i) if i == r.index && across_singular => 180.0 + 1e-9,
-                        Some(i) if i == r.index => bound(self.step_rate),
-                        Some(_) => bound(TILT_RATE),
-                        None => bound(self.step_rate),
+                        _ if switch && !across_singular => STEP_FLOOR_DEG,
+                        _ => bound,
                     };
                     if step > limit {
                         continuous = false;
@@ -223,7 +225,12 @@ mod tests {
         };
         let (_, ok) = costs.transition(&joints(0.4, 10.0), 0, &joints(0.4, 190.0), 0, across);
         assert!(ok);
-        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(-40.0, 10.0), 0, across);
+        // A switch of branch away from the pole is a flip, however small
+        // the turn of the tool axis.
+        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(38.0, 12.0), 1, cut);
+        assert!(!ok);
+        // Whole turns never pass.
+        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(40.0, 370.0), 0, across);
         assert!(!ok);
         // Free moves only cost travel.
         let (c, ok) = costs.transition(&joints(0.0, 0.0), 0, &joints(90.0, 170.0), 1, Link::Free);
