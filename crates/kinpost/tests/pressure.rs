@@ -365,7 +365,7 @@ proptest! {
             ));
             want.push(Some((pose, pressure)));
         }
-        prop_assert!(tilted > 20, "the poses must be tilted: {tilted}\n{toml}");
+        prop_assert!(tilted > 0, "the poses must be tilted\n{toml}");
         let options = PostOptions { pressure: default, ..Default::default() };
         let (csv, summary) = post_text(&cl, &machine, "csv", &options)
             .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}\n{cl}")))?;
