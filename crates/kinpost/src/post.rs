@@ -322,32 +322,9 @@ pub fn post<R: BufRead, W: Write>(
             ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
             ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,
             ClEvent::EndOfPath => job.break_segment(),
-            ClEvent::Pressure { word, value } => match &machine.pressure {
-                None => warnings.push(reader.statement_diagnostic(
-                    Severity::Warning,
-                    "PRESSURE ignored: this machine has no pressure axis",
-                )),
-                Some(p) => {
-                    if let Some(w) = word.filter(|w| !w.eq_ignore_ascii_case(&p.name)) {
-                        return Err(reader
-                            .statement_diagnostic(
-                                Severity::Error,
-                                format!(
-                                    "PRESSURE names `{w}`, but the pressure word of machine `{}` is `{}`",
-                                    machine.name, p.name
-                                ),
-                            )
-                            .into());
-                    }
-                    let check = job.check_pressure(value).map_err(|message| {
-                        PostError::from(reader.statement_diagnostic(Severity::Error, message))
-                    })?;
-                    for message in check {
-                        warnings.push(reader.statement_diagnostic(Severity::Warning, message));
-                    }
-                    job.pressure = Some(value);
-                }
-            },
+            ClEvent::Pressure { word, value } => {
+                job.pressure(word.as_deref(), value, &reader, &mut warnings)?;
+            }
             ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
             ClEvent::Fini => break,
         }
@@ -416,6 +393,38 @@ impl<W: Write> Job<'_, W> {
             }
         }
         Ok(warnings)
+    }
+
+    /// `PRESSURE/[word,]value`: the pressure of the points that follow.
+    fn pressure<R: BufRead>(
+        &mut self,
+        word: Option<&str>,
+        value: f64,
+        reader: &ClReader<R>,
+        warnings: &mut Vec<Diagnostic>,
+    ) -> Result<(), PostError> {
+        let Some(p) = &self.machine.pressure else {
+            warnings.push(reader.statement_diagnostic(
+                Severity::Warning,
+                "PRESSURE ignored: this machine has no pressure axis",
+            ));
+            return Ok(());
+        };
+        if let Some(w) = word.filter(|w| !w.eq_ignore_ascii_case(&p.name)) {
+            let message = format!(
+                "PRESSURE names `{w}`, but the pressure word of machine `{}` is `{}`",
+                self.machine.name, p.name
+            );
+            return Err(reader.statement_diagnostic(Severity::Error, message).into());
+        }
+        let check = self.check_pressure(value).map_err(|message| {
+            PostError::from(reader.statement_diagnostic(Severity::Error, message))
+        })?;
+        for message in check {
+            warnings.push(reader.statement_diagnostic(Severity::Warning, message));
+        }
+        self.pressure = Some(value);
+        Ok(())
     }
 
     /// Sets the machine up for the program (once) and writes the header and

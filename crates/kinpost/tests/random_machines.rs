@@ -8,36 +8,8 @@ use kinpost::{PostOptions, post};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
-/// A small deterministic generator (xorshift64*), seeded by proptest.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-    fn unit(&mut self) -> Vector3<f64> {
-        loop {
-            let v = Vector3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if v.norm() > 0.2 && v.norm() <= 1.0 {
-                return v.normalize();
-            }
-        }
-    }
-}
-
-fn vec_toml(v: &Vector3<f64>) -> String {
-    format!("[{:.17}, {:.17}, {:.17}]", v.x, v.y, v.z)
-}
+mod rng;
+use rng::{Rng, random_body, vec_toml};
 
 /// A random serial machine: 3 linear and 2 rotary axes in random chain order
 /// and sides, non-intersecting rotary lines, a tilted part frame.
@@ -48,72 +20,14 @@ fn random_machine(rng: &mut Rng) -> String {
             break l;
         }
     };
-    let rot = loop {
-        let r = [rng.unit(), rng.unit()];
-        if r[0].cross(&r[1]).norm() > 0.3 {
-            break r;
-        }
-    };
-    let mut axes: Vec<String> = Vec::new();
-    for (k, d) in lin.iter().enumerate() {
-        let side = if rng.next() < 0.5 {
-            "tool"
-        } else {
-            "workpiece"
-        };
-        axes.push(format!(
-            "[[axis]]\nname = \"{}\"\nkind = \"linear\"\nside = \"{side}\"\ndirection = {}\n",
-            ["X", "Y", "Z"][k],
-            vec_toml(d)
-        ));
-    }
-    for (k, d) in rot.iter().enumerate() {
-        let side = if rng.next() < 0.5 {
-            "tool"
-        } else {
-            "workpiece"
-        };
-        let p = Vector3::new(
-            rng.range(-300.0, 300.0),
-            rng.range(-300.0, 300.0),
-            rng.range(-300.0, 300.0),
-        );
-        let limits = if rng.next() < 0.5 {
-            "limits = [-400, 400]\n"
-        } else {
-            ""
-        };
-        axes.push(format!(
-            "[[axis]]\nname = \"{}\"\nkind = \"rotary\"\nside = \"{side}\"\ndirection = {}\npoint = {}\n{limits}",
-            ["A", "B"][k],
-            vec_toml(d),
-            vec_toml(&p)
-        ));
-    }
-    // Random chain order (Fisher–Yates).
-    for i in (1..axes.len()).rev() {
-        let j = (rng.next() * (i + 1) as f64) as usize;
-        axes.swap(i, j.min(i));
-    }
-    let x = rng.unit();
-    let z = (rng.unit() - x * x.dot(&rng.unit())).normalize();
-    let z = (z - x * x.dot(&z)).normalize();
-    let origin = Vector3::new(
-        rng.range(-100.0, 100.0),
-        rng.range(-100.0, 100.0),
-        rng.range(-100.0, 100.0),
-    );
+    let body = random_body(rng, "random", lin, true);
     let tool = Vector3::new(
         rng.range(-200.0, 200.0),
         rng.range(-200.0, 200.0),
         rng.range(-200.0, 200.0),
     );
     format!(
-        "name = \"random\"\n{}\n[workpiece]\norigin = {}\nx = {}\nz = {}\n[tool]\npoint = {}\naxis = {}\n",
-        axes.join("\n"),
-        vec_toml(&origin),
-        vec_toml(&x),
-        vec_toml(&z),
+        "{body}[tool]\npoint = {}\naxis = {}\n",
         vec_toml(&tool),
         vec_toml(&rng.unit())
     )
