@@ -54,10 +54,17 @@ impl Wheel {
     /// it; NaN: none programmed, the reference applies) in `kin`, which
     /// holds that of the previous pressure. Returns the wheel offset the
     /// post compensates.
+    #[inline]
     pub(crate) fn select(&mut self, kin: &mut Kinematics, written: f64) -> Vector3<f64> {
+        // The hot path: the pressure of the previous block.
         if written.to_bits() == self.current.to_bits() {
             return self.offset;
         }
+        self.change(kin, written)
+    }
+
+    #[cold]
+    fn change(&mut self, kin: &mut Kinematics, written: f64) -> Vector3<f64> {
         self.current = written;
         let offset = if self.compensate && !written.is_nan() {
             self.axis.offset(written)

@@ -553,7 +553,9 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv {
             return self.csv_block(block);
         }
-        if self.pressure.is_some() {
+        if let Some(p) = &self.pressure
+            && !block.axes[p.word.index].is_nan()
+        {
             self.pressure_line(block.axes)?;
         }
         // Pass 1: quantize, decide what is written.
