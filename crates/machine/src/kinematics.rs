@@ -233,8 +233,6 @@ pub struct Kinematics {
     n: usize,
     /// The chain in the part frame at home, outermost first.
     steps: Vec<Step>,
-    /// The free rotary steps by slot.
-    turns: Vec<Turn>,
     /// The number of steps outside the outermost free linear axis (all of
     /// them if there is none): the linear axes are solved inside them.
     split: usize,
@@ -251,10 +249,14 @@ pub struct Kinematics {
     limits: [Option<[f64; 2]>; MAX_AXES],
     /// Free rotary axes in effective-chain order: (axis index, signed direction).
     free_rot: Vec<(usize, Vector3<f64>)>,
-    /// The free rotary slots that may have no equivalent inside their
-    /// travel (less than a full turn and a degree of it), with the arc test
-    /// of their travel.
-    check: Vec<(usize, Arc)>,
+    /// The free rotary axes by slot.
+    slots: [Slot; 3],
+    /// The steps inside the outermost free linear axis other than free
+    /// linear axes: what moves the tool point when those are at zero.
+    inner_fixed: Vec<Step>,
+    /// `C0ᵀ·R_W0`: the CL tool axis as subproblem 2 of two free rotary
+    /// axes takes it.
+    axis_to_sp2: Rot,
     /// Constant rotations between the free rotary axes in the effective chain:
     /// `E = C[0]·F1·C[1]·F2·C[2]…`.
     between: Vec<Matrix3<f64>>,
@@ -383,14 +385,24 @@ impl Kinematics {
         let tip_axis = carried.rot.apply(&tool.axis);
         let tip_reference = carried.rot.apply(&tool.reference.unwrap_or_else(V3::zeros));
 
-        let mut turns: Vec<Turn> = steps
-            .iter()
-            .filter_map(|s| match s {
-                Step::Rotary(t) => Some(*t),
-                Step::Linear { .. } => None,
-            })
-            .collect();
-        turns.sort_by_key(|t| t.slot);
+        let mut slots = [Slot::default(); 3];
+        for step in &steps {
+            if let Step::Rotary(t) = step {
+                let limits = limits[t.axis];
+                slots[t.slot] = Slot {
+                    axis: t.axis,
+                    limits,
+                    // A travel of a full turn and a degree has an
+                    // equivalent of every angle, with margin over the
+                    // rounding of `turn_range`.
+                    arc: match limits {
+                        Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
+                        _ => None,
+                    },
+                    turn: *t,
+                };
+            }
+        }
         let is_free_linear = |s: &Step| {
             matches!(
                 s,
@@ -405,6 +417,11 @@ impl Kinematics {
         let turns_between = steps[split..last_linear.max(split)]
             .iter()
             .any(|s| matches!(s, Step::Rotary(_)));
+        let inner_fixed = steps[split..]
+            .iter()
+            .filter(|s| !is_free_linear(s))
+            .copied()
+            .collect();
         let mut columns = [V3::zeros(); 3];
         for s in &steps {
             if let Step::Linear {
@@ -435,21 +452,14 @@ impl Kinematics {
         let c0t = between[0].transpose();
         let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
         let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
-        // A travel of a full turn and a degree has an equivalent of every
-        // angle, with margin over the rounding of `turn_range`.
-        let check = free_rot
-            .iter()
-            .enumerate()
-            .filter_map(|(slot, &(i, _))| match limits[i] {
-                Some([lo, hi]) if hi - lo < 361.0 => Some((slot, Arc::new(lo, hi))),
-                _ => None,
-            })
-            .collect();
+        let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
         Kinematics {
             n,
             steps,
-            turns,
             split,
+            slots,
+            inner_fixed,
+            axis_to_sp2,
             linear_solve,
             tip,
             tip_axis,
@@ -464,7 +474,6 @@ impl Kinematics {
             fixed,
             limits,
             free_rot,
-            check,
             between,
             free_lin,
         }
@@ -537,10 +546,93 @@ impl Kinematics {
         out: &mut Vec<Solution>,
         all_branches: bool,
     ) -> Result<(), IkError> {
+        match self.free_rot.len() {
+            0 => self.solve_n::<0>(pose, hint, out, all_branches),
+            1 => self.solve_n::<1>(pose, hint, out, all_branches),
+            2 => self.solve_n::<2>(pose, hint, out, all_branches),
+            _ => self.solve_n::<3>(pose, hint, out, all_branches),
+        }
+    }
+
+    /// [`Kinematics::solve`] for `N` free rotary axes: one piece of code,
+    /// its loops over the rotary slots unrolled for each `N`.
+    #[inline(always)]
+    fn solve_n<const N: usize>(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+        all_branches: bool,
+    ) -> Result<(), IkError> {
         out.clear();
+        let mut branches = [Branch::default(); 2];
+        let count = match if N == 2 {
+            self.orient_two(pose, &mut branches)
+        } else {
+            None
+        } {
+            Some(count) => count,
+            None => self.orient(pose, hint, &mut branches)?,
+        };
+        // Branches whose rotary angles fit the travel first; the others are
+        // only needed to say why nothing fits. An angle (its `atan2`) is
+        // found only when it is needed: for the slots with less than a full
+        // turn of travel to decide whether a branch fits, for the others
+        // when the branch is solved.
+        // (Written out for the one or two branches: as loops, the compiler
+        // hoists the setup of every slot out of them, which costs more than
+        // the loops save.)
+        let [b0, b1] = &mut branches;
+        let second = count > 1;
+        if self.fits::<N>(b0) {
+            self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
+        }
+        if second && self.fits::<N>(b1) {
+            self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
+        }
+        if all_branches || !out.iter().any(Solution::is_valid) {
+            if !self.fits::<N>(b0) {
+                self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
+            }
+            if second && !self.fits::<N>(b1) {
+                self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
+            }
+        }
+        if out.is_empty() {
+            return Err(IkError::PositionUnreachable);
+        }
+        Ok(())
+    }
+
+    /// The orientation of two free rotary axes when subproblem 2 has
+    /// solutions and no angle is free (the usual pose): the number of
+    /// branches. `None` otherwise, for [`Kinematics::orient`] to decide
+    /// (from the very same subproblem).
+    #[inline(always)]
+    fn orient_two(&self, pose: &Pose, branches: &mut [Branch; 2]) -> Option<usize> {
+        let (sols, n) = self
+            .sp2
+            .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
+        for (b, s) in branches.iter_mut().zip(&sols[..n]) {
+            let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
+            b.angles[0] = SlotAngle::from_xy(x1, y1);
+            b.angles[1] = SlotAngle::from_xy(x2, y2);
+        }
+        (n > 0).then_some(n)
+    }
+
+    /// The orientation branches of `pose`, for any number of free rotary
+    /// axes and singular poses: the number of branches.
+    #[cold]
+    #[inline(never)]
+    fn orient(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        branches: &mut [Branch; 2],
+    ) -> Result<usize, IkError> {
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
         let target = self.rw0 * pose.axis;
-        let mut branches = [Branch::default(); 2];
         let count;
         match self.free_rot.len() {
             0 => {
@@ -585,7 +677,7 @@ impl Kinematics {
                     let q = self.c0t * target_rot * c[3].transpose() * w3;
                     (self.sp2_p, q, Some(target_rot))
                 } else {
-                    (self.sp2_p, self.c0t * target, None)
+                    (self.sp2_p, self.axis_to_sp2.apply(&pose.axis), None)
                 };
                 let (sols, n) = self.sp2.solve_xy(&q, 1e-10);
                 if n == 0 {
@@ -639,31 +731,39 @@ impl Kinematics {
             }
         }
 
-        // Branches whose rotary angles fit the travel first; the others are
-        // only needed to say why nothing fits. An angle (its `atan2`) is
-        // found only when it is needed: for the slots with less than a full
-        // turn of travel to decide whether a branch fits, for the others
-        // when the branch is solved.
-        for pass in [true, false] {
-            if !pass && !all_branches && out.iter().any(Solution::is_valid) {
+        Ok(count)
+    }
+
+    /// Whether every rotary angle of the branch has an equivalent inside its
+    /// travel (decided once per branch). An angle not yet known in degrees
+    /// is first tried with the arc test, which leaves out its `atan2` when
+    /// the answer is no.
+    #[inline(always)]
+    fn fits<const N: usize>(&self, b: &mut Branch) -> bool {
+        if let Some(f) = b.fits {
+            return f;
+        }
+        let mut f = true;
+        for (slot, a) in self.slots[..N].iter().zip(&mut b.angles) {
+            let Some(arc) = &slot.arc else {
+                continue;
+            };
+            let inside = match (a.degrees, arc.contains(a.cos, a.sin)) {
+                (None, Some(inside)) => inside,
+                _ => slot.range(a.in_degrees(), None).has_equivalent(),
+            };
+            if !inside {
+                f = false;
                 break;
             }
-            for (k, b) in branches[..count].iter_mut().enumerate() {
-                if self.fits(b) != pass {
-                    continue;
-                }
-                self.solve_branch(b, k as u8, &pose.point, hint, out);
-            }
         }
-        if out.is_empty() {
-            return Err(IkError::PositionUnreachable);
-        }
-        Ok(())
+        b.fits = Some(f);
+        f
     }
 
     /// The linear axes of one orientation branch, and its solutions.
-    #[inline(never)]
-    fn solve_branch(
+    #[inline(always)]
+    fn solve_branch<const N: usize>(
         &self,
         b: &mut Branch,
         branch: u8,
@@ -674,59 +774,14 @@ impl Kinematics {
         let mut joints = self.fixed;
         let mut rots = [Rot::IDENTITY; 3];
         let mut ranges = [SlotRange::default(); 3];
-        for (slot, &(i, _)) in self.free_rot.iter().enumerate() {
-            ranges[slot] = self.range(b, slot, hint);
-            joints[i] = ranges[slot].raw;
-            let a = &b.angles[slot];
-            rots[slot] = self.turns[slot].rotation(a.cos, a.sin);
+        for k in 0..N {
+            let (slot, a) = (&self.slots[k], &mut b.angles[k]);
+            ranges[k] = slot.range(a.in_degrees(), hint);
+            joints[slot.axis] = ranges[k].raw;
+            rots[k] = slot.turn.rotation(a.cos, a.sin);
         }
         if let Some(joints) = self.solve_linear(&joints, &rots, point) {
-            self.push_equivalents(joints, &ranges, branch, b.singular, out);
-        }
-    }
-
-    /// Whether every rotary angle of the branch has an equivalent inside its
-    /// travel (decided once per branch). An angle not yet known in degrees
-    /// is first tried with the arc test, which leaves out its `atan2` when
-    /// the answer is no.
-    fn fits(&self, b: &mut Branch) -> bool {
-        if let Some(f) = b.fits {
-            return f;
-        }
-        let f = self.check.iter().all(|(slot, arc)| {
-            let a = b.angles[*slot];
-            if a.degrees.is_none() {
-                match arc.contains(a.cos, a.sin) {
-                    Some(true) => return true,
-                    Some(false) => return false,
-                    None => {}
-                }
-            }
-            self.range(b, *slot, None).has_equivalent()
-        });
-        b.fits = Some(f);
-        f
-    }
-
-    /// The angle of a slot in degrees, its principal value and the whole
-    /// turns that keep it inside the travel; for an axis without limits, the
-    /// one turn nearest to the hint (continuous output).
-    fn range(&self, b: &mut Branch, slot: usize, hint: Option<&[f64]>) -> SlotRange {
-        let raw = b.angles[slot].in_degrees();
-        let principal = wrap180(raw);
-        let i = self.free_rot[slot].0;
-        let (first, last) = match self.limits[i] {
-            None => {
-                let t = turns_nearest((hint.map_or(0.0, |h| h[i]) - principal) / 360.0);
-                (t, t)
-            }
-            Some([lo, hi]) => turn_range(lo, hi, principal),
-        };
-        SlotRange {
-            raw,
-            principal,
-            first,
-            last,
+            self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
@@ -749,11 +804,8 @@ impl Kinematics {
         if let LinearSolve::Constant(rows) = &self.linear_solve {
             // The tool point with the free linear axes at zero.
             let mut point = self.tip;
-            for step in inner.iter().rev() {
+            for step in self.inner_fixed.iter().rev() {
                 match step {
-                    Step::Linear {
-                        column: Some(_), ..
-                    } => {}
                     Step::Linear { axis, dir, .. } => point += dir * q[*axis],
                     Step::Rotary(t) => point = t.move_point(&rots[t.slot], &point),
                 }
@@ -830,7 +882,8 @@ impl Kinematics {
     /// Appends the solution `joints` with every 360° equivalent of its
     /// rotary angles inside their travel (`ranges`, by slot; the first free
     /// rotary axis varies slowest).
-    fn push_equivalents(
+    #[inline(always)]
+    fn push_equivalents<const N: usize>(
         &self,
         mut joints: Joints,
         ranges: &[SlotRange; 3],
@@ -838,15 +891,14 @@ impl Kinematics {
         singular: bool,
         out: &mut Vec<Solution>,
     ) {
-        let nslots = self.free_rot.len();
-        if let Some(slot) = ranges[..nslots].iter().position(|r| !r.has_equivalent()) {
+        if let Some(slot) = ranges[..N].iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
             out.push(Solution {
                 joints,
                 branch,
                 singular,
                 violation: Some(Violation {
-                    axis: self.free_rot[slot].0,
+                    axis: self.slots[slot].axis,
                     value: ranges[slot].principal,
                 }),
             });
@@ -867,8 +919,8 @@ impl Kinematics {
             *t = r.first;
         }
         loop {
-            for (slot, &(i, _)) in self.free_rot.iter().enumerate() {
-                joints[i] = ranges[slot].principal + 360.0 * turn[slot] as f64;
+            for k in 0..N {
+                joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k] as f64;
             }
             out.push(Solution {
                 joints,
@@ -880,7 +932,7 @@ impl Kinematics {
                 return;
             }
             // The next combination, the last slot fastest.
-            let mut slot = nslots;
+            let mut slot = N;
             loop {
                 if slot == 0 {
                     return;
@@ -1017,6 +1069,51 @@ impl Arc {
             Some(false)
         } else {
             None
+        }
+    }
+}
+
+/// A free rotary axis, by its slot.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    /// Machine-file index of the axis.
+    axis: usize,
+    limits: Option<[f64; 2]>,
+    /// The arc test of a travel of less than a full turn and a degree.
+    arc: Option<Arc>,
+    turn: Turn,
+}
+
+impl Default for Slot {
+    fn default() -> Self {
+        Slot {
+            axis: 0,
+            limits: None,
+            arc: None,
+            turn: Turn::new(0, 0, V3::z(), V3::zeros()),
+        }
+    }
+}
+
+impl Slot {
+    /// The angle `raw` (degrees, as solved), its principal value and the
+    /// whole turns that keep it inside the travel; for an axis without
+    /// limits, the one turn nearest to the hint (continuous output).
+    #[inline(always)]
+    fn range(&self, raw: f64, hint: Option<&[f64]>) -> SlotRange {
+        let principal = wrap180(raw);
+        let (first, last) = match self.limits {
+            None => {
+                let t = turns_nearest((hint.map_or(0.0, |h| h[self.axis]) - principal) / 360.0);
+                (t, t)
+            }
+            Some([lo, hi]) => turn_range(lo, hi, principal),
+        };
+        SlotRange {
+            raw,
+            principal,
+            first,
+            last,
         }
     }
 }
