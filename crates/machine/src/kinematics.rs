@@ -38,6 +38,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use crate::angle::{atan2_deg, sin_cos_deg};
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
 use crate::subproblems::{FREE_EPS, Sp2, rotation, rotation_cs, sp1_xy, unit_xy};
 
@@ -494,7 +495,7 @@ impl Kinematics {
             match step {
                 Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
                 Step::Rotary(t) => {
-                    let (s, c) = rad(q[t.axis]).sin_cos();
+                    let (s, c) = sin_cos_deg(q[t.axis]);
                     let m = t.rotation(c, s);
                     point = t.move_point(&m, &point);
                     axis = m.apply(&axis);
@@ -1026,7 +1027,7 @@ impl SlotAngle {
     fn in_degrees(&mut self) -> f64 {
         *self
             .degrees
-            .get_or_insert_with(|| f64::atan2(self.y, self.x).to_degrees())
+            .get_or_insert_with(|| atan2_deg(self.y, self.x))
     }
 
     fn rotation(&self, w: &V3) -> Matrix3<f64> {
