@@ -915,13 +915,13 @@ impl Kinematics {
                 axis: i,
                 value: joints[i],
             });
-        let mut turn = [0i64; 3];
+        let mut turn = [0.0; 3];
         for (t, r) in turn.iter_mut().zip(ranges) {
             *t = r.first;
         }
         loop {
             for k in 0..N {
-                joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k] as f64;
+                joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
             }
             out.push(Solution {
                 joints,
@@ -940,7 +940,7 @@ impl Kinematics {
                 }
                 slot -= 1;
                 if turn[slot] < ranges[slot].last {
-                    turn[slot] += 1;
+                    turn[slot] += 1.0;
                     break;
                 }
                 turn[slot] = ranges[slot].first;
@@ -1125,8 +1125,8 @@ impl Slot {
 struct SlotRange {
     raw: f64,
     principal: f64,
-    first: i64,
-    last: i64,
+    first: f64,
+    last: f64,
 }
 
 impl SlotRange {
@@ -1142,36 +1142,44 @@ fn accepts(limits: Option<[f64; 2]>, v: f64) -> bool {
     }
 }
 
-// Rounding by integer conversion: `floor`, `ceil`, `round` and `fmod` are
-// library calls on baseline x86-64 and showed up in the posting profile.
-// Angles here are far below 2^53 turns.
+// Rounding in floating point: `floor`, `ceil` and `round` are library
+// calls on baseline x86-64, and conversions to integers saturate (several
+// instructions each); both showed up in the posting profile.
 
-/// ⌊x⌋ as an integer.
-#[inline]
-fn floor_i(x: f64) -> i64 {
-    let t = x as i64;
-    if (t as f64) > x { t - 1 } else { t }
+/// ⌊x⌋: below 2^51 by rounding to the nearest whole number with the
+/// 1.5·2^52 trick (adding it leaves no fraction bits) and stepping down if
+/// that rounded up; larger numbers are whole or nearly, for the library.
+#[inline(always)]
+fn floor_f(x: f64) -> f64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    if x.abs() < 2_251_799_813_685_248.0 {
+        let r = (x + ROUND) - ROUND;
+        if r > x { r - 1.0 } else { r }
+    } else {
+        x.floor()
+    }
 }
 
-/// The nearest integer to x (halves away from zero or not: callers do not care).
-#[inline]
-fn turns_nearest(x: f64) -> i64 {
-    floor_i(x + 0.5)
+/// The nearest whole number to x (halves up).
+#[inline(always)]
+fn turns_nearest(x: f64) -> f64 {
+    floor_f(x + 0.5)
 }
 
-/// The whole turns k with lo ≤ principal + 360k ≤ hi (1e-9° slack).
-#[inline]
-fn turn_range(lo: f64, hi: f64, principal: f64) -> (i64, i64) {
+/// The whole turns k with lo ≤ principal + 360k ≤ hi (1e-9° slack), as
+/// the first and last k.
+#[inline(always)]
+fn turn_range(lo: f64, hi: f64, principal: f64) -> (f64, f64) {
     (
-        -floor_i(-(lo - 1e-9 - principal) / 360.0),
-        floor_i((hi + 1e-9 - principal) / 360.0),
+        -floor_f(-(lo - 1e-9 - principal) / 360.0),
+        floor_f((hi + 1e-9 - principal) / 360.0),
     )
 }
 
 /// Angle in degrees wrapped to (−180, 180].
 #[inline]
 pub fn wrap180(deg: f64) -> f64 {
-    let w = deg - 360.0 * turns_nearest(deg / 360.0) as f64;
+    let w = deg - 360.0 * turns_nearest(deg / 360.0);
     if w <= -180.0 {
         w + 360.0
     } else if w > 180.0 {
@@ -1220,7 +1228,8 @@ mod tests {
             540.0,
             1e6 + 0.25,
         ] {
-            assert_eq!(floor_i(x), x.floor() as i64, "{x}");
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+            assert_eq!(floor_f(-x), (-x).floor(), "{x}");
             let w = wrap180(x);
             assert!(w > -180.0 && w <= 180.0, "{x} -> {w}");
             assert!(
@@ -1229,10 +1238,14 @@ mod tests {
             );
         }
         assert_eq!(wrap180(-180.0), 180.0);
-        assert_eq!(turn_range(-360.0, 360.0, 10.0), (-1, 0));
-        assert_eq!(turn_range(-45.2, 45.2, 10.0), (0, 0));
-        assert_eq!(turn_range(-45.2, 45.2, 50.0), (0, -1));
-        assert_eq!(turn_range(0.0, 720.0, -90.0), (1, 2));
+        assert_eq!(turn_range(-360.0, 360.0, 10.0), (-1.0, 0.0));
+        assert_eq!(turn_range(-45.2, 45.2, 10.0), (0.0, 0.0));
+        assert_eq!(turn_range(-45.2, 45.2, 50.0), (0.0, -1.0));
+        assert_eq!(turn_range(0.0, 720.0, -90.0), (1.0, 2.0));
+        for x in [0.5, 1.5, 2.5, -0.5, -1.5, 4503599627370495.5, 1e300, -1e300] {
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+        }
+        assert!(floor_f(f64::NAN).is_nan());
     }
 }
 
