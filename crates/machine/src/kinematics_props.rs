@@ -30,17 +30,14 @@ impl Draw {
     fn chance(&mut self, p: f64) -> bool {
         self.next() < p
     }
+    /// Uniform on the unit sphere (Archimedes: z uniform in [−1, 1]).
     fn unit(&mut self) -> Vector3<f64> {
-        loop {
-            let v = Vector3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if v.norm() > 0.2 && v.norm() <= 1.0 {
-                return v.normalize();
-            }
-        }
+        let z = self.range(-1.0, 1.0);
+        let (s, c) = self
+            .range(-std::f64::consts::PI, std::f64::consts::PI)
+            .sin_cos();
+        let r = (1.0 - z * z).sqrt();
+        Vector3::new(r * c, r * s, z)
     }
     fn point(&mut self, r: f64) -> Vector3<f64> {
         Vector3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))

@@ -111,7 +111,8 @@ pub struct Sp2Solution {
     pub theta2: Option<Angle>,
 }
 
-/// One solution of subproblem 2 before the `atan2`s (see [`sp1_xy`]).
+/// One solution of subproblem 2 before the `atan2`s (see [`sp1_xy`] and
+/// [`Sp2::solve_xy`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sp2Xy {
     /// `(x, y)` of the angle about the first axis; `None` if free (singular).
@@ -132,25 +133,13 @@ pub fn sp2(
     q: &Vector3<f64>,
     slack: f64,
 ) -> ([Sp2Solution; 2], usize) {
-    let (xy, n) = sp2_xy(w1, w2, p, q, slack);
+    let (xy, n) = Sp2::new(w1, w2, p).solve_xy(q, slack);
     let angle = |t: Option<(f64, f64)>| t.map(|(x, y)| Angle::from_xy(x, y));
     let sol = |s: &Sp2Xy| Sp2Solution {
         theta1: angle(s.theta1),
         theta2: angle(s.theta2),
     };
     ([sol(&xy[0]), sol(&xy[1])], n)
-}
-
-/// [`sp2`] before the `atan2`s.
-#[inline]
-pub fn sp2_xy(
-    w1: &Vector3<f64>,
-    w2: &Vector3<f64>,
-    p: &Vector3<f64>,
-    q: &Vector3<f64>,
-    slack: f64,
-) -> ([Sp2Xy; 2], usize) {
-    Sp2::new(w1, w2, p).solve_xy(q, slack)
 }
 
 /// Subproblem 2 for given axes `w1`, `w2` and vector `p`, with everything
@@ -193,7 +182,7 @@ impl Sp2 {
         }
     }
 
-    /// The solutions for `q` (see [`sp2`] and [`sp2_xy`]).
+    /// The solutions for `q`, as [`sp2`] has them but before the `atan2`s.
     #[inline]
     pub fn solve_xy(&self, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
         let none = Sp2Xy {
