@@ -25,9 +25,11 @@
 //! W(q)⁻¹ · T(q) = W0⁻¹ · G_wk⁻¹ ⋯ G_w1⁻¹ · G_t1 ⋯ G_tm · T0,
 //! ```
 //!
-//! and every constant motion in it (the part frame, axes locked at a value)
-//! is carried inwards to the tool at construction: a constant `C` in front
-//! of an axis motion `G(u, p)` equals `G(R_C u, C p) · C`. What is left is
+//! and every constant motion in it (the part frame, rotary axes locked at a
+//! value) is carried inwards to the tool at construction: a constant `C` in
+//! front of an axis motion `G(u, p)` equals `G(R_C u, C p) · C`. (A locked
+//! linear axis stays in the chain and moves by the value it is given, like
+//! the free ones.) What is left is
 //! the product of exponentials in the part frame at home (Murray, Li,
 //! Sastry §3.2): the free axes with their lines moved into the part frame,
 //! then the constant tool point and directions. [`Kinematics::fk`] applies
