@@ -18,14 +18,35 @@
 //! subproblem 2 and a third one, when the pose carries a reference direction,
 //! subproblem 1. With every angle known the tool point is affine in the
 //! linear axis values: a 3×3 linear solve.
+//!
+//! Evaluation: the tool pose in the part frame is one chain of rigid motions,
+//!
+//! ```text
+//! W(q)⁻¹ · T(q) = W0⁻¹ · G_wk⁻¹ ⋯ G_w1⁻¹ · G_t1 ⋯ G_tm · T0,
+//! ```
+//!
+//! and every constant motion in it (the part frame, rotary axes locked at a
+//! value) is carried inwards to the tool at construction: a constant `C` in
+//! front of an axis motion `G(u, p)` equals `G(R_C u, C p) · C`. (A locked
+//! linear axis stays in the chain and moves by the value it is given, like
+//! the free ones.) What is left is
+//! the product of exponentials in the part frame at home (Murray, Li,
+//! Sastry §3.2): the free axes with their lines moved into the part frame,
+//! then the constant tool point and directions. [`Kinematics::fk`] applies
+//! that chain to three vectors with hand-written 3×3 products; the inverse
+//! kinematics solves the linear axes in the frame just inside the outermost
+//! of them, where their columns are constant on most machines (precomputed
+//! Cramer rows).
 
 use nalgebra::{Matrix3, Vector3};
+
+use crate::angle::{atan2_deg, sin_cos_deg};
 
 mod singular;
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{Angle, FREE_EPS, rotation, sp1_cs, sp2};
+use crate::subproblems::{FREE_EPS, Sp2, rotation, rotation_cs, sp1_xy, unit_xy};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -87,41 +108,162 @@ impl std::fmt::Display for IkError {
 
 impl std::error::Error for IkError {}
 
-#[derive(Debug, Clone, Copy)]
-struct Link {
-    kind: AxisKind,
-    dir: Vector3<f64>,
-    point: Vector3<f64>,
-    /// Machine-file index of the axis.
-    index: usize,
-    /// Position among the free linear axes (the column of the linear solve).
-    free_lin: Option<usize>,
-    /// Position among the free rotary axes (effective-chain order).
-    slot: Option<usize>,
-    /// Rotation of a rotary axis locked by `fixed`.
-    fixed_rot: Matrix3<f64>,
+type V3 = Vector3<f64>;
+
+/// A 3×3 matrix by rows, multiplied out by hand: the hot path needs only
+/// matrix × vector, which nalgebra's generic products do not inline as well.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Rot([[f64; 3]; 3]);
+
+impl Rot {
+    const IDENTITY: Rot = Rot([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+
+    fn from_matrix(m: &Matrix3<f64>) -> Rot {
+        Rot(std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])))
+    }
+
+    fn matrix(&self) -> Matrix3<f64> {
+        Matrix3::from_fn(|i, j| self.0[i][j])
+    }
+
+    /// `self · v`.
+    #[inline(always)]
+    fn apply(&self, v: &V3) -> V3 {
+        let r = &self.0;
+        V3::new(
+            r[0][0] * v.x + r[0][1] * v.y + r[0][2] * v.z,
+            r[1][0] * v.x + r[1][1] * v.y + r[1][2] * v.z,
+            r[2][0] * v.x + r[2][1] * v.y + r[2][2] * v.z,
+        )
+    }
+
+    /// `selfᵀ · v`.
+    #[inline(always)]
+    fn apply_t(&self, v: &V3) -> V3 {
+        let r = &self.0;
+        V3::new(
+            r[0][0] * v.x + r[1][0] * v.y + r[2][0] * v.z,
+            r[0][1] * v.x + r[1][1] * v.y + r[2][1] * v.z,
+            r[0][2] * v.x + r[1][2] * v.y + r[2][2] * v.z,
+        )
+    }
 }
 
-/// Rotation matrices of the free rotary axes, by slot.
-type Rots = [Matrix3<f64>; 3];
+/// The line of a free rotary axis in the part frame at home, with what
+/// Rodrigues' formula needs of its direction.
+#[derive(Debug, Clone, Copy)]
+struct Turn {
+    /// Machine-file index of the axis.
+    axis: usize,
+    /// Position among the free rotary axes (effective-chain order).
+    slot: usize,
+    /// Unit direction (negated for a workpiece axis: the chain holds its
+    /// inverse) and a point of the line.
+    dir: V3,
+    point: V3,
+    /// xx, xy, xz, yy, yz, zz of `dir`.
+    dir2: [f64; 6],
+}
+
+impl Turn {
+    fn new(axis: usize, slot: usize, dir: V3, point: V3) -> Turn {
+        let (x, y, z) = (dir.x, dir.y, dir.z);
+        Turn {
+            axis,
+            slot,
+            dir,
+            point,
+            dir2: [x * x, x * y, x * z, y * y, y * z, z * z],
+        }
+    }
+
+    /// The rotation about `dir` by the angle with cosine `c` and sine `s`
+    /// (Rodrigues: `c·I + s·[w]× + (1 − c)·w wᵀ`, as
+    /// [`rotation_cs`](crate::subproblems::rotation_cs)).
+    #[inline(always)]
+    fn rotation(&self, c: f64, s: f64) -> Rot {
+        let v = 1.0 - c;
+        let (x, y, z) = (self.dir.x * s, self.dir.y * s, self.dir.z * s);
+        let [xx, xy, xz, yy, yz, zz] = self.dir2;
+        Rot([
+            [c + xx * v, xy * v - z, xz * v + y],
+            [xy * v + z, c + yy * v, yz * v - x],
+            [xz * v - y, yz * v + x, c + zz * v],
+        ])
+    }
+
+    /// `m·(x − point) + point`: the point `x` turned about the line.
+    #[inline(always)]
+    fn move_point(&self, m: &Rot, x: &V3) -> V3 {
+        m.apply(&(x - self.point)) + self.point
+    }
+
+    /// The inverse of [`Turn::move_point`].
+    #[inline(always)]
+    fn unmove_point(&self, m: &Rot, x: &V3) -> V3 {
+        m.apply_t(&(x - self.point)) + self.point
+    }
+}
+
+/// One motion of the chain from the part frame (outermost) to the tool.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// `x ↦ x + q·dir`, `q` the value of axis `axis`; `column`: position
+    /// among the free linear axes (`None` for a locked axis, which moves by
+    /// the value it is given like the others).
+    Linear {
+        axis: usize,
+        column: Option<usize>,
+        dir: V3,
+    },
+    /// A free rotary axis.
+    Rotary(Turn),
+}
+
+/// How the free linear axes are solved once the angles are known.
+#[derive(Debug, Clone, Copy)]
+enum LinearSolve {
+    /// Three free linear axes with no free rotary axis between them: their
+    /// columns are constant inside the outermost of them, and so are the
+    /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic).
+    Constant([V3; 3]),
+    /// Columns that depend on the angles, or fewer than three axes.
+    General,
+}
+
+/// The rotation matrices of the free rotary slots, for some angles.
+type Rots = [Rot; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
 pub struct Kinematics {
     n: usize,
-    tool_chain: Vec<Link>,
-    work_chain: Vec<Link>,
+    /// The chain in the part frame at home, outermost first.
+    steps: Vec<Step>,
+    /// The number of steps outside the outermost free linear axis (all of
+    /// them if there is none): the linear axes are solved inside them.
+    split: usize,
+    linear_solve: LinearSolve,
+    /// The tool point, axis and reference at home in the part frame, with
+    /// every constant of the chain applied.
+    tip: V3,
+    tip_axis: V3,
+    tip_reference: V3,
     rw0: Matrix3<f64>,
-    ow0: Vector3<f64>,
-    t0: Vector3<f64>,
     a0: Vector3<f64>,
     r0: Option<Vector3<f64>>,
     fixed: Joints,
-    is_fixed: [bool; MAX_AXES],
     limits: [Option<[f64; 2]>; MAX_AXES],
-    rotary: [bool; MAX_AXES],
     /// Free rotary axes in effective-chain order: (axis index, signed direction).
     free_rot: Vec<(usize, Vector3<f64>)>,
+    /// The free rotary axes by slot.
+    slots: [Slot; 3],
+    /// The steps inside the outermost free linear axis other than free
+    /// linear axes: what moves the tool point when those are at zero.
+    inner_fixed: Vec<Step>,
+    /// `C0ᵀ·R_W0`: the CL tool axis as subproblem 2 of two free rotary
+    /// axes takes it.
+    axis_to_sp2: Rot,
     /// Constant rotations between the free rotary axes in the effective chain:
     /// `E = C[0]·F1·C[1]·F2·C[2]…`.
     between: Vec<Matrix3<f64>>,
@@ -132,10 +274,8 @@ pub struct Kinematics {
     /// `C1·C2·a0` (two free axes) or `C1·C2·w3` (three), and `C0ᵀ`.
     sp2_w2: Vector3<f64>,
     sp2_p: Vector3<f64>,
+    sp2: Sp2,
     c0t: Matrix3<f64>,
-    /// Axis index and own direction of each free rotary slot.
-    slot_axis: Vec<usize>,
-    slot_dir: Vec<Vector3<f64>>,
 }
 
 #[inline]
@@ -143,13 +283,30 @@ fn rad(deg: f64) -> f64 {
     deg.to_radians()
 }
 
-/// The tool pose in the part frame for some joint values, and how the tool
-/// point moves per unit of each free linear axis.
-struct Eval {
-    point: Vector3<f64>,
-    axis: Vector3<f64>,
-    reference: Option<Vector3<f64>>,
-    cols: [Vector3<f64>; 3],
+/// A rigid motion `x ↦ rot·x + shift`.
+#[derive(Clone, Copy)]
+struct Rigid {
+    rot: Rot,
+    shift: V3,
+}
+
+impl Rigid {
+    /// `self · other`.
+    fn then_inner(&self, other: &Rigid) -> Rigid {
+        Rigid {
+            rot: Rot::from_matrix(&(self.rot.matrix() * other.rot.matrix())),
+            shift: self.rot.apply(&other.shift) + self.shift,
+        }
+    }
+
+    /// The rotation by `deg` about the line (`point`, `dir`).
+    fn about(dir: &V3, point: &V3, deg: f64) -> Rigid {
+        let rot = Rot::from_matrix(&rotation(dir, rad(deg)));
+        Rigid {
+            rot,
+            shift: point - rot.apply(point),
+        }
+    }
 }
 
 impl Kinematics {
@@ -160,54 +317,36 @@ impl Kinematics {
         let mut is_fixed = [false; MAX_AXES];
         let mut limits = [None; MAX_AXES];
         let mut rotary = [false; MAX_AXES];
-        let (mut tool_chain, mut work_chain): (Vec<Link>, Vec<Link>) = (Vec::new(), Vec::new());
         for (i, a) in machine.axes.iter().enumerate() {
             fixed[i] = a.fixed.unwrap_or(0.0);
             is_fixed[i] = a.fixed.is_some();
             limits[i] = a.limits;
             rotary[i] = a.is_rotary();
-            let free_lin = (!a.is_rotary() && a.fixed.is_none()).then(|| {
-                machine.axes[..i]
-                    .iter()
-                    .filter(|b| !b.is_rotary() && b.fixed.is_none())
-                    .count()
-            });
-            let link = Link {
-                kind: a.kind,
-                dir: a.direction,
-                point: a.point,
-                index: i,
-                free_lin,
-                slot: None,
-                fixed_rot: Matrix3::identity(),
-            };
-            // An axis locked at zero is the identity motion: leave it out of
-            // the chains (the C axis of the 5-axis mts1600).
-            if a.fixed == Some(0.0) {
-                continue;
-            }
-            match a.side {
-                Side::Tool => tool_chain.push(link),
-                Side::Workpiece => work_chain.push(link),
-            }
         }
-        // Effective orientation chain: workpiece rotaries outermost first,
-        // direction negated (R(u, q)ᵀ = R(−u, q)), then tool rotaries.
-        let effective: Vec<(usize, Vector3<f64>)> = work_chain
+        // The chain outermost first: W0⁻¹, the workpiece axes inverted from
+        // the part outwards, then the tool axes from the base. An axis
+        // locked at zero is the identity motion (the C axis of the 5-axis
+        // mts1600).
+        let (work, tool): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| machine.axes[i].side == Side::Workpiece);
+        let chain: Vec<(usize, f64)> = work
             .iter()
             .rev()
-            .filter(|l| l.kind == AxisKind::Rotary)
-            .map(|l| (l.index, -l.dir))
-            .chain(
-                tool_chain
-                    .iter()
-                    .filter(|l| l.kind == AxisKind::Rotary)
-                    .map(|l| (l.index, l.dir)),
-            )
+            .map(|&i| (i, -1.0))
+            .chain(tool.iter().map(|&i| (i, 1.0)))
+            .filter(|&(i, _)| machine.axes[i].fixed != Some(0.0))
             .collect();
+        let free_lin: Vec<usize> = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
+
+        // Effective orientation chain (directions only): the free rotary
+        // axes and the constant rotations between them.
         let mut free_rot = Vec::new();
         let mut between = vec![Matrix3::identity()];
-        for (i, w) in effective {
+        for &(i, sign) in &chain {
+            if !rotary[i] {
+                continue;
+            }
+            let w = machine.axes[i].direction * sign;
             if is_fixed[i] {
                 let last = between.last_mut().expect("never empty");
                 *last *= rotation(&w, rad(fixed[i]));
@@ -216,19 +355,96 @@ impl Kinematics {
                 between.push(Matrix3::identity());
             }
         }
-        let free_lin = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
-        // Slots of the free rotary axes and cached rotations of fixed ones.
-        let slot_axis: Vec<usize> = free_rot.iter().map(|&(i, _)| i).collect();
-        let slot_dir = slot_axis
-            .iter()
-            .map(|&i| machine.axes[i].direction)
-            .collect();
-        for l in tool_chain.iter_mut().chain(work_chain.iter_mut()) {
-            l.slot = free_rot.iter().position(|&(i, _)| i == l.index);
-            if l.kind == AxisKind::Rotary && is_fixed[l.index] {
-                l.fixed_rot = rotation(&l.dir, rad(fixed[l.index]));
+
+        // The constants carried inwards: `carried` is the product of the
+        // constant motions met so far.
+        let rw0t = machine.workpiece_rotation.transpose();
+        let mut carried = Rigid {
+            rot: Rot::from_matrix(&rw0t),
+            shift: -(rw0t * machine.workpiece_origin),
+        };
+        let mut steps = Vec::new();
+        for &(i, sign) in &chain {
+            let a = &machine.axes[i];
+            let dir = a.direction * sign;
+            match (a.kind, a.fixed) {
+                (AxisKind::Linear, _) => steps.push(Step::Linear {
+                    axis: i,
+                    column: free_lin.iter().position(|&j| j == i),
+                    dir: carried.rot.apply(&dir),
+                }),
+                (AxisKind::Rotary, Some(v)) => {
+                    carried = carried.then_inner(&Rigid::about(&dir, &a.point, v));
+                }
+                (AxisKind::Rotary, None) => {
+                    let slot = free_rot.iter().position(|&(j, _)| j == i).expect("free");
+                    steps.push(Step::Rotary(Turn::new(
+                        i,
+                        slot,
+                        carried.rot.apply(&dir),
+                        carried.rot.apply(&a.point) + carried.shift,
+                    )));
+                }
             }
         }
+        let tool = &machine.tool;
+        let tip = carried.rot.apply(&tool.point) + carried.shift;
+        let tip_axis = carried.rot.apply(&tool.axis);
+        let tip_reference = carried.rot.apply(&tool.reference.unwrap_or_else(V3::zeros));
+
+        let mut slots = [Slot::default(); 3];
+        for step in &steps {
+            if let Step::Rotary(t) = step {
+                let limits = limits[t.axis];
+                slots[t.slot] = Slot {
+                    axis: t.axis,
+                    limits,
+                    // A travel of a full turn and a degree has an
+                    // equivalent of every angle, with margin over the
+                    // rounding of `turn_range`.
+                    arc: match limits {
+                        Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
+                        _ => None,
+                    },
+                    turn: *t,
+                };
+            }
+        }
+        let is_free_linear = |s: &Step| {
+            matches!(
+                s,
+                Step::Linear {
+                    column: Some(_),
+                    ..
+                }
+            )
+        };
+        let split = steps.iter().position(is_free_linear).unwrap_or(steps.len());
+        let last_linear = steps.iter().rposition(is_free_linear).unwrap_or(split);
+        let turns_between = steps[split..last_linear.max(split)]
+            .iter()
+            .any(|s| matches!(s, Step::Rotary(_)));
+        let inner_fixed = steps[split..]
+            .iter()
+            .filter(|s| !is_free_linear(s))
+            .copied()
+            .collect();
+        let mut columns = [V3::zeros(); 3];
+        for s in &steps {
+            if let Step::Linear {
+                column: Some(k),
+                dir,
+                ..
+            } = s
+            {
+                columns[*k] = *dir;
+            }
+        }
+        let linear_solve = match cramer_rows(&columns) {
+            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant(rows),
+            _ => LinearSolve::General,
+        };
+
         let (sp2_w2, sp2_p) = match free_rot.len() {
             2 => (
                 between[1] * free_rot[1].1,
@@ -241,27 +457,32 @@ impl Kinematics {
             _ => (Vector3::zeros(), Vector3::zeros()),
         };
         let c0t = between[0].transpose();
+        let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
+        let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
+        let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
         Kinematics {
             n,
+            steps,
+            split,
+            slots,
+            inner_fixed,
+            axis_to_sp2,
+            linear_solve,
+            tip,
+            tip_axis,
+            tip_reference,
             sp2_w2,
             sp2_p,
+            sp2,
             c0t,
-            tool_chain,
-            work_chain,
             rw0: machine.workpiece_rotation,
-            ow0: machine.workpiece_origin,
-            t0: machine.tool.point,
             a0: machine.tool.axis,
             r0: machine.tool.reference,
             fixed,
-            is_fixed,
             limits,
-            rotary,
             free_rot,
             between,
             free_lin,
-            slot_axis,
-            slot_dir,
         }
     }
 
@@ -273,82 +494,25 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
-        let mut rots = [Matrix3::identity(); 3];
-        for (k, &i) in self.slot_axis.iter().enumerate() {
-            rots[k] = rotation(&self.slot_dir[k], rad(q[i]));
+        let mut point = self.tip;
+        let mut axis = self.tip_axis;
+        let mut reference = self.tip_reference;
+        for step in self.steps.iter().rev() {
+            match step {
+                Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
+                Step::Rotary(t) => {
+                    let (s, c) = sin_cos_deg(q[t.axis]);
+                    let m = t.rotation(c, s);
+                    point = t.move_point(&m, &point);
+                    axis = m.apply(&axis);
+                    reference = m.apply(&reference);
+                }
+            }
         }
-        let e = self.eval(q, &rots);
         Pose {
-            point: e.point,
-            axis: e.axis,
-            reference: e.reference,
-        }
-    }
-
-    /// The rotation of link `l` (cached for fixed axes).
-    #[inline]
-    fn rot<'a>(l: &'a Link, rots: &'a Rots) -> &'a Matrix3<f64> {
-        match l.slot {
-            Some(k) => &rots[k],
-            None => &l.fixed_rot,
-        }
-    }
-
-    /// One pass over both chains: the tool pose in the part frame at `q`, and
-    /// the column of each free linear axis (the pose is affine in them).
-    #[inline]
-    fn eval(&self, q: &[f64], rots: &Rots) -> Eval {
-        // Tool chain, base outwards: T = G_t1 ⋯ G_tm, G x = g (x − p) + p.
-        let mut r = Matrix3::identity();
-        let mut t = Vector3::zeros();
-        let mut tool_cols = [Vector3::zeros(); 3];
-        for l in &self.tool_chain {
-            match l.kind {
-                AxisKind::Linear => {
-                    let d = r * l.dir;
-                    if let Some(k) = l.free_lin {
-                        tool_cols[k] = d;
-                    }
-                    t += d * q[l.index];
-                }
-                AxisKind::Rotary => {
-                    let g = Self::rot(l, rots);
-                    t += r * (l.point - g * l.point);
-                    r *= g;
-                }
-            }
-        }
-        let x = r * self.t0 + t;
-        // Workpiece chain, outermost first: S_j = G_w(j+1) ⋯ G_wk · W0 ends
-        // as W. A linear axis j moves the part point by −S_jᵀ u_j per unit.
-        let mut sr = self.rw0;
-        let mut st = self.ow0;
-        let mut cols = [Vector3::zeros(); 3];
-        for l in self.work_chain.iter().rev() {
-            match l.kind {
-                AxisKind::Linear => {
-                    if let Some(k) = l.free_lin {
-                        cols[k] = -(sr.tr_mul(&l.dir));
-                    }
-                    st += l.dir * q[l.index];
-                }
-                AxisKind::Rotary => {
-                    let g = Self::rot(l, rots);
-                    sr = g * sr;
-                    st = g * st + (l.point - g * l.point);
-                }
-            }
-        }
-        for l in &self.tool_chain {
-            if let Some(k) = l.free_lin {
-                cols[k] = sr.tr_mul(&tool_cols[k]);
-            }
-        }
-        Eval {
-            point: sr.tr_mul(&(x - st)),
-            axis: sr.tr_mul(&(r * self.a0)),
-            reference: self.r0.map(|v| sr.tr_mul(&(r * v))),
-            cols,
+            point,
+            axis,
+            reference: self.r0.map(|_| reference),
         }
     }
 
@@ -389,14 +553,93 @@ impl Kinematics {
         out: &mut Vec<Solution>,
         all_branches: bool,
     ) -> Result<(), IkError> {
+        match self.free_rot.len() {
+            0 => self.solve_n::<0>(pose, hint, out, all_branches),
+            1 => self.solve_n::<1>(pose, hint, out, all_branches),
+            2 => self.solve_n::<2>(pose, hint, out, all_branches),
+            _ => self.solve_n::<3>(pose, hint, out, all_branches),
+        }
+    }
+
+    /// [`Kinematics::solve`] for `N` free rotary axes: one piece of code,
+    /// its loops over the rotary slots unrolled for each `N`.
+    #[inline(always)]
+    fn solve_n<const N: usize>(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+        all_branches: bool,
+    ) -> Result<(), IkError> {
         out.clear();
+        let mut branches = [Branch::default(); 2];
+        let count = match if N == 2 {
+            self.orient_two(pose, &mut branches)
+        } else {
+            None
+        } {
+            Some(count) => count,
+            None => self.orient(pose, hint, &mut branches)?,
+        };
+        // Branches whose rotary angles fit the travel first; the others are
+        // only needed to say why nothing fits. An angle (its `atan2`) is
+        // found only when it is needed: for the slots with less than a full
+        // turn of travel to decide whether a branch fits, for the others
+        // when the branch is solved.
+        // (Written out for the one or two branches: as loops, the compiler
+        // hoists the setup of every slot out of them, which costs more than
+        // the loops save.)
+        let [b0, b1] = &mut branches;
+        let second = count > 1;
+        if self.fits::<N>(b0) {
+            self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
+        }
+        if second && self.fits::<N>(b1) {
+            self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
+        }
+        if all_branches || !out.iter().any(Solution::is_valid) {
+            if !self.fits::<N>(b0) {
+                self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
+            }
+            if second && !self.fits::<N>(b1) {
+                self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
+            }
+        }
+        if out.is_empty() {
+            return Err(IkError::PositionUnreachable);
+        }
+        Ok(())
+    }
+
+    /// The orientation of two free rotary axes when subproblem 2 has
+    /// solutions and no angle is free (the usual pose): the number of
+    /// branches. `None` otherwise, for [`Kinematics::orient`] to decide
+    /// (from the very same subproblem).
+    #[inline(always)]
+    fn orient_two(&self, pose: &Pose, branches: &mut [Branch; 2]) -> Option<usize> {
+        let (sols, n) = self
+            .sp2
+            .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
+        for (b, s) in branches.iter_mut().zip(&sols[..n]) {
+            let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
+            b.angles[0] = SlotAngle::from_xy(x1, y1);
+            b.angles[1] = SlotAngle::from_xy(x2, y2);
+        }
+        (n > 0).then_some(n)
+    }
+
+    /// The orientation branches of `pose`, for any number of free rotary
+    /// axes and singular poses: the number of branches.
+    #[cold]
+    #[inline(never)]
+    fn orient(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        branches: &mut [Branch; 2],
+    ) -> Result<usize, IkError> {
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
         let target = self.rw0 * pose.axis;
-        let mut orientations = [Orientation {
-            joints: self.fixed,
-            singular: false,
-            angles: [ZERO_ANGLE; 3],
-        }; 2];
         let count;
         match self.free_rot.len() {
             0 => {
@@ -412,12 +655,14 @@ impl Kinematics {
                 if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
                     return Err(IkError::OrientationUnreachable);
                 }
-                let o = &mut orientations[0];
-                let angle = sp1_cs(&w, &u, &v).unwrap_or_else(|| {
-                    o.singular = true;
-                    degrees(hint_of(i))
-                });
-                o.set(0, i, angle);
+                let b = &mut branches[0];
+                b.angles[0] = match sp1_xy(&w, &u, &v) {
+                    Some((x, y)) => SlotAngle::from_xy(x, y),
+                    None => {
+                        b.singular = true;
+                        SlotAngle::from_degrees(hint_of(i))
+                    }
+                };
                 count = 1;
             }
             nfree => {
@@ -439,94 +684,168 @@ impl Kinematics {
                     let q = self.c0t * target_rot * c[3].transpose() * w3;
                     (self.sp2_p, q, Some(target_rot))
                 } else {
-                    (self.sp2_p, self.c0t * target, None)
+                    (self.sp2_p, self.axis_to_sp2.apply(&pose.axis), None)
                 };
-                let (sols, n) = sp2(&w1, &w2e, &p, &q, 1e-10);
+                let (sols, n) = self.sp2.solve_xy(&q, 1e-10);
                 if n == 0 {
                     return Err(IkError::OrientationUnreachable);
                 }
                 for (k, s) in sols[..n].iter().enumerate() {
-                    let o = &mut orientations[k];
+                    let b = &mut branches[k];
                     let (a1, a2) = match (s.theta1, s.theta2) {
-                        (Some(a1), Some(a2)) => (a1, a2),
+                        (Some((x1, y1)), Some((x2, y2))) => {
+                            (SlotAngle::from_xy(x1, y1), SlotAngle::from_xy(x2, y2))
+                        }
                         // One angle is free (the tool axis lies on a rotary
                         // axis): keep the hinted value and solve the other
                         // one for it so that the tool axis is exact.
                         (None, a2) => {
-                            o.singular = true;
-                            let a1 = degrees(hint_of(i1));
+                            b.singular = true;
+                            let a1 = SlotAngle::from_degrees(hint_of(i1));
                             let v = a1.rotation(&w1).transpose() * q;
-                            let a2 = sp1_cs(&w2e, &p, &v).or(a2).unwrap_or(degrees(hint_of(i2)));
+                            let a2 = match sp1_xy(&w2e, &p, &v).or(a2) {
+                                Some((x, y)) => SlotAngle::from_xy(x, y),
+                                None => SlotAngle::from_degrees(hint_of(i2)),
+                            };
                             (a1, a2)
                         }
-                        (Some(a1), None) => {
-                            o.singular = true;
-                            let a2 = degrees(hint_of(i2));
+                        (Some((x1, y1)), None) => {
+                            b.singular = true;
+                            let a2 = SlotAngle::from_degrees(hint_of(i2));
                             let u = a2.rotation(&w2e) * p;
-                            (sp1_cs(&w1, &u, &q).unwrap_or(a1), a2)
+                            let (x, y) = sp1_xy(&w1, &u, &q).unwrap_or((x1, y1));
+                            (SlotAngle::from_xy(x, y), a2)
                         }
                     };
-                    o.set(0, i1, a1);
-                    o.set(1, i2, a2);
+                    b.angles[0] = a1;
+                    b.angles[1] = a2;
                     if let Some(target_rot) = full {
                         let (i3, w3) = self.free_rot[2];
                         let r12 = c[0] * a1.rotation(&w1) * c[1] * a2.rotation(&w2) * c[2];
                         let f3 = r12.transpose() * target_rot * c[3].transpose();
                         // Any vector off the axis shows the angle of F3.
                         let x = any_perpendicular(&w3);
-                        let a3 = sp1_cs(&w3, &x, &(f3 * x)).unwrap_or_else(|| {
-                            o.singular = true;
-                            degrees(hint_of(i3))
-                        });
-                        o.set(2, i3, a3);
+                        b.angles[2] = match sp1_xy(&w3, &x, &(f3 * x)) {
+                            Some((x, y)) => SlotAngle::from_xy(x, y),
+                            None => {
+                                b.singular = true;
+                                SlotAngle::from_degrees(hint_of(i3))
+                            }
+                        };
                     }
                 }
                 count = n;
             }
         }
 
-        // Branches whose rotary angles fit the travel first; the others are
-        // only needed to say why nothing fits.
-        let fits = |j: &Joints| {
-            self.free_rot
-                .iter()
-                .all(|&(i, _)| has_equivalent(self.limits[i], wrap180(j[i])))
-        };
-        for pass in [true, false] {
-            if !pass && !all_branches && out.iter().any(Solution::is_valid) {
-                break;
-            }
-            for (k, o) in orientations[..count].iter().enumerate() {
-                if fits(&o.joints) != pass {
-                    continue;
-                }
-                let mut rots = [Matrix3::identity(); 3];
-                for (slot, a) in o.angles[..self.free_rot.len()].iter().enumerate() {
-                    rots[slot] = a.rotation(&self.slot_dir[slot]);
-                }
-                let Some(joints) = self.solve_linear(&o.joints, &rots, &pose.point) else {
-                    continue;
-                };
-                self.push_equivalents(joints, k as u8, o.singular, hint, out);
-            }
-        }
-        if out.is_empty() {
-            return Err(IkError::PositionUnreachable);
-        }
-        Ok(())
+        Ok(count)
     }
 
-    /// With every rotary angle set in `joints`, solves the free linear axes so
-    /// that the tool point lands on `target` (part frame).
-    fn solve_linear(&self, joints: &Joints, rots: &Rots, target: &Vector3<f64>) -> Option<Joints> {
-        let mut q = *joints;
-        for &i in &self.free_lin {
-            q[i] = 0.0;
+    /// Whether every rotary angle of the branch has an equivalent inside its
+    /// travel (decided once per branch). An angle not yet known in degrees
+    /// is first tried with the arc test, which leaves out its `atan2` when
+    /// the answer is no.
+    #[inline(always)]
+    fn fits<const N: usize>(&self, b: &mut Branch) -> bool {
+        if let Some(f) = b.fits {
+            return f;
         }
-        let e = self.eval(&q, rots);
-        let rhs = target - e.point;
-        let c = &e.cols;
+        let mut f = true;
+        for (slot, a) in self.slots[..N].iter().zip(&mut b.angles) {
+            let Some(arc) = &slot.arc else {
+                continue;
+            };
+            let inside = match (a.degrees, arc.contains(a.cos, a.sin)) {
+                (None, Some(inside)) => inside,
+                _ => slot.range(a.in_degrees(), None).has_equivalent(),
+            };
+            if !inside {
+                f = false;
+                break;
+            }
+        }
+        b.fits = Some(f);
+        f
+    }
+
+    /// The linear axes of one orientation branch, and its solutions.
+    #[inline(always)]
+    fn solve_branch<const N: usize>(
+        &self,
+        b: &mut Branch,
+        branch: u8,
+        point: &V3,
+        hint: Option<&[f64]>,
+        out: &mut Vec<Solution>,
+    ) {
+        let mut joints = self.fixed;
+        let mut rots = [Rot::IDENTITY; 3];
+        let mut ranges = [SlotRange::default(); 3];
+        for k in 0..N {
+            let (slot, a) = (&self.slots[k], &mut b.angles[k]);
+            ranges[k] = slot.range(a.in_degrees(), hint);
+            joints[slot.axis] = ranges[k].raw;
+            rots[k] = slot.turn.rotation(a.cos, a.sin);
+        }
+        if let Some(joints) = self.solve_linear(&joints, &rots, point) {
+            self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
+        }
+    }
+
+    /// With every rotary angle set in `joints` (and their rotations in
+    /// `rots`), solves the free linear axes so that the tool point lands on
+    /// `target` (part frame).
+    fn solve_linear(&self, joints: &Joints, rots: &Rots, target: &V3) -> Option<Joints> {
+        let mut q = *joints;
+        // Bring the target inside the steps outside the linear axes.
+        let mut y = *target;
+        for step in &self.steps[..self.split] {
+            match step {
+                // Locked linear axes only: the split is at the first free one.
+                Step::Linear { axis, dir, .. } => y -= dir * q[*axis],
+                Step::Rotary(t) => y = t.unmove_point(&rots[t.slot], &y),
+            }
+        }
+        let inner = &self.steps[self.split..];
         let m = self.free_lin.len();
+        if let LinearSolve::Constant(rows) = &self.linear_solve {
+            // The tool point with the free linear axes at zero.
+            let mut point = self.tip;
+            for step in self.inner_fixed.iter().rev() {
+                match step {
+                    Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                    Step::Rotary(t) => point = t.move_point(&rots[t.slot], &point),
+                }
+            }
+            let rhs = y - point;
+            for (k, &i) in self.free_lin.iter().enumerate() {
+                q[i] = rows[k].dot(&rhs);
+            }
+            return self.free_lin.iter().all(|&i| q[i].is_finite()).then_some(q);
+        }
+
+        // The tool point with the free linear axes at zero, and the column
+        // of each free linear axis (how the point moves per unit of it).
+        let mut point = self.tip;
+        let mut c = [V3::zeros(); 3];
+        for step in inner.iter().rev() {
+            match step {
+                Step::Linear {
+                    column: Some(k),
+                    dir,
+                    ..
+                } => c[*k] = *dir,
+                Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                Step::Rotary(t) => {
+                    let r = &rots[t.slot];
+                    point = t.move_point(r, &point);
+                    for col in &mut c[..m] {
+                        *col = r.apply(col);
+                    }
+                }
+            }
+        }
+        let rhs = y - point;
         let values: [f64; 3] = match m {
             3 => {
                 // Cramer's rule with triple products.
@@ -553,7 +872,7 @@ impl Kinematics {
                 out
             }
         };
-        let mut moved = Vector3::zeros();
+        let mut moved = V3::zeros();
         for (k, &i) in self.free_lin.iter().enumerate() {
             q[i] = values[k];
             moved += c[k] * values[k];
@@ -567,81 +886,258 @@ impl Kinematics {
         Some(q)
     }
 
-    fn push_equivalents(
+    /// Appends the solution `joints` with every 360° equivalent of its
+    /// rotary angles inside their travel (`ranges`, by slot; the first free
+    /// rotary axis varies slowest).
+    #[inline(always)]
+    fn push_equivalents<const N: usize>(
         &self,
-        joints: Joints,
+        mut joints: Joints,
+        ranges: &[SlotRange; 3],
         branch: u8,
         singular: bool,
-        hint: Option<&[f64]>,
         out: &mut Vec<Solution>,
     ) {
-        // Linear axes first: their values do not change between equivalents.
-        let linear_violation = (0..self.n)
-            .filter(|&i| !self.rotary[i] && !self.is_fixed[i])
-            .find(|&i| !accepts(self.limits[i], joints[i]))
-            .map(|i| Violation {
-                axis: i,
-                value: joints[i],
-            });
-        let start = out.len();
-        let mut stack = joints;
-        self.expand(0, &mut stack, branch, singular, hint, out);
-        if out.len() == start {
+        if let Some(slot) = ranges[..N].iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
-            let (i, v) = self
-                .free_rot
-                .iter()
-                .map(|&(i, _)| (i, wrap180(joints[i])))
-                .find(|&(i, v)| !has_equivalent(self.limits[i], v))
-                .unwrap_or((0, joints[0]));
             out.push(Solution {
                 joints,
                 branch,
                 singular,
-                violation: Some(Violation { axis: i, value: v }),
+                violation: Some(Violation {
+                    axis: self.slots[slot].axis,
+                    value: ranges[slot].principal,
+                }),
             });
-        } else if let Some(v) = linear_violation {
-            for s in &mut out[start..] {
-                s.violation = Some(v);
+            return;
+        }
+        // Linear axes: their values do not change between equivalents. A
+        // branch outside the linear travel is given once.
+        let violation = self
+            .free_lin
+            .iter()
+            .find(|&&i| !accepts(self.limits[i], joints[i]))
+            .map(|&i| Violation {
+                axis: i,
+                value: joints[i],
+            });
+        let mut turn = [0.0; 3];
+        for (t, r) in turn.iter_mut().zip(ranges) {
+            *t = r.first;
+        }
+        loop {
+            for k in 0..N {
+                joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
             }
-            out.truncate(start + 1);
+            out.push(Solution {
+                joints,
+                branch,
+                singular,
+                violation,
+            });
+            if violation.is_some() {
+                return;
+            }
+            // The next combination, the last slot fastest.
+            let mut slot = N;
+            loop {
+                if slot == 0 {
+                    return;
+                }
+                slot -= 1;
+                if turn[slot] < ranges[slot].last {
+                    turn[slot] += 1.0;
+                    break;
+                }
+                turn[slot] = ranges[slot].first;
+            }
+        }
+    }
+}
+
+/// The rows of Cramer's rule for the columns `c`: `x_k = rows[k]·rhs` solves
+/// `Σ x_k c_k = rhs`. `None` for a (nearly) singular matrix.
+fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
+    let n = [c[1].cross(&c[2]), c[2].cross(&c[0]), c[0].cross(&c[1])];
+    let det = c[0].dot(&n[0]);
+    // A margin above the singularity test of the general path, which then
+    // decides (identically) for nearly singular machines.
+    if det.abs() < 1e-9 {
+        return None;
+    }
+    Some(n.map(|v| v / det))
+}
+
+/// One solved orientation branch: the angle of every free rotary slot,
+/// known as cosine and sine first, in degrees once needed.
+#[derive(Clone, Copy, Default)]
+struct Branch {
+    angles: [SlotAngle; 3],
+    fits: Option<bool>,
+    singular: bool,
+}
+
+/// The angle of one free rotary slot.
+#[derive(Clone, Copy)]
+struct SlotAngle {
+    cos: f64,
+    sin: f64,
+    /// `(x, y)` from subproblem 1, whose `atan2` is the angle; unused when
+    /// `degrees` is known from the start.
+    x: f64,
+    y: f64,
+    degrees: Option<f64>,
+}
+
+impl Default for SlotAngle {
+    fn default() -> Self {
+        SlotAngle {
+            cos: 1.0,
+            sin: 0.0,
+            x: 1.0,
+            y: 0.0,
+            degrees: Some(0.0),
+        }
+    }
+}
+
+impl SlotAngle {
+    #[inline]
+    fn from_xy(x: f64, y: f64) -> SlotAngle {
+        let (cos, sin) = unit_xy(x, y);
+        SlotAngle {
+            cos,
+            sin,
+            x,
+            y,
+            degrees: None,
         }
     }
 
-    fn expand(
-        &self,
-        k: usize,
-        joints: &mut Joints,
-        branch: u8,
-        singular: bool,
-        hint: Option<&[f64]>,
-        out: &mut Vec<Solution>,
-    ) {
-        let Some(&(i, _)) = self.free_rot.get(k) else {
-            out.push(Solution {
-                joints: *joints,
-                branch,
-                singular,
-                violation: None,
-            });
-            return;
-        };
-        let principal = wrap180(joints[i]);
-        match self.limits[i] {
-            None => {
-                // Unlimited: the turn nearest the hint (continuous output).
-                let h = hint.map_or(0.0, |h| h[i]);
-                joints[i] = principal + 360.0 * turns_nearest((h - principal) / 360.0) as f64;
-                self.expand(k + 1, joints, branch, singular, hint, out);
-            }
-            Some([lo, hi]) => {
-                let (first, last) = turn_range(lo, hi, principal);
-                for turn in first..=last {
-                    joints[i] = principal + 360.0 * turn as f64;
-                    self.expand(k + 1, joints, branch, singular, hint, out);
-                }
-            }
+    /// An angle given in degrees (a hint), through radians as the solver
+    /// has it.
+    fn from_degrees(deg: f64) -> SlotAngle {
+        let rad = deg.to_radians();
+        let (sin, cos) = rad.sin_cos();
+        SlotAngle {
+            cos,
+            sin,
+            x: cos,
+            y: sin,
+            degrees: Some(rad.to_degrees()),
         }
+    }
+
+    /// The angle in degrees (its `atan2` taken once).
+    #[inline]
+    fn in_degrees(&mut self) -> f64 {
+        *self
+            .degrees
+            .get_or_insert_with(|| atan2_deg(self.y, self.x))
+    }
+
+    fn rotation(&self, w: &V3) -> Matrix3<f64> {
+        rotation_cs(w, self.cos, self.sin)
+    }
+}
+
+/// The travel `[lo, hi]` of a rotary axis (less than a full turn and a
+/// degree), tested on the cosine and sine of an angle: the angle has an
+/// equivalent inside iff `cos(θ − mid) ≥ cos(half)`, `mid` and `half` the
+/// middle and half width of the travel with the 1e-9° slack of
+/// [`turn_range`].
+#[derive(Debug, Clone, Copy)]
+struct Arc {
+    cos_mid: f64,
+    sin_mid: f64,
+    cos_half: f64,
+}
+
+impl Arc {
+    fn new(lo: f64, hi: f64) -> Arc {
+        let (sin_mid, cos_mid) = rad(0.5 * (lo + hi)).sin_cos();
+        Arc {
+            cos_mid,
+            sin_mid,
+            cos_half: rad(0.5 * (hi - lo) + 1e-9).cos(),
+        }
+    }
+
+    /// Whether the angle with cosine `c` and sine `s` has an equivalent
+    /// inside the travel; `None` within 1e-9 of the edge, where the
+    /// rounding of either test could decide, and the angle in degrees
+    /// must (exactly as [`turn_range`] has it).
+    #[inline]
+    fn contains(&self, c: f64, s: f64) -> Option<bool> {
+        let d = c * self.cos_mid + s * self.sin_mid - self.cos_half;
+        if d > 1e-9 {
+            Some(true)
+        } else if d < -1e-9 {
+            Some(false)
+        } else {
+            None
+        }
+    }
+}
+
+/// A free rotary axis, by its slot.
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    /// Machine-file index of the axis.
+    axis: usize,
+    limits: Option<[f64; 2]>,
+    /// The arc test of a travel of less than a full turn and a degree.
+    arc: Option<Arc>,
+    turn: Turn,
+}
+
+impl Default for Slot {
+    fn default() -> Self {
+        Slot {
+            axis: 0,
+            limits: None,
+            arc: None,
+            turn: Turn::new(0, 0, V3::z(), V3::zeros()),
+        }
+    }
+}
+
+impl Slot {
+    /// The angle `raw` (degrees, as solved), its principal value and the
+    /// whole turns that keep it inside the travel; for an axis without
+    /// limits, the one turn nearest to the hint (continuous output).
+    #[inline(always)]
+    fn range(&self, raw: f64, hint: Option<&[f64]>) -> SlotRange {
+        let principal = wrap180(raw);
+        let (first, last) = match self.limits {
+            None => {
+                let t = turns_nearest((hint.map_or(0.0, |h| h[self.axis]) - principal) / 360.0);
+                (t, t)
+            }
+            Some([lo, hi]) => turn_range(lo, hi, principal),
+        };
+        SlotRange {
+            raw,
+            principal,
+            first,
+            last,
+        }
+    }
+}
+
+/// A slot angle in degrees as solved (`raw`), wrapped to (−180°, 180°], and
+/// the whole turns `first..=last` that keep it inside the travel.
+#[derive(Clone, Copy, Default)]
+struct SlotRange {
+    raw: f64,
+    principal: f64,
+    first: f64,
+    last: f64,
+}
+
+impl SlotRange {
+    fn has_equivalent(&self) -> bool {
+        self.first <= self.last
     }
 }
 
@@ -652,46 +1148,44 @@ fn accepts(limits: Option<[f64; 2]>, v: f64) -> bool {
     }
 }
 
-fn has_equivalent(limits: Option<[f64; 2]>, principal: f64) -> bool {
-    match limits {
-        None => true,
-        Some([lo, hi]) => {
-            let (first, last) = turn_range(lo, hi, principal);
-            first <= last
-        }
+// Rounding in floating point: `floor`, `ceil` and `round` are library
+// calls on baseline x86-64, and conversions to integers saturate (several
+// instructions each); both showed up in the posting profile.
+
+/// ⌊x⌋: below 2^51 by rounding to the nearest whole number with the
+/// 1.5·2^52 trick (adding it leaves no fraction bits) and stepping down if
+/// that rounded up; larger numbers are whole or nearly, for the library.
+#[inline(always)]
+fn floor_f(x: f64) -> f64 {
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    if x.abs() < 2_251_799_813_685_248.0 {
+        let r = (x + ROUND) - ROUND;
+        if r > x { r - 1.0 } else { r }
+    } else {
+        x.floor()
     }
 }
 
-// Rounding by integer conversion: `floor`, `ceil`, `round` and `fmod` are
-// library calls on baseline x86-64 and showed up in the posting profile.
-// Angles here are far below 2^53 turns.
-
-/// ⌊x⌋ as an integer.
-#[inline]
-fn floor_i(x: f64) -> i64 {
-    let t = x as i64;
-    if (t as f64) > x { t - 1 } else { t }
+/// The nearest whole number to x (halves up).
+#[inline(always)]
+fn turns_nearest(x: f64) -> f64 {
+    floor_f(x + 0.5)
 }
 
-/// The nearest integer to x (halves away from zero or not: callers do not care).
-#[inline]
-fn turns_nearest(x: f64) -> i64 {
-    floor_i(x + 0.5)
-}
-
-/// The whole turns k with lo ≤ principal + 360k ≤ hi (1e-9° slack).
-#[inline]
-fn turn_range(lo: f64, hi: f64, principal: f64) -> (i64, i64) {
+/// The whole turns k with lo ≤ principal + 360k ≤ hi (1e-9° slack), as
+/// the first and last k.
+#[inline(always)]
+fn turn_range(lo: f64, hi: f64, principal: f64) -> (f64, f64) {
     (
-        -floor_i(-(lo - 1e-9 - principal) / 360.0),
-        floor_i((hi + 1e-9 - principal) / 360.0),
+        -floor_f(-(lo - 1e-9 - principal) / 360.0),
+        floor_f((hi + 1e-9 - principal) / 360.0),
     )
 }
 
 /// Angle in degrees wrapped to (−180, 180].
 #[inline]
 pub fn wrap180(deg: f64) -> f64 {
-    let w = deg - 360.0 * turns_nearest(deg / 360.0) as f64;
+    let w = deg - 360.0 * turns_nearest(deg / 360.0);
     if w <= -180.0 {
         w + 360.0
     } else if w > 180.0 {
@@ -699,35 +1193,6 @@ pub fn wrap180(deg: f64) -> f64 {
     } else {
         w
     }
-}
-
-/// The solved orientation of one branch.
-#[derive(Clone, Copy)]
-struct Orientation {
-    joints: Joints,
-    singular: bool,
-    /// Angles of the free rotary slots.
-    angles: [Angle; 3],
-}
-
-impl Orientation {
-    fn set(&mut self, slot: usize, axis: usize, angle: Angle) {
-        self.joints[axis] = angle.rad.to_degrees();
-        self.angles[slot] = angle;
-    }
-}
-
-const ZERO_ANGLE: Angle = Angle {
-    rad: 0.0,
-    cos: 1.0,
-    sin: 0.0,
-};
-
-/// An angle given in degrees.
-fn degrees(deg: f64) -> Angle {
-    let rad = deg.to_radians();
-    let (sin, cos) = rad.sin_cos();
-    Angle { rad, cos, sin }
 }
 
 /// Orthonormal frame (columns a, b', a×b') from a direction and a second,
@@ -769,7 +1234,8 @@ mod tests {
             540.0,
             1e6 + 0.25,
         ] {
-            assert_eq!(floor_i(x), x.floor() as i64, "{x}");
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+            assert_eq!(floor_f(-x), (-x).floor(), "{x}");
             let w = wrap180(x);
             assert!(w > -180.0 && w <= 180.0, "{x} -> {w}");
             assert!(
@@ -778,9 +1244,17 @@ mod tests {
             );
         }
         assert_eq!(wrap180(-180.0), 180.0);
-        assert_eq!(turn_range(-360.0, 360.0, 10.0), (-1, 0));
-        assert_eq!(turn_range(-45.2, 45.2, 10.0), (0, 0));
-        assert_eq!(turn_range(-45.2, 45.2, 50.0), (0, -1));
-        assert_eq!(turn_range(0.0, 720.0, -90.0), (1, 2));
+        assert_eq!(turn_range(-360.0, 360.0, 10.0), (-1.0, 0.0));
+        assert_eq!(turn_range(-45.2, 45.2, 10.0), (0.0, 0.0));
+        assert_eq!(turn_range(-45.2, 45.2, 50.0), (0.0, -1.0));
+        assert_eq!(turn_range(0.0, 720.0, -90.0), (1.0, 2.0));
+        for x in [0.5, 1.5, 2.5, -0.5, -1.5, 4503599627370495.5, 1e300, -1e300] {
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+        }
+        assert!(floor_f(f64::NAN).is_nan());
     }
 }
+
+#[cfg(test)]
+#[path = "kinematics_props.rs"]
+mod props;

@@ -57,20 +57,41 @@ impl Angle {
 /// Subproblem 1 with the cosine and sine of the solution (see [`sp1`]).
 #[inline]
 pub fn sp1_cs(w: &Vector3<f64>, u: &Vector3<f64>, v: &Vector3<f64>) -> Option<Angle> {
+    sp1_xy(w, u, v).map(|(x, y)| Angle::from_xy(x, y))
+}
+
+/// Subproblem 1 before its `atan2`: `(x, y)`, a positive multiple of
+/// `(cos θ, sin θ)` (see [`sp1`]). The inverse kinematics takes the angle
+/// itself only for the branches it needs.
+#[inline]
+pub fn sp1_xy(w: &Vector3<f64>, u: &Vector3<f64>, v: &Vector3<f64>) -> Option<(f64, f64)> {
     let up = u - w * w.dot(u);
     let vp = v - w * w.dot(v);
     if up.norm_squared() < FREE_EPS * FREE_EPS || vp.norm_squared() < FREE_EPS * FREE_EPS {
         return None;
     }
-    let y = w.dot(&up.cross(&vp));
-    let x = up.dot(&vp);
+    Some((up.dot(&vp), w.dot(&up.cross(&vp))))
+}
+
+impl Angle {
+    /// The angle of the direction `(x, y)` (not both zero).
+    #[inline]
+    pub fn from_xy(x: f64, y: f64) -> Angle {
+        let (cos, sin) = unit_xy(x, y);
+        Angle {
+            rad: f64::atan2(y, x),
+            cos,
+            sin,
+        }
+    }
+}
+
+/// `(x, y)` scaled to unit length: the cosine and sine of its angle.
+#[inline]
+pub fn unit_xy(x: f64, y: f64) -> (f64, f64) {
     // Both are products of unit-length-scale vectors: no overflow to fear.
     let r = (x * x + y * y).sqrt();
-    Some(Angle {
-        rad: f64::atan2(y, x),
-        cos: x / r,
-        sin: y / r,
-    })
+    (x / r, y / r)
 }
 
 /// Subproblem 1: the angle `θ` with `rot(w, θ)·u = v`, assuming `w·u = w·v`
@@ -90,6 +111,16 @@ pub struct Sp2Solution {
     pub theta2: Option<Angle>,
 }
 
+/// One solution of subproblem 2 before the `atan2`s (see [`sp1_xy`] and
+/// [`Sp2::solve_xy`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sp2Xy {
+    /// `(x, y)` of the angle about the first axis; `None` if free (singular).
+    pub theta1: Option<(f64, f64)>,
+    /// `(x, y)` of the angle about the second axis; `None` if free (singular).
+    pub theta2: Option<(f64, f64)>,
+}
+
 /// Subproblem 2: angles with `rot(w1, θ1)·rot(w2, θ2)·p = q` for unit vectors
 /// `p`, `q` and non-parallel unit axes `w1`, `w2`. Returns 0, 1 or 2
 /// solutions. `slack` is how far below zero the squared height of the
@@ -102,35 +133,99 @@ pub fn sp2(
     q: &Vector3<f64>,
     slack: f64,
 ) -> ([Sp2Solution; 2], usize) {
-    let none = Sp2Solution {
-        theta1: None,
-        theta2: None,
+    let (xy, n) = Sp2::new(w1, w2, p).solve_xy(q, slack);
+    let angle = |t: Option<(f64, f64)>| t.map(|(x, y)| Angle::from_xy(x, y));
+    let sol = |s: &Sp2Xy| Sp2Solution {
+        theta1: angle(s.theta1),
+        theta2: angle(s.theta2),
     };
-    let w12 = w1.dot(w2);
-    let cross = w1.cross(w2);
-    let cross2 = cross.norm_squared();
-    if cross2 < 1e-24 {
-        return ([none; 2], 0);
-    }
-    let denom = w12 * w12 - 1.0;
-    let a = (w12 * w2.dot(p) - w1.dot(q)) / denom;
-    let b = (w12 * w1.dot(q) - w2.dot(p)) / denom;
-    let g2 = (p.norm_squared() - a * a - b * b - 2.0 * a * b * w12) / cross2;
-    if g2 < -slack {
-        return ([none; 2], 0);
-    }
-    let g = g2.max(0.0).sqrt();
-    let solve = |g: f64| {
-        let z = w1 * a + w2 * b + cross * g;
-        Sp2Solution {
-            theta1: sp1_cs(w1, &z, q),
-            theta2: sp1_cs(w2, p, &z),
+    ([sol(&xy[0]), sol(&xy[1])], n)
+}
+
+/// Subproblem 2 for given axes `w1`, `w2` and vector `p`, with everything
+/// that does not depend on `q` worked out once: the inverse kinematics of a
+/// machine solves it for one `q` per CL point. Same arithmetic as [`sp2`],
+/// hence the same results to the bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sp2 {
+    w1: Vector3<f64>,
+    w2: Vector3<f64>,
+    w12: f64,
+    cross: Vector3<f64>,
+    cross2: f64,
+    denom: f64,
+    w2p: f64,
+    p2: f64,
+    /// `p` with its component along `w2` removed (subproblem 1 for `θ2`
+    /// turns it), and whether that leaves nothing (`θ2` free).
+    p_off_w2: Vector3<f64>,
+    p_on_w2: bool,
+}
+
+impl Sp2 {
+    pub fn new(w1: &Vector3<f64>, w2: &Vector3<f64>, p: &Vector3<f64>) -> Sp2 {
+        let w12 = w1.dot(w2);
+        let cross = w1.cross(w2);
+        let w2p = w2.dot(p);
+        let p_off_w2 = p - w2 * w2p;
+        Sp2 {
+            w1: *w1,
+            w2: *w2,
+            w12,
+            cross,
+            cross2: cross.norm_squared(),
+            denom: w12 * w12 - 1.0,
+            w2p,
+            p2: p.norm_squared(),
+            p_off_w2,
+            p_on_w2: p_off_w2.norm_squared() < FREE_EPS * FREE_EPS,
         }
-    };
-    if g == 0.0 {
-        ([solve(0.0), none], 1)
-    } else {
-        ([solve(g), solve(-g)], 2)
+    }
+
+    /// The solutions for `q`, as [`sp2`] has them but before the `atan2`s.
+    #[inline]
+    pub fn solve_xy(&self, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
+        let none = Sp2Xy {
+            theta1: None,
+            theta2: None,
+        };
+        let (w1, w2, w12) = (&self.w1, &self.w2, self.w12);
+        if self.cross2 < 1e-24 {
+            return ([none; 2], 0);
+        }
+        let w1q = w1.dot(q);
+        let a = (w12 * self.w2p - w1q) / self.denom;
+        let b = (w12 * w1q - self.w2p) / self.denom;
+        let g2 = (self.p2 - a * a - b * b - 2.0 * a * b * w12) / self.cross2;
+        if g2 < -slack {
+            return ([none; 2], 0);
+        }
+        let g = g2.max(0.0).sqrt();
+        // Subproblem 1 (see `sp1_xy`) for both angles, sharing the
+        // projections that do not depend on the intersection point `z`.
+        let q_off_w1 = q - w1 * w1q;
+        let q_on_w1 = q_off_w1.norm_squared() < FREE_EPS * FREE_EPS;
+        let solve = |g: f64| {
+            let z = w1 * a + w2 * b + self.cross * g;
+            let z_off_w1 = z - w1 * w1.dot(&z);
+            let z_off_w2 = z - w2 * w2.dot(&z);
+            let free = |v: &Vector3<f64>| v.norm_squared() < FREE_EPS * FREE_EPS;
+            Sp2Xy {
+                theta1: (!(free(&z_off_w1) || q_on_w1))
+                    .then(|| (z_off_w1.dot(&q_off_w1), w1.dot(&z_off_w1.cross(&q_off_w1)))),
+                theta2: (!(self.p_on_w2 || free(&z_off_w2))).then(|| {
+                    (
+                        self.p_off_w2.dot(&z_off_w2),
+                        w2.dot(&self.p_off_w2.cross(&z_off_w2)),
+                    )
+                }),
+            }
+        };
+        if g == 0.0 {
+            ([solve(0.0), none], 1)
+        } else {
+            ([solve(g), solve(-g)], 2)
+        }
     }
 }
 
@@ -151,7 +246,65 @@ mod tests {
         assert!((r * Vector3::x() - Vector3::y()).norm() < 1e-15);
     }
 
+    /// Subproblem 2 as first written, solved from scratch for each `q`
+    /// (Murray, Li, Sastry §3.3.2): the precomputed [`Sp2`] must give the
+    /// same bits.
+    fn sp2_from_scratch(
+        w1: &Vector3<f64>,
+        w2: &Vector3<f64>,
+        p: &Vector3<f64>,
+        q: &Vector3<f64>,
+        slack: f64,
+    ) -> ([Sp2Xy; 2], usize) {
+        let none = Sp2Xy {
+            theta1: None,
+            theta2: None,
+        };
+        let w12 = w1.dot(w2);
+        let cross = w1.cross(w2);
+        let cross2 = cross.norm_squared();
+        if cross2 < 1e-24 {
+            return ([none; 2], 0);
+        }
+        let denom = w12 * w12 - 1.0;
+        let a = (w12 * w2.dot(p) - w1.dot(q)) / denom;
+        let b = (w12 * w1.dot(q) - w2.dot(p)) / denom;
+        let g2 = (p.norm_squared() - a * a - b * b - 2.0 * a * b * w12) / cross2;
+        if g2 < -slack {
+            return ([none; 2], 0);
+        }
+        let g = g2.max(0.0).sqrt();
+        let solve = |g: f64| {
+            let z = w1 * a + w2 * b + cross * g;
+            Sp2Xy {
+                theta1: sp1_xy(w1, &z, q),
+                theta2: sp1_xy(w2, p, &z),
+            }
+        };
+        if g == 0.0 {
+            ([solve(0.0), none], 1)
+        } else {
+            ([solve(g), solve(-g)], 2)
+        }
+    }
+
     proptest! {
+        #[test]
+        fn precomputed_sp2_is_sp2_to_the_bit(
+            w1 in unit(), w2 in unit(), p in unit(), q in unit(),
+            on_axis in 0usize..4, t1 in -3.1..3.1f64, t2 in -3.1..3.1f64,
+        ) {
+            // Reachable targets, and the singular cases: p on w2, q on w1.
+            let p = if on_axis == 1 { w2 } else { p };
+            let q = match on_axis {
+                2 => w1,
+                3 => rotation(&w1, t1) * rotation(&w2, t2) * p,
+                _ => q,
+            };
+            let fast = Sp2::new(&w1, &w2, &p).solve_xy(&q, 1e-12);
+            prop_assert_eq!(fast, sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
+        }
+
         #[test]
         fn sp1_recovers_the_angle(w in unit(), u in unit(), t in -3.1..3.1f64) {
             prop_assume!(w.cross(&u).norm() > 1e-3);

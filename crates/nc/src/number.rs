@@ -214,7 +214,7 @@ impl Formatter {
     /// Writes the text of `n` units into `buf` at `at` and returns where it
     /// ends. Writes at most [`ENCODE_MAX`] bytes (so `buf` must have that
     /// room), each byte once and in place (no scratch copy).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn encode_into(&self, n: i64, buf: &mut [u8], at: usize) -> usize {
         let d = self.decimals as usize;
         let mut u = n.unsigned_abs();

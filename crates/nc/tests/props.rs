@@ -231,3 +231,41 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// A block of values just given to `quantized` (as the closed-loop check
+    /// does first) reuses their rounding: the program is the same bytes as
+    /// without the calls, also when the values asked about were others, NaN
+    /// or too large to write.
+    #[test]
+    fn quantized_calls_do_not_change_the_program(
+        input in blocks(),
+        asked in proptest::collection::vec((0usize..4, -1000.0..1000.0f64), 6),
+        dialect in prop_oneof![Just("sinumerik"), Just("csv"), Just("fanuc"), Just("heidenhain")],
+    ) {
+        let d = Dialect::builtin(dialect).unwrap();
+        let axes = mts_axes();
+        let mut plain = NcWriter::new(&d, &axes, Vec::new());
+        let mut checked = NcWriter::new(&d, &axes, Vec::new());
+        for (k, (rapid, v, f)) in input.iter().enumerate() {
+            for (i, &(how, other)) in asked.iter().enumerate() {
+                let q = match (how + k) % 4 {
+                    0 => checked.quantized(i, v[i]),
+                    1 => checked.quantized(i, other),
+                    2 => checked.quantized(i, f64::NAN),
+                    _ => checked.quantized(i, 1e300),
+                };
+                if (how + k) % 4 == 0 {
+                    prop_assert_eq!(q, d.quantize(&axes[i], v[i]));
+                }
+            }
+            let motion = if *rapid { Motion::Rapid } else { Motion::Feed };
+            let block = Block { cl_line: Some(k + 1), motion, axes: v, feed: Some(*f) };
+            plain.block(&block).unwrap();
+            checked.block(&block).unwrap();
+        }
+        prop_assert_eq!(plain.finish().unwrap(), checked.finish().unwrap());
+    }
+}

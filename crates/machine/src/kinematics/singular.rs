@@ -11,8 +11,8 @@
 
 use nalgebra::Vector3;
 
-use super::{Kinematics, degrees};
-use crate::subproblems::sp1_cs;
+use super::Kinematics;
+use crate::subproblems::{rotation, sp1_cs};
 
 /// The tool-axis direction at which one rotary angle becomes free.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,7 +55,7 @@ impl Kinematics {
         }
         let (_, w1) = self.free_rot[0];
         let q = self.c0t * (self.rw0 * axis);
-        let r1 = degrees(held_deg).rotation(&w1);
+        let r1 = rotation(&w1, held_deg.to_radians());
         let v = r1.transpose() * q;
         let w2 = self.sp2_w2;
         let p = self.sp2_p;
