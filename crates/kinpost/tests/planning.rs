@@ -9,6 +9,10 @@ use kinpost::{PostError, PostOptions, Summary, post};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
+#[allow(dead_code)] // random_body serves the other property tests
+mod rng;
+use rng::{Rng, vec_toml};
+
 fn post_csv(
     machine: &Machine,
     cl: &str,
@@ -280,45 +284,19 @@ fn point_by_point_planning_needs_more_reconfigurations() {
 
 /// A random serial machine whose linear axes are not carried by rotary
 /// axes (as on every real machine): the linear axes keep spanning space.
-/// A small deterministic generator (xorshift64*), seeded by proptest.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-    fn unit(&mut self) -> Vector3<f64> {
-        let v = Vector3::new(
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-        );
-        if v.norm() < 0.2 {
-            Vector3::z()
-        } else {
-            v.normalize()
-        }
-    }
-    fn coin(&mut self) -> usize {
-        usize::from(self.next() < 0.5)
-    }
+fn coin(rng: &mut Rng) -> usize {
+    usize::from(rng.next() < 0.5)
 }
 
 fn random_machine(rng: &mut Rng) -> String {
     let lin_dirs = [rng.unit(), rng.unit(), rng.unit()];
     let (r1, r2) = (rng.unit(), rng.unit());
-    let v = |v: &Vector3<f64>| format!("[{:.17}, {:.17}, {:.17}]", v.x, v.y, v.z);
+    let v = vec_toml;
     let mut axes = String::new();
     // Linear axes first on their side, rotaries after them.
     let sides = ["workpiece", "tool"];
-    let lin_side: Vec<&str> = (0..3).map(|_| sides[rng.coin()]).collect();
-    let rot_side: Vec<&str> = (0..2).map(|_| sides[rng.coin()]).collect();
+    let lin_side: Vec<&str> = (0..3).map(|_| sides[coin(rng)]).collect();
+    let rot_side: Vec<&str> = (0..2).map(|_| sides[coin(rng)]).collect();
     for (k, name) in ["X", "Y", "Z"].iter().enumerate() {
         axes += &format!(
             "[[axis]]\nname = \"{name}\"\nkind = \"linear\"\nside = \"{}\"\ndirection = {}\n",
