@@ -578,8 +578,7 @@ impl<W: Write> Job<'_, W> {
         let at = |message: String| -> PostError {
             reader.statement_diagnostic(Severity::Error, message).into()
         };
-        let unlocks = self.machine.unlocks_with_reference();
-        let six_axis = pose.reference.is_some() && unlocks;
+        let six_axis = pose.reference.is_some() && self.machine.unlocks_with_reference();
         self.open(six_axis)?;
         let Some(s) = self.setup.as_mut() else {
             unreachable!("`open` sets the job up")

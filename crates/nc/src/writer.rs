@@ -1,6 +1,5 @@
 //! The NC writer.
 
-use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::io::{self, Write};
 use std::sync::Arc;
@@ -146,10 +145,6 @@ pub struct NcWriter<W: Write> {
     axis_specs: Vec<AxisSpec>,
     /// Number format per machine axis (machine order).
     formats: Vec<Formatter>,
-    /// The last value given to [`NcWriter::quantized`] per machine axis,
-    /// as bits, with its units: a block of the values just quantized (the
-    /// closed-loop check comes first) does not round them again.
-    quantized: Vec<Cell<(u64, i64)>>,
     /// Words written in a block, in output order.
     words: Vec<Word>,
     /// The pressure word of an NC dialect, written on its own line (see
@@ -262,10 +257,6 @@ impl<W: Write> NcWriter<W> {
             units: vec![0; words.len()],
             names: axes.iter().map(|a| a.name.clone()).collect(),
             axis_specs: axes.to_vec(),
-            quantized: formats
-                .iter()
-                .map(|f| Cell::new((0f64.to_bits(), f.units(0.0).unwrap_or(0))))
-                .collect(),
             formats,
             words,
             pressure,
@@ -295,26 +286,7 @@ impl<W: Write> NcWriter<W> {
     /// (same as [`Dialect::quantize`] for that axis).
     #[inline]
     pub fn quantized(&self, axis_index: usize, value: f64) -> f64 {
-        let f = &self.formats[axis_index];
-        match f.units(value) {
-            Ok(n) => {
-                self.quantized[axis_index].set((value.to_bits(), n));
-                f.value_of_units(n)
-            }
-            Err(_) => value,
-        }
-    }
-
-    /// The units of `value` for machine axis `axis`, from the last
-    /// [`NcWriter::quantized`] if it was this value.
-    #[inline(always)]
-    fn units_of(&self, axis: usize, value: f64) -> Result<i64, crate::NumberError> {
-        let (bits, n) = self.quantized[axis].get();
-        if bits == value.to_bits() {
-            Ok(n)
-        } else {
-            self.formats[axis].units(value)
-        }
+        self.formats[axis_index].quantize(value)
     }
 
     /// Number of motion blocks written so far.
@@ -590,7 +562,7 @@ impl<W: Write> NcWriter<W> {
         let mut any = false;
         for (k, w) in self.words.iter().enumerate() {
             let v = block.axes[w.index];
-            let n = match self.units_of(w.index, v) {
+            let n = match w.fmt.units(v) {
                 Ok(n) => n,
                 Err(e) => return Err(self.bad_value(w.index, v, e)),
             };
@@ -769,7 +741,7 @@ impl<W: Write> NcWriter<W> {
                 line.put(&self.sep);
                 continue;
             }
-            let n = match self.units_of(w.index, v) {
+            let n = match w.fmt.units(v) {
                 Ok(n) => n,
                 Err(e) => {
                     self.line = line;
