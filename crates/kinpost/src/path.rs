@@ -50,6 +50,8 @@ enum Item {
 #[derive(Clone, Copy)]
 struct Decided {
     node: Node,
+    /// The closed-form branch of its configuration.
+    branch: u8,
     continuous: bool,
 }
 
@@ -77,7 +79,7 @@ pub(crate) struct PathPlan {
     segment: u64,
     break_pending: bool,
     /// The last point written: its node and segment.
-    last: Option<(Node, u64)>,
+    last: Option<(Node, u8, u64)>,
     choices: Vec<Choice>,
     solutions: Vec<Solution>,
     pub stretches: Vec<SingularStretch>,
@@ -272,7 +274,7 @@ impl PathPlan {
                             at: &at,
                         },
                     )?;
-                    self.last = Some((d.node, p.segment));
+                    self.last = Some((d.node, d.branch, p.segment));
                 }
             }
         }
@@ -292,9 +294,8 @@ impl PathPlan {
                 }
             }
         }
-        if let Some((node, _)) = &self.last {
-            // Branch labels do not matter across a decision boundary.
-            self.trellis.set_anchor(node.joints, 0);
+        if let Some((node, branch, _)) = &self.last {
+            self.trellis.set_anchor(node.joints, *branch);
         }
         Ok(())
     }
@@ -326,6 +327,7 @@ impl PathPlan {
                         joints: choice.joints,
                         hold: None,
                     },
+                    branch: choice.branch,
                     continuous: choice.continuous,
                 });
             }
@@ -368,7 +370,7 @@ impl PathPlan {
                 .then(|| out[run.start - 1].map(|d| d.node))
                 .flatten()
         } else {
-            self.last.filter(|(_, s)| *s == seg).map(|(n, _)| n)
+            self.last.filter(|(_, _, s)| *s == seg).map(|(n, _, _)| n)
         };
         let after: Option<Node> = points
             .get(run.end)
@@ -378,7 +380,7 @@ impl PathPlan {
             .map(|d| d.node);
         let anchor = self
             .last
-            .map(|(n, _)| n.joints)
+            .map(|(n, _, _)| n.joints)
             .or_else(|| self.trellis.anchor().copied())
             .unwrap_or([0.0; MAX_AXES]);
         let axis = self.singularity.map(|s| s.axis);
@@ -467,6 +469,7 @@ impl PathPlan {
                     joints: sol.joints,
                     hold,
                 },
+                branch: sol.branch,
                 continuous: true,
             });
         }

@@ -472,3 +472,34 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
         );
     }
 }
+
+#[test]
+fn deciding_point_by_point_keeps_the_branch_it_is_on() {
+    // A limited to negative values puts the path on one branch of the
+    // closed form; steps of 3° of the tool axis are no flip, whether the
+    // planner decides at the end or at every point.
+    let source = builtin::source("trunnion-ac")
+        .unwrap()
+        .replace("limits = [-30, 120]", "limits = [-60, 0]");
+    let m = machine_from_toml(&source, "negative-a.toml").unwrap();
+    let mut cl = String::from("FEDRAT/MMPM,500\nRAPID\n");
+    for k in 0..8 {
+        let t = (20.0 + 3.0 * k as f64).to_radians();
+        cl.push_str(&goto(
+            &Vector3::new(k as f64, 0.0, 0.0),
+            &Vector3::new(t.sin(), 0.0, t.cos()),
+        ));
+    }
+    for planner in [kinpost::PlannerMode::Global, kinpost::PlannerMode::Nearest] {
+        let options = PostOptions {
+            planner,
+            ..Default::default()
+        };
+        let (_, summary) = post_csv(&m, &cl, &options).unwrap();
+        assert!(
+            summary.planning.reconfigurations.is_empty(),
+            "{planner:?}: {:?}",
+            summary.planning.reconfigurations
+        );
+    }
+}
