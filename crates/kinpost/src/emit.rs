@@ -110,9 +110,7 @@ impl<W: Write> Emitter<W> {
             writer,
             settings,
             n: axes.len(),
-            rotary: (0..axes.len())
-                .filter(|&i| axes[i].is_rotary() && axes[i].is_free())
-                .collect(),
+            rotary: machine.free_rotary_axes().collect(),
             vmax: (0..axes.len())
                 .filter(|&i| axes[i].is_free())
                 .filter_map(|i| axes[i].max_velocity.map(|v| (i, v)))

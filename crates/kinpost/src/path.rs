@@ -98,9 +98,7 @@ impl PathPlan {
             trellis,
             singularity: kin.singularity(),
             cone_rad: cone_deg.to_radians(),
-            rotary: (0..axes.len())
-                .filter(|&i| axes[i].is_rotary() && axes[i].is_free())
-                .collect(),
+            rotary: machine.free_rotary_axes().collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
             file: file.to_string(),
             items: Vec::new(),
@@ -170,10 +168,11 @@ impl PathPlan {
         let n = kin.axis_count();
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
             .map_err(|e| PointError::Ik(e.to_string()))?;
-        let in_cone = self
+        // Angle between the tool axis and the singular direction.
+        let pole = self
             .singularity
-            .is_some_and(|s| s.distance(&pose.axis) < self.cone_rad);
-        let singular = in_cone || self.solutions.iter().all(|s| s.singular);
+            .map_or(f64::INFINITY, |s| s.distance(&pose.axis));
+        let singular = pole < self.cone_rad || self.solutions.iter().all(|s| s.singular);
         if singular {
             if !self.solutions.iter().any(Solution::is_valid) {
                 return Err(PointError::Rejected(rejection(&self.solutions)));
@@ -183,9 +182,7 @@ impl PathPlan {
             // The tool axis swept past the pole between the two points (its
             // distances to the pole add up to the turn): the branches meet
             // there, as across singular points.
-            let pole_deg = self
-                .singularity
-                .map_or(f64::INFINITY, |s| s.distance(&pose.axis).to_degrees());
+            let pole_deg = pole.to_degrees();
             let cone_deg = self.cone_rad.to_degrees();
             if self.planned_pole_deg + pole_deg <= self.turn + 2.0 * cone_deg + 1e-9 {
                 self.across = true;

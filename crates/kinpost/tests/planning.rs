@@ -149,54 +149,27 @@ fn near_the_pole_c_turns_no_more_than_the_pass_needs() {
     }
 }
 
-/// An A/C table whose C turns by ±100° only.
-const SHORT_C: &str = r#"
-name = "short-c"
-[[axis]]
-name = "X"
-kind = "linear"
-side = "tool"
-direction = [1, 0, 0]
-[[axis]]
-name = "Y"
-kind = "linear"
-side = "tool"
-direction = [0, 1, 0]
-[[axis]]
-name = "Z"
-kind = "linear"
-side = "tool"
-direction = [0, 0, 1]
-[[axis]]
-name = "A"
-kind = "rotary"
-side = "workpiece"
-direction = [1, 0, 0]
-point = [0, 0, -50]
-limits = [-60, 60]
-[[axis]]
-name = "C"
-kind = "rotary"
-side = "workpiece"
-direction = [0, 0, 1]
-point = [0, 0, 0]
-limits = [-100, 100]
-[workpiece]
-origin = [0, 0, 0]
-x = [1, 0, 0]
-z = [0, 0, 1]
-[tool]
-point = [0, 0, 0]
-axis = [0, 0, 1]
-"#;
+/// The built-in A/C trunnion with C turning by ±100° only.
+fn short_c() -> Machine {
+    let source = builtin::source("trunnion-ac").unwrap().replace(
+        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+        "point = [0, 0, 0]\nlimits = [-100, 100]",
+    );
+    let m = machine_from_toml(&source, "short-c.toml").unwrap();
+    assert_eq!(
+        m.axes[m.axis_index("C").unwrap()].limits,
+        Some([-100.0, 100.0])
+    );
+    m
+}
 
-/// Tool axis tilted 30° turning about the part's Z by 270°: more than C's
+/// Tool axis tilted 25° turning about the part's Z by 270°: more than C's
 /// range on either A branch.
 fn long_turn() -> String {
     let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
     for k in 0..=54 {
         let phi = (5.0 * k as f64).to_radians();
-        let tilt = 30f64.to_radians();
+        let tilt = 25f64.to_radians();
         let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
         let point = Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0);
         cl.push_str(&goto(&point, &axis));
@@ -206,7 +179,7 @@ fn long_turn() -> String {
 
 #[test]
 fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
-    let m = machine_from_toml(SHORT_C, "short-c.toml").unwrap();
+    let m = short_c();
     let kin = Kinematics::new(&m);
     let cl = long_turn();
     let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
@@ -251,7 +224,7 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
 fn point_by_point_planning_needs_more_reconfigurations() {
     // The whole-path planner starts on the branch that lasts; point by
     // point takes the one nearest zero first.
-    let m = machine_from_toml(SHORT_C, "short-c.toml").unwrap();
+    let m = short_c();
     let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
     for k in 0..=30 {
         // Azimuth from 0° to −150°: C = 90° → 240° on the A = 20° branch,

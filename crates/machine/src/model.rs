@@ -194,12 +194,14 @@ impl Machine {
             .position(|a| a.name.eq_ignore_ascii_case(name))
     }
 
+    /// Indices of the free (not `fixed`) rotary axes, in file order.
+    pub fn free_rotary_axes(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.axes.len()).filter(|&i| self.axes[i].is_rotary() && self.axes[i].is_free())
+    }
+
     /// Number of free (not `fixed`) rotary axes.
     pub fn free_rotary_count(&self) -> usize {
-        self.axes
-            .iter()
-            .filter(|a| a.is_rotary() && a.is_free())
-            .count()
+        self.free_rotary_axes().count()
     }
 
     /// Whether some axis is locked only until the CL gives reference

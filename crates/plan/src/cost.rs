@@ -71,9 +71,8 @@ impl Costs {
     /// direction, if the machine has one.
     pub fn new(machine: &Machine, cone_deg: f64, singular_axis: Option<usize>) -> Costs {
         let free = |i: &usize| machine.axes[*i].is_free();
-        let rotary = (0..machine.axes.len())
-            .filter(free)
-            .filter(|&i| machine.axes[i].is_rotary())
+        let rotary = machine
+            .free_rotary_axes()
             .map(|i| Rotary {
                 index: i,
                 wrap: machine.axes[i].wrap,
