@@ -11,9 +11,11 @@ use std::io::Write;
 use std::ops::Range;
 
 use kinpost_diag::Diagnostic;
+use kinpost_machine::angle::atan2_deg;
 use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
+use nalgebra::Vector3;
 
 use crate::check::angle_between;
 use crate::emit::{Emitter, Node, Target};
@@ -41,11 +43,6 @@ pub(crate) struct PlanPoint {
     pub starts_segment: bool,
 }
 
-enum Item {
-    Point(PlanPoint),
-    Output(Pending),
-}
-
 /// What was decided for a point.
 #[derive(Clone, Copy)]
 struct Decided {
@@ -63,24 +60,32 @@ pub(crate) struct PathPlan {
     rotary: Vec<usize>,
     names: Vec<String>,
     file: String,
-    items: Vec<Item>,
+    /// The waiting points, in path order. The buffers of the plan keep their
+    /// room from one decision to the next: a decision every `lag` points
+    /// must not cost fresh pages.
+    points: Vec<PlanPoint>,
+    /// NC outputs among the waiting points, each with the number of waiting
+    /// points before it.
+    outputs: Vec<(usize, Pending)>,
     /// CL line texts of the waiting points, back to back.
     source: Vec<u8>,
-    /// Since the last point in the trellis: tool-axis turn, singular points,
-    /// a segment start.
+    /// Since the last point in the trellis: tool-axis turn (degrees),
+    /// singular points, a segment start.
     turn: f64,
     across: bool,
     free: bool,
     /// Tool axis and reference of the last point.
-    previous_axes: Option<(nalgebra::Vector3<f64>, Option<nalgebra::Vector3<f64>>)>,
+    previous_axes: Option<(Vector3<f64>, Option<Vector3<f64>>)>,
     /// Angle between the tool axis of the last point in the trellis and the
     /// singular direction, degrees.
     planned_pole_deg: f64,
     segment: u64,
     break_pending: bool,
-    /// The last point written: its node and segment.
+    /// The last point written: its node, branch and segment.
     last: Option<(Node, u8, u64)>,
     choices: Vec<Choice>,
+    /// The decided nodes of one run of singular points.
+    run: Vec<Decided>,
     solutions: Vec<Solution>,
     pub stretches: Vec<SingularStretch>,
 }
@@ -101,7 +106,8 @@ impl PathPlan {
             rotary: machine.free_rotary_axes().collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
             file: file.to_string(),
-            items: Vec::new(),
+            points: Vec::new(),
+            outputs: Vec::new(),
             source: Vec::new(),
             turn: 0.0,
             across: false,
@@ -112,6 +118,7 @@ impl PathPlan {
             break_pending: true,
             last: None,
             choices: Vec::new(),
+            run: Vec::new(),
             solutions: Vec::with_capacity(16),
             stretches: Vec::new(),
         }
@@ -125,12 +132,12 @@ impl PathPlan {
 
     /// An NC output between points, written in its place.
     pub fn push_output(&mut self, p: Pending) {
-        self.items.push(Item::Output(p));
+        self.outputs.push((self.points.len(), p));
     }
 
     /// Whether nothing waits.
     pub fn is_idle(&self) -> bool {
-        self.items.is_empty()
+        self.points.is_empty() && self.outputs.is_empty()
     }
 
     /// Adds a CL point. An error is returned for the point at once when it
@@ -155,11 +162,11 @@ impl PathPlan {
             self.free = true;
         }
         if let Some((axis, reference)) = &self.previous_axes {
-            let mut turn = angle_between(axis, &pose.axis);
+            let mut turn = angle_between_deg(axis, &pose.axis);
             if let (Some(a), Some(b)) = (reference, &pose.reference) {
-                turn = turn.max(angle_between(a, b));
+                turn = turn.max(angle_between_deg(a, b));
             }
-            self.turn += turn.to_degrees();
+            self.turn += turn;
         }
         self.previous_axes = Some((pose.axis, pose.reference));
         // The hint picks the turn of axes without limits: near the cheapest
@@ -205,7 +212,7 @@ impl PathPlan {
         }
         let start = self.source.len();
         self.source.extend_from_slice(source_line);
-        self.items.push(Item::Point(PlanPoint {
+        self.points.push(PlanPoint {
             pose,
             line,
             motion,
@@ -215,7 +222,7 @@ impl PathPlan {
             singular,
             segment: self.segment,
             starts_segment,
-        }));
+        });
         Ok(())
     }
 
@@ -224,8 +231,9 @@ impl PathPlan {
         self.trellis.is_full()
     }
 
-    /// Decides the waiting points and writes them. Unless `all`, singular
-    /// points after the last planned one keep waiting for their next
+    /// Decides the waiting points and writes them, with the outputs among
+    /// them, in path order. Unless `all`, singular points after the last
+    /// planned one (and outputs after it) keep waiting for their next
     /// neighbour.
     pub fn flush<W: Write>(
         &mut self,
@@ -238,56 +246,75 @@ impl PathPlan {
         self.choices.clear();
         self.trellis.decide(&mut self.choices);
         let end = if all {
-            self.items.len()
+            self.points.len()
         } else {
-            self.items
+            self.points
                 .iter()
-                .rposition(|i| matches!(i, Item::Point(p) if !p.singular))
+                .rposition(|p| !p.singular)
                 .map_or(0, |k| k + 1)
         };
-        let mut items = std::mem::take(&mut self.items);
-        self.items = items.split_off(end);
-        let decided = self.decide(kin, wheel, &items)?;
+        let written = if all {
+            self.outputs.len()
+        } else {
+            self.outputs.partition_point(|(at, _)| *at < end)
+        };
+        let mut outputs = std::mem::take(&mut self.outputs);
+        let mut pending = outputs.drain(..written).peekable();
+        // Planned points take the trellis's choices, in order; a run of
+        // singular points is decided when it comes, between its neighbours.
+        let mut c = 0;
         let mut k = 0;
-        for item in items {
-            match item {
-                Item::Output(p) => write_pending(&mut emitter.writer, p)?,
-                Item::Point(p) => {
-                    let d = decided[k];
-                    k += 1;
-                    let at = |message: String| self.error_at(&p, message);
-                    select(kin, wheel, p.pressure);
-                    emitter.emit(
-                        machine,
-                        kin,
-                        &Target {
-                            node: d.node,
-                            motion: p.motion,
-                            line: p.line,
-                            feed: p.feed,
-                            pressure: p.pressure,
-                            continuous: d.continuous,
-                            cut: !p.starts_segment,
-                            at: &at,
-                        },
-                    )?;
-                    self.last = Some((d.node, d.branch, p.segment));
+        while k < end {
+            if !self.points[k].singular {
+                while let Some((_, p)) = pending.next_if(|(at, _)| *at <= k) {
+                    write_pending(&mut emitter.writer, p)?;
                 }
+                let choice = self.choices[c];
+                c += 1;
+                let decided = Decided {
+                    node: Node {
+                        pose: self.points[k].pose,
+                        joints: choice.joints,
+                        hold: None,
+                    },
+                    branch: choice.branch,
+                    continuous: choice.continuous,
+                };
+                self.write_point(machine, kin, wheel, emitter, k, decided)?;
+                k += 1;
+                continue;
             }
+            let segment = self.points[k].segment;
+            let mut e = k;
+            while e < end && self.points[e].singular && self.points[e].segment == segment {
+                e += 1;
+            }
+            let next = self.choices.get(c).copied();
+            self.fill_run(kin, wheel, k..e, next)?;
+            for j in k..e {
+                while let Some((_, p)) = pending.next_if(|(at, _)| *at <= j) {
+                    write_pending(&mut emitter.writer, p)?;
+                }
+                let decided = self.run[j - k];
+                self.write_point(machine, kin, wheel, emitter, j, decided)?;
+            }
+            k = e;
         }
+        for (_, p) in pending {
+            write_pending(&mut emitter.writer, p)?;
+        }
+        for o in &mut outputs {
+            o.0 -= end;
+        }
+        self.outputs = outputs;
+        self.points.drain(..end);
         // Keep the text of the points still waiting only.
-        let keep = self.items.iter().find_map(|i| match i {
-            Item::Point(p) => Some(p.source.start),
-            Item::Output(_) => None,
-        });
-        match keep {
+        match self.points.first().map(|p| p.source.start) {
             None => self.source.clear(),
             Some(from) => {
                 self.source.drain(..from);
-                for i in &mut self.items {
-                    if let Item::Point(p) = i {
-                        p.source = p.source.start - from..p.source.end - from;
-                    }
+                for p in &mut self.points {
+                    p.source = p.source.start - from..p.source.end - from;
                 }
             }
         }
@@ -297,84 +324,62 @@ impl PathPlan {
         Ok(())
     }
 
-    /// The configuration of each point among `items`, in order.
-    fn decide(
+    /// Writes waiting point `k` as decided.
+    fn write_point<W: Write>(
         &mut self,
+        machine: &Machine,
         kin: &mut Kinematics,
         wheel: &mut Option<Wheel>,
-        items: &[Item],
-    ) -> Result<Vec<Decided>, PostError> {
-        let points: Vec<&PlanPoint> = items
-            .iter()
-            .filter_map(|i| match i {
-                Item::Point(p) => Some(p),
-                Item::Output(_) => None,
-            })
-            .collect();
-        let mut out: Vec<Option<Decided>> = vec![None; points.len()];
-        // Planned points take the trellis's choices.
-        let mut c = 0;
-        for (k, p) in points.iter().enumerate() {
-            if !p.singular {
-                let choice = self.choices[c];
-                c += 1;
-                out[k] = Some(Decided {
-                    node: Node {
-                        pose: p.pose,
-                        joints: choice.joints,
-                        hold: None,
-                    },
-                    branch: choice.branch,
-                    continuous: choice.continuous,
-                });
-            }
-        }
-        // Runs of singular points.
-        let mut k = 0;
-        while k < points.len() {
-            if !points[k].singular {
-                k += 1;
-                continue;
-            }
-            let seg = points[k].segment;
-            let mut e = k;
-            while e < points.len() && points[e].singular && points[e].segment == seg {
-                e += 1;
-            }
-            self.fill_run(kin, wheel, &points, k..e, &mut out)?;
-            k = e;
-        }
-        Ok(out
-            .into_iter()
-            .map(|d| d.expect("every point decided"))
-            .collect())
+        emitter: &mut Emitter<W>,
+        k: usize,
+        d: Decided,
+    ) -> Result<(), PostError> {
+        let p = &self.points[k];
+        let at = |message: String| self.error_at(p, message);
+        select(kin, wheel, p.pressure);
+        emitter.emit(
+            machine,
+            kin,
+            &Target {
+                node: d.node,
+                motion: p.motion,
+                line: p.line,
+                feed: p.feed,
+                pressure: p.pressure,
+                continuous: d.continuous,
+                cut: !p.starts_segment,
+                at: &at,
+            },
+        )?;
+        let segment = p.segment;
+        self.last = Some((d.node, d.branch, segment));
+        Ok(())
     }
 
-    /// Holds the singular angle over `run` and solves its points.
+    /// Holds the singular angle over the waiting points `run` and solves
+    /// them, into `self.run`. The point before is the last one written;
+    /// `next` is the choice of the planned point after the run, if any.
     fn fill_run(
         &mut self,
         kin: &mut Kinematics,
         wheel: &mut Option<Wheel>,
-        points: &[&PlanPoint],
         run: Range<usize>,
-        out: &mut [Option<Decided>],
+        next: Option<Choice>,
     ) -> Result<(), PostError> {
+        let points = &self.points;
         let seg = points[run.start].segment;
         // The decided neighbours in the same segment.
-        let before: Option<Node> = if run.start > 0 {
-            let p = points[run.start - 1];
-            (p.segment == seg)
-                .then(|| out[run.start - 1].map(|d| d.node))
-                .flatten()
-        } else {
-            self.last.filter(|(_, _, s)| *s == seg).map(|(n, _, _)| n)
-        };
+        let before: Option<Node> = self.last.filter(|(_, _, s)| *s == seg).map(|(n, _, _)| n);
         let after: Option<Node> = points
             .get(run.end)
             .filter(|p| p.segment == seg && !p.singular)
-            .and_then(|_| out[run.end])
-            .filter(|d| d.continuous)
-            .map(|d| d.node);
+            .zip(next)
+            .filter(|(_, c)| c.continuous)
+            .map(|(p, c)| Node {
+                pose: p.pose,
+                joints: c.joints,
+                hold: None,
+            });
         let anchor = self
             .last
             .map(|(n, _, _)| n.joints)
@@ -396,8 +401,8 @@ impl PathPlan {
         let mut lengths = Vec::with_capacity(run.len() + 1);
         let mut total = 0.0;
         let mut previous = before.map(|b| b.pose.point);
-        for k in run.clone() {
-            let p = points[k].pose.point;
+        for p in &points[run.clone()] {
+            let p = p.pose.point;
             total += previous.map_or(0.0, |q| (p - q).norm());
             lengths.push(total);
             previous = Some(p);
@@ -409,8 +414,9 @@ impl PathPlan {
         let mut guess = before.map_or(anchor, |b| b.joints);
         let mut deviation: f64 = 0.0;
         let mut held_values = (f64::NAN, f64::NAN);
+        self.run.clear();
         for (j, k) in run.clone().enumerate() {
-            let p = points[k];
+            let p = &self.points[k];
             let t = if total > 1e-9 {
                 lengths[j] / total
             } else {
@@ -460,7 +466,7 @@ impl PathPlan {
             }
             held_values.1 = axis.map_or(0.0, |i| sol.joints[i]);
             guess = sol.joints;
-            out[k] = Some(Decided {
+            self.run.push(Decided {
                 node: Node {
                     pose,
                     joints: sol.joints,
@@ -472,8 +478,8 @@ impl PathPlan {
         }
         if let Some(i) = axis {
             self.stretches.push(SingularStretch {
-                first_line: points[run.start].line,
-                last_line: points[run.end - 1].line,
+                first_line: self.points[run.start].line,
+                last_line: self.points[run.end - 1].line,
                 axis: self.names[i].clone(),
                 from_deg: held_values.0,
                 to_deg: held_values.1,
@@ -493,6 +499,12 @@ impl PathPlan {
             &self.file, p.line, column, width, text, message,
         )))
     }
+}
+
+/// Angle between unit vectors, degrees (the turn of the tool axis between
+/// two points: atan2 of sine and cosine, accurate at small angles).
+fn angle_between_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    atan2_deg(a.cross(b).norm(), a.dot(b))
 }
 
 /// Why a point cannot be added.

@@ -17,7 +17,7 @@
 
 /// `(sin, cos)` of `deg` degrees.
 #[inline]
-pub(crate) fn sin_cos_deg(deg: f64) -> (f64, f64) {
+pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
     // Beyond 2^40 degrees (and for NaN and infinities) the library decides.
     if deg.is_nan() || deg.abs() > 1_099_511_627_776.0 {
         return deg.to_radians().sin_cos();
@@ -74,7 +74,7 @@ fn cos_kernel(x: f64) -> f64 {
 /// The angle of the direction `(x, y)` in degrees, in [−180, 180]: what
 /// `f64::atan2(y, x).to_degrees()` gives, within 2 ulp.
 #[inline]
-pub(crate) fn atan2_deg(y: f64, x: f64) -> f64 {
+pub fn atan2_deg(y: f64, x: f64) -> f64 {
     // π/2 and π as a rounded value and what it leaves out.
     const PI_2_HI: f64 = std::f64::consts::FRAC_PI_2;
     const PI_2_LO: f64 = 6.123_233_995_736_766_036e-17;

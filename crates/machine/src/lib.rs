@@ -13,7 +13,7 @@
 //! assert!(solutions.iter().any(|s| (s.joints[0] - 459.0).abs() < 1e-9));
 //! ```
 
-mod angle;
+pub mod angle;
 pub mod builtin;
 mod file;
 mod kinematics;
