@@ -7,7 +7,9 @@
 
 use std::io::Write;
 
-use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_machine::{
+    Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
+};
 use kinpost_nc::{Block, Motion, NcWriter};
 use nalgebra::Vector3;
 
@@ -18,6 +20,9 @@ use crate::summary::{FeedClamp, Planning, Reconfiguration};
 
 /// Deepest halving of one CL segment by the linearization (2^16 blocks).
 const MAX_DEPTH: u32 = 16;
+/// What the chord bound adds for the ends of a joint motion not being
+/// exactly on their CL points (the inverse kinematics is exact to 1e-9 mm).
+const CHORD_SLACK_MM: f64 = 1e-6;
 /// At most this many feed clamps are listed (all are counted).
 const MAX_CLAMPS_LISTED: usize = 1000;
 
@@ -60,6 +65,9 @@ struct Last {
     line: usize,
     /// Values as handed to the writer (tool point on X, Y, Z in TCP output).
     values: Joints,
+    /// Upper bound of the lever of `node.joints` (see
+    /// [`kinpost_machine::midpoint_bound`]); infinite when unknown.
+    lever: f64,
 }
 
 /// Settings of the emitter.
@@ -87,6 +95,9 @@ pub(crate) struct Emitter<W: Write> {
     n: usize,
     /// Free rotary axes.
     rotary: Vec<usize>,
+    /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
+    /// measures it: one unit of the last decimal of every free axis.
+    rounding_travel: (f64, f64),
     /// Axes with a maximum velocity (index, units per minute).
     vmax: Vec<(usize, f64)>,
     names: Vec<String>,
@@ -106,8 +117,16 @@ pub(crate) struct Emitter<W: Write> {
 impl<W: Write> Emitter<W> {
     pub fn new(machine: &Machine, writer: NcWriter<W>, settings: EmitSettings) -> Self {
         let axes = &machine.axes;
+        let free = |rotary: bool| {
+            (0..axes.len())
+                .filter(|&i| axes[i].is_free() && axes[i].is_rotary() == rotary)
+                .map(|i| settings.resolution[i])
+                .sum::<f64>()
+        };
+        let rounding_travel = (free(true).to_radians(), free(false));
         Emitter {
             writer,
+            rounding_travel,
             settings,
             n: axes.len(),
             rotary: machine.free_rotary_axes().collect(),
@@ -147,6 +166,7 @@ impl<W: Write> Emitter<W> {
                 reference: last.node.pose.reference.and(here.reference),
                 ..here
             };
+            last.lever = f64::INFINITY;
             self.last = Some(last);
         }
         if let Some(last) = self.last
@@ -157,7 +177,7 @@ impl<W: Write> Emitter<W> {
             } else if self.settings.lintol > 0.0 && self.settings.tcp.is_none() {
                 self.inserted.clear();
                 let mut inserted = std::mem::take(&mut self.inserted);
-                let result = self.linearize(kin, &last.node, &t.node, 0, &mut inserted);
+                let result = self.linearize(kin, &last.node, &t.node, last.lever, 0, &mut inserted);
                 match result {
                     Ok(()) => {}
                     // A move that starts a segment may be a repositioning
@@ -193,19 +213,31 @@ impl<W: Write> Emitter<W> {
     /// Halves the CL segment `a`–`b` until the contact point at the
     /// joint-space midpoint of every piece lies within the tolerance of the
     /// straight segment; the inserted nodes go to `out` in path order.
+    /// `lever`: a bound of the lever at `a` (infinite when unknown).
     fn linearize(
         &mut self,
         kin: &Kinematics,
         a: &Node,
         b: &Node,
+        lever: f64,
         depth: u32,
         out: &mut Vec<Node>,
     ) -> Result<(), &'static str> {
+        let n = self.n;
+        // Most segments of a fine path are settled by the chord bound of the
+        // chain, without the midpoint's forward kinematics.
+        let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n], false);
+        let bound = midpoint_bound(lever, w, v) + CHORD_SLACK_MM;
+        if bound <= self.settings.lintol {
+            let p = &mut self.planning;
+            p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
+            return Ok(());
+        }
         let mut mid = a.joints;
-        for (m, v) in mid.iter_mut().zip(&b.joints).take(self.n) {
+        for (m, v) in mid.iter_mut().zip(&b.joints).take(n) {
             *m = 0.5 * (*m + v);
         }
-        let reached = kin.fk(&mid[..self.n]).point;
+        let reached = kin.fk(&mid[..n]).point;
         let deviation = distance_to_segment(&reached, &a.pose.point, &b.pose.point);
         if deviation <= self.settings.lintol {
             let p = &mut self.planning;
@@ -251,9 +283,9 @@ impl<W: Write> Emitter<W> {
             joints: sol.joints,
             hold,
         };
-        self.linearize(kin, a, &m, depth + 1, out)?;
+        self.linearize(kin, a, &m, lever, depth + 1, out)?;
         out.push(m);
-        self.linearize(kin, &m, b, depth + 1, out)
+        self.linearize(kin, &m, b, f64::INFINITY, depth + 1, out)
     }
 
     /// Retract along the tool axis from the last block, turn the rotary axes
@@ -376,11 +408,15 @@ impl<W: Write> Emitter<W> {
         for (i, (w, v)) in self.written[..n].iter_mut().zip(&values[..n]).enumerate() {
             *w = self.writer.quantized(i, *v);
         }
-        let mut reached = kin.fk(&self.written[..n]);
+        let (mut reached, written_lever) = kin.fk_lever(&self.written[..n]);
+        // The lever at the exact values, from that at the written ones.
+        let (w, v) = self.rounding_travel;
+        let mut lever = lever_over(written_lever, w, v);
         if let Some([x, y, z]) = self.settings.tcp {
             // The controller puts the tool point where the words say; the
             // orientation comes from the rotary words alone.
             reached.point = Vector3::new(self.written[x], self.written[y], self.written[z]);
+            lever = f64::INFINITY;
         }
         if !self
             .stats
@@ -425,6 +461,7 @@ impl<W: Write> Emitter<W> {
             pressure: self.pressure,
             line,
             values,
+            lever,
         });
         // The pressure column, if any, follows the axes.
         let mut row = [f64::NAN; MAX_AXES + 1];

@@ -42,7 +42,9 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::angle::{atan2_deg, sin_cos_deg};
 
+mod chord;
 mod singular;
+pub use chord::{lever_over, midpoint_bound};
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};

@@ -234,6 +234,41 @@ proptest! {
         }
     }
 
+    /// The chord bound (module `chord`) holds: the tool point at the middle
+    /// of a straight joint motion, by the definition, is within
+    /// `midpoint_bound` of the middle of the chord; the lever at the end is
+    /// within `lever_over` of the lever at the start, either way round.
+    #[test]
+    fn the_chord_bound_holds(mut rng in rngs()) {
+        let m = random_machine(&mut rng);
+        let kin = Kinematics::new(&m);
+        for _ in 0..4 {
+            let a = random_joints(&m, &mut rng);
+            // Steps from hundredths of a degree (fine CL) to tens.
+            let scale = 10f64.powf(rng.range(-2.0, 1.5));
+            let b: Vec<f64> = a
+                .iter()
+                .zip(&m.axes)
+                .map(|(&v, ax)| match (ax.fixed, ax.is_rotary()) {
+                    (Some(_), _) => v,
+                    (None, true) => v + scale * rng.range(-1.0, 1.0),
+                    (None, false) => v + 5.0 * scale * rng.range(-1.0, 1.0),
+                })
+                .collect();
+            let mid: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * (x + y)).collect();
+            let (pa, pb, pm) = (reference_fk(&m, &a), reference_fk(&m, &b), reference_fk(&m, &mid));
+            let deviation = (pm.point - 0.5 * (pa.point + pb.point)).norm();
+            let (_, lever_a) = kin.fk_lever(&a);
+            let (_, lever_b) = kin.fk_lever(&b);
+            let (w, v) = kin.joint_travel(&a, &b, false);
+            let bound = midpoint_bound(lever_a, w, v);
+            prop_assert!(deviation <= bound + 1e-9, "{deviation} > {bound} (w {w}, v {v}, lever {lever_a})\n{m:?}");
+            let (wp, vp) = kin.joint_travel(&a, &b, true);
+            prop_assert!(lever_b <= lever_over(lever_a, wp, vp) + 1e-9);
+            prop_assert!(lever_a <= lever_over(lever_b, wp, vp) + 1e-9);
+        }
+    }
+
     /// Every branch the inverse kinematics gives reaches the pose by the
     /// definition, `q` is among them, and the precomputed linear solve gives
     /// what the general one gives.
