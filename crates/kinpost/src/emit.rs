@@ -155,29 +155,36 @@ impl<W: Write> Emitter<W> {
         t: &Target,
     ) -> Result<(), PostError> {
         self.pressure = t.pressure;
-        if let Some(mut last) = self.last
+        if let Some(last) = &mut self.last
             && last.pressure.to_bits() != t.pressure.to_bits()
         {
             // The wheel moved with the pressure: the last block's axes put
             // the contact point elsewhere now, and the move starts there.
-            let n = self.n;
-            let here = kin.fk(&last.node.joints[..n]);
+            let here = kin.fk(&last.node.joints[..self.n]);
             last.node.pose = Pose {
                 reference: last.node.pose.reference.and(here.reference),
                 ..here
             };
             last.lever = f64::INFINITY;
-            self.last = Some(last);
         }
-        if let Some(last) = self.last
+        if let Some(last) = &self.last
             && t.motion == Motion::Feed
         {
+            let linearize = self.settings.lintol > 0.0 && self.settings.tcp.is_none();
             if t.cut && !t.continuous {
+                let last = *last;
                 self.reconfigure(machine, kin, &last, t)?;
-            } else if self.settings.lintol > 0.0 && self.settings.tcp.is_none() {
+            } else if linearize
+                && let Some(bound) =
+                    chord_settles(kin, &last.node, &t.node, last.lever, &self.settings)
+            {
+                let p = &mut self.planning;
+                p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
+            } else if linearize {
+                let (from, lever, from_line) = (last.node, last.lever, last.line);
                 self.inserted.clear();
                 let mut inserted = std::mem::take(&mut self.inserted);
-                let result = self.linearize(kin, &last.node, &t.node, last.lever, 0, &mut inserted);
+                let result = self.linearize(kin, &from, &t.node, lever, 0, &mut inserted);
                 match result {
                     Ok(()) => {}
                     // A move that starts a segment may be a repositioning
@@ -186,7 +193,7 @@ impl<W: Write> Emitter<W> {
                     Err(e) => {
                         return Err((t.at)(format!(
                             "{e} between CL line {} and this point, {}",
-                            last.line,
+                            from_line,
                             describe(&t.node.pose)
                         )));
                     }
@@ -224,11 +231,7 @@ impl<W: Write> Emitter<W> {
         out: &mut Vec<Node>,
     ) -> Result<(), &'static str> {
         let n = self.n;
-        // Most segments of a fine path are settled by the chord bound of the
-        // chain, without the midpoint's forward kinematics.
-        let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n], false);
-        let bound = midpoint_bound(lever, w, v) + CHORD_SLACK_MM;
-        if bound <= self.settings.lintol {
+        if let Some(bound) = chord_settles(kin, a, b, lever, &self.settings) {
             let p = &mut self.planning;
             p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
             return Ok(());
@@ -557,6 +560,24 @@ impl<W: Write> Emitter<W> {
         s.tolerance.axis_rad = s.tolerance.axis_rad.max(a);
         true
     }
+}
+
+/// Most segments of a fine path are settled by the chord bound of the chain
+/// (see [`midpoint_bound`]), without the forward kinematics of their
+/// midpoint: the bound, when it is within the linearization tolerance.
+/// `lever`: a bound of the lever at `a`.
+#[inline]
+fn chord_settles(
+    kin: &Kinematics,
+    a: &Node,
+    b: &Node,
+    lever: f64,
+    settings: &EmitSettings,
+) -> Option<f64> {
+    let n = kin.axis_count();
+    let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n], false);
+    let bound = midpoint_bound(lever, w, v) + CHORD_SLACK_MM;
+    (bound <= settings.lintol).then_some(bound)
 }
 
 /// Distance from `p` to the segment `a`–`b`.
