@@ -408,9 +408,8 @@ impl<W: Write> Emitter<W> {
             values[y] = pose.point.y;
             values[z] = pose.point.z;
         }
-        for (i, (w, v)) in self.written[..n].iter_mut().zip(&values[..n]).enumerate() {
-            *w = self.writer.quantized(i, *v);
-        }
+        self.writer
+            .quantize_axes(&values[..n], &mut self.written[..n]);
         let (mut reached, written_lever) = kin.fk_lever(&self.written[..n]);
         // The lever at the exact values, from that at the written ones.
         let (w, v) = self.rounding_travel;

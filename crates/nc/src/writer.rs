@@ -145,6 +145,10 @@ pub struct NcWriter<W: Write> {
     axis_specs: Vec<AxisSpec>,
     /// Number format per machine axis (machine order).
     formats: Vec<Formatter>,
+    /// Per machine axis, the bits of the value [`NcWriter::quantize_axes`]
+    /// last rounded and its units: the block that follows does not round
+    /// them again.
+    memo: Vec<Option<(u64, i64)>>,
     /// Words written in a block, in output order.
     words: Vec<Word>,
     /// The pressure word of an NC dialect, written on its own line (see
@@ -257,6 +261,7 @@ impl<W: Write> NcWriter<W> {
             units: vec![0; words.len()],
             names: axes.iter().map(|a| a.name.clone()).collect(),
             axis_specs: axes.to_vec(),
+            memo: vec![None; formats.len()],
             formats,
             words,
             pressure,
@@ -287,6 +292,38 @@ impl<W: Write> NcWriter<W> {
     #[inline]
     pub fn quantized(&self, axis_index: usize, value: f64) -> f64 {
         self.formats[axis_index].quantize(value)
+    }
+
+    /// Rounds the values of the first `axes.len()` machine axes as they are
+    /// written (see [`NcWriter::quantized`]) into `written`, and remembers
+    /// their units for the next [`NcWriter::block`] with these values, which
+    /// then does not round them again. A value that cannot be written is
+    /// copied unchanged (the block fails on it).
+    #[inline]
+    pub fn quantize_axes(&mut self, axes: &[f64], written: &mut [f64]) {
+        for (i, (&v, w)) in axes.iter().zip(written.iter_mut()).enumerate() {
+            let f = &self.formats[i];
+            match f.units(v) {
+                Ok(n) => {
+                    self.memo[i] = Some((v.to_bits(), n));
+                    *w = f.value_of_units(n);
+                }
+                Err(_) => {
+                    self.memo[i] = None;
+                    *w = v;
+                }
+            }
+        }
+    }
+
+    /// The units of `v` for machine axis `index`, remembered by
+    /// [`NcWriter::quantize_axes`] or worked out.
+    #[inline(always)]
+    fn units_of(&self, index: usize, v: f64) -> Result<i64, crate::NumberError> {
+        match self.memo[index] {
+            Some((bits, n)) if bits == v.to_bits() => Ok(n),
+            _ => self.formats[index].units(v),
+        }
     }
 
     /// Number of motion blocks written so far.
@@ -562,7 +599,7 @@ impl<W: Write> NcWriter<W> {
         let mut any = false;
         for (k, w) in self.words.iter().enumerate() {
             let v = block.axes[w.index];
-            let n = match w.fmt.units(v) {
+            let n = match self.units_of(w.index, v) {
                 Ok(n) => n,
                 Err(e) => return Err(self.bad_value(w.index, v, e)),
             };
@@ -741,7 +778,7 @@ impl<W: Write> NcWriter<W> {
                 line.put(&self.sep);
                 continue;
             }
-            let n = match w.fmt.units(v) {
+            let n = match self.units_of(w.index, v) {
                 Ok(n) => n,
                 Err(e) => {
                     self.line = line;
