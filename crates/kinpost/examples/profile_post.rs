@@ -2,14 +2,17 @@
 //! sinumerik into a sink, for profilers (`perf record`, callgrind); the
 //! criterion benchmark `benches/post.rs` is the measurement of record.
 //! A second argument `point-by-point` turns whole-path planning and
-//! linearization off.
+//! linearization off. A first argument that is not a number is a CL file to
+//! post instead (so that a profiler sees the post alone).
 
 #[path = "../benches/cl_gen.rs"]
 mod cl_gen;
 
 fn main() {
-    let points = std::env::args()
-        .nth(1)
+    let first = std::env::args().nth(1);
+    let file = first.as_deref().filter(|a| a.parse::<usize>().is_err());
+    let points = first
+        .as_deref()
         .and_then(|a| a.parse().ok())
         .unwrap_or(1_000_000);
     let options = match std::env::args().nth(2).as_deref() {
@@ -20,7 +23,10 @@ fn main() {
         },
         _ => kinpost::PostOptions::default(),
     };
-    let cl = cl_gen::generate_cl(points);
+    let cl = match file {
+        Some(path) => std::fs::read_to_string(path).expect("a readable CL file"),
+        None => cl_gen::generate_cl(points),
+    };
     let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
     let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
     let summary =
