@@ -155,6 +155,15 @@ fn eight_digits(d: u64) -> u64 {
     (d & 0x0000_FFFF_0000_FFFF).wrapping_mul(42_949_672_960_001) >> 32
 }
 
+/// -1 for a first byte `-`, else 1: the sign of a plain number, looked up
+/// by its first byte (a table, as the optimizer turns a comparison into a
+/// branch).
+const SIGN: [f64; 256] = {
+    let mut sign = [1.0; 256];
+    sign[b'-' as usize] = -1.0;
+    sign
+};
+
 /// The length of the chunk [`plain_number`] reads: a sign, eight digits, a
 /// point and the byte after the number.
 pub(crate) const PLAIN_CHUNK: usize = 11;
@@ -203,7 +212,7 @@ pub(crate) fn plain_number(chunk: &[u8; PLAIN_CHUNK]) -> Option<(f64, usize)> {
     let v = (mantissa as i64) as f64 / POW10[(n - whole) & 15];
     // `-v` without a branch on the sign, which is unpredictable (exact, and
     // -0 for 0 as `str::parse` has it).
-    Some((v * [1.0, -1.0][usize::from(sign == b'-')], len))
+    Some((v * SIGN[usize::from(sign)], len))
 }
 
 /// The eight bytes at `chunk[i..]` (`i` is 0, 1 or 2), little-endian.

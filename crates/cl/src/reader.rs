@@ -1264,7 +1264,10 @@ fn trim_end_ascii(line: &[u8]) -> usize {
 #[inline(always)]
 fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<PlainGoto> {
     let mut rest = buf.strip_prefix(b"GOTO/")?;
-    for (count, slot) in v.iter_mut().enumerate() {
+    // The count of values is what `slots` has left, not a counter: one
+    // instruction less per number.
+    let mut slots = v.iter_mut();
+    while let Some(slot) = slots.next() {
         let chunk = rest.first_chunk::<PLAIN_CHUNK>()?;
         let (x, len) = plain_number(chunk)?;
         *slot = x;
@@ -1280,7 +1283,7 @@ fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<PlainGoto> {
         };
         let end = buf.len() - rest.len() + len;
         return Some(PlainGoto {
-            count: count + 1,
+            count: 9 - slots.len(),
             end,
             next: end + line_end,
         });
