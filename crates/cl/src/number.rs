@@ -127,68 +127,77 @@ pub(crate) fn scan_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
 }
 
 const ONES: u64 = 0x0101_0101_0101_0101;
-const LOW_BITS: u64 = 0x7F7F_7F7F_7F7F_7F7F;
 const HIGH_BITS: u64 = 0x8080_8080_8080_8080;
 
-/// The eight bytes at `b[i..]`, little-endian (the first in the low byte).
-#[inline(always)]
-pub(crate) fn word_at(b: &[u8], i: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(*b.get(i..)?.first_chunk::<8>()?))
-}
-
-/// `word` with each ASCII digit turned into its value, and the high bit of
-/// each byte that is not a digit (exactly: no carries between bytes).
+/// `word` with each ASCII digit turned into its value, and a mask whose
+/// lowest set bit is the high bit of the first byte (from the low end) that
+/// is not a digit; 0 if all eight are digits.
 #[inline(always)]
 fn digit_values(word: u64) -> (u64, u64) {
     let v = word ^ (ONES * u64::from(b'0'));
-    // A byte is a digit iff it becomes 0..=9: then adding 0x76 to its low
-    // seven bits leaves the high bit clear.
-    let not_digit = (((v & LOW_BITS) + ONES * 0x76) | v) & HIGH_BITS;
-    (v, not_digit)
+    // A byte is a digit iff it becomes 0..=9: then adding 0x76 leaves its
+    // high bit clear and carries nothing into the next byte. A byte that is
+    // not a digit gets its high bit set (by the sum, or by `| v` for bytes
+    // from 0x80 up); its carry may garble the bytes above it, but not the
+    // lowest flagged byte, the only one looked at.
+    let stop = (v.wrapping_add(ONES * 0x76) | v) & HIGH_BITS;
+    (v, stop)
 }
 
-/// The number written by the digit values in `d`, most significant in the
-/// lowest byte; leading digits may be zero bytes (the classic SWAR
-/// conversion of eight digits).
+/// The number written by the digit values in `d` (each byte 0..=9), most
+/// significant in the lowest byte; leading digits may be zero bytes (the
+/// classic SWAR conversion of eight digits, without its first mask: the
+/// bytes are already values).
 #[inline(always)]
 fn eight_digits(d: u64) -> u64 {
-    let d = (d & 0x0F0F_0F0F_0F0F_0F0F).wrapping_mul(2561) >> 8;
+    let d = d.wrapping_mul(2561) >> 8;
     let d = (d & 0x00FF_00FF_00FF_00FF).wrapping_mul(6_553_601) >> 16;
     (d & 0x0000_FFFF_0000_FFFF).wrapping_mul(42_949_672_960_001) >> 32
 }
 
+/// -1 for a first byte `-`, else 1: the sign of a plain number, looked up
+/// by its first byte (a table, as the optimizer turns a comparison into a
+/// branch).
+const SIGN: [f64; 256] = {
+    let mut sign = [1.0; 256];
+    sign[b'-' as usize] = -1.0;
+    sign
+};
+
+/// The length of the chunk [`plain_number`] reads: a sign, eight digits, a
+/// point and the byte after the number.
+pub(crate) const PLAIN_CHUNK: usize = 11;
+
 /// [`scan_number`] for the shape CL files are made of: `[-+]?d*[.d*]` with
 /// at most 7 digits before the point and at most 8 digits in all, read a
-/// word at a time. Returns the value and the index just after the digits;
-/// the caller must check that the byte there is a separator, neither a digit
-/// (more digits), nor `.`, `e` or `E`: then the result is what
-/// [`scan_number`] gives. `None` for any other shape, or if `b` has fewer
-/// than 9 bytes after the sign (pad the buffer).
+/// word at a time from a fixed-size chunk (so that no load needs a bounds
+/// check). Returns the value and the length of the number, which is at most
+/// 10: `chunk[len]` is the byte after it. The caller must check that this
+/// byte is a separator, neither a digit (more digits), nor `.`, `e` or `E`:
+/// then the result is what [`scan_number`] gives. `None` for any other shape.
 #[inline(always)]
-pub(crate) fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
-    let sign = *b.get(start)?;
-    let negative = sign == b'-';
-    let s = start + usize::from(negative || sign == b'+');
-    let word = word_at(b, s)?;
-    let next = word_at(b, s + 1)?;
-    let (_, stop) = digit_values(word);
+pub(crate) fn plain_number(chunk: &[u8; PLAIN_CHUNK]) -> Option<(f64, usize)> {
+    let sign = chunk[0];
+    let s = usize::from(sign == b'-' || sign == b'+');
+    let word = load_word(chunk, s);
+    let (values, stop) = digit_values(word);
     if stop == 0 {
         return None; // eight digits or more before the point
     }
-    // The digits before the point (0..=7), then the point, if any.
-    let whole = (stop.trailing_zeros() / 8) as usize;
-    let point = (word >> (8 * whole)) as u8 == b'.';
-    // The whole digits, then those after the point moved down over it.
-    let low = (1u64 << (8 * whole)) - 1;
-    let digits = if point {
-        (word & low) | (next & !low)
+    // The digits before the point (0..=7), times 8, then the point, if any.
+    let whole_bits = stop.trailing_zeros() & 0x38;
+    let whole = (whole_bits / 8) as usize;
+    let (values, n, len) = if (word >> whole_bits) as u8 == b'.' {
+        // The whole digits, then those after the point moved down over it.
+        let low = (1u64 << whole_bits) - 1;
+        let digits = (word & low) | (load_word(chunk, s + 1) & !low);
+        let (values, stop) = digit_values(digits);
+        // `trailing_zeros` is 64 if all eight are digits.
+        let n = (stop.trailing_zeros() / 8) as usize;
+        (values, n, s + n + 1)
     } else {
-        word
+        (values, whole, s + whole)
     };
-    let (values, stop) = digit_values(digits);
-    // `trailing_zeros` is 64 if all eight are digits.
-    let n = (stop.trailing_zeros() / 8) as usize;
-    let n = if point { n } else { whole };
     if n == 0 {
         return None;
     }
@@ -197,11 +206,30 @@ pub(crate) fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> 
     let mantissa = eight_digits(values << (64 - 8 * n));
     // At most 8 digits: the mantissa is exact, and so is the power of ten
     // (Clinger's fast path; `scan_number` computes the very same quotient).
-    // Through i64, which converts in one instruction, unlike u64.
-    let v = (mantissa as i64) as f64 / POW10[n - whole];
-    // `-v` without a branch on the sign (`v` is positive or +0).
-    let v = f64::from_bits(v.to_bits() | (u64::from(negative) << 63));
-    Some((v, s + n + usize::from(point)))
+    // Through i64, which converts in one instruction, unlike u64. The index
+    // is at most 8 (n >= whole when there is a point); the mask only spares
+    // a bounds check.
+    let v = (mantissa as i64) as f64 / POW10[(n - whole) & 15];
+    // `-v` without a branch on the sign, which is unpredictable (exact, and
+    // -0 for 0 as `str::parse` has it).
+    Some((v * SIGN[usize::from(sign)], len))
+}
+
+/// The eight bytes at `chunk[i..]` (`i` is 0, 1 or 2), little-endian.
+#[inline(always)]
+fn load_word(chunk: &[u8; PLAIN_CHUNK], i: usize) -> u64 {
+    let mut word = [0; 8];
+    word.copy_from_slice(&chunk[i..i + 8]);
+    u64::from_le_bytes(word)
+}
+
+/// [`plain_number`] on `b[start..]`: the value and the index just after the
+/// number. `None` also if `b` has fewer than [`PLAIN_CHUNK`] bytes from
+/// `start` (pad the buffer).
+#[cfg(test)]
+fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
+    let (v, len) = plain_number(b.get(start..)?.first_chunk()?)?;
+    Some((v, start + len))
 }
 
 #[cfg(test)]
@@ -277,7 +305,7 @@ mod tests {
         }
         for text in &texts {
             for after in [",", "\n", "\r\n", ",1.5,2\n", " ", "e5", ".5", "5", ""] {
-                let b = format!("{text}{after}\0\0\0\0\0\0\0\0\0");
+                let b = format!("{text}{after}\0\0\0\0\0\0\0\0\0\0\0");
                 let Some((v, end)) = scan_plain_number(b.as_bytes(), 0) else {
                     continue;
                 };
@@ -295,7 +323,7 @@ mod tests {
                 && parts.iter().all(|p| p.bytes().all(|c| c.is_ascii_digit()))
                 && parts[0].len() < 8
                 && (1..=8).contains(&digits);
-            let b = format!("{text},\0\0\0\0\0\0\0\0\0");
+            let b = format!("{text},\0\0\0\0\0\0\0\0\0\0\0");
             assert_eq!(
                 scan_plain_number(b.as_bytes(), 0).is_some_and(|(_, end)| end == text.len()),
                 plain,
@@ -354,6 +382,58 @@ mod tests {
             "00000000000000000000000000000000001.5",
         ] {
             assert_eq!(parse_number(text), text.parse::<f64>().ok(), "{text}");
+        }
+    }
+
+    /// A decimal text as CAM systems write it: a sign or none, digits with
+    /// leading and trailing zeros, with or without a point, up to 17
+    /// significant digits, maybe an exponent (which the reader accepts).
+    fn cam_number() -> impl proptest::strategy::Strategy<Value = String> {
+        use proptest::prelude::*;
+        (
+            prop::sample::select(vec!["", "-", "+"]),
+            "0{0,2}[0-9]{0,8}",
+            prop::sample::select(vec!["", "."]),
+            "[0-9]{0,9}0{0,2}",
+            prop::option::weighted(0.2, ("[eE]", "[-+]?", "[0-9]{1,2}")),
+        )
+            .prop_filter("at least one digit", |(_, whole, _, fraction, _)| {
+                !whole.is_empty() || !fraction.is_empty()
+            })
+            .prop_map(|(sign, whole, point, fraction, exponent)| {
+                // Without a point, the fraction digits are more whole digits.
+                let mut text = format!("{sign}{whole}{point}{fraction}");
+                if let Some((e, exponent_sign, digits)) = exponent {
+                    text = format!("{text}{e}{exponent_sign}{digits}");
+                }
+                text
+            })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+        /// Both fast paths give the very bits of `str::parse::<f64>`; the
+        /// plain one takes every plain number of up to 8 digits.
+        #[test]
+        fn fast_paths_are_bit_identical_to_std(text in cam_number()) {
+            let std: f64 = text.parse().unwrap();
+            let general = parse_number(&text).map(f64::to_bits);
+            proptest::prop_assert_eq!(general, Some(std.to_bits()), "{}", text);
+            for after in [",", "\n", "\r\n"] {
+                let b = format!("{text}{after}\0\0\0\0\0\0\0\0\0\0\0");
+                // As the reader uses it: followed by a separator.
+                let plain = scan_plain_number(b.as_bytes(), 0)
+                    .filter(|&(_, end)| !matches!(b.as_bytes()[end], b'0'..=b'9' | b'.' | b'e' | b'E'));
+                if let Some((v, end)) = plain {
+                    proptest::prop_assert_eq!((v.to_bits(), end), (std.to_bits(), text.len()), "{}", text);
+                }
+                let unsigned = text.trim_start_matches(['-', '+']);
+                let digits = unsigned.bytes().filter(u8::is_ascii_digit).count();
+                let whole = unsigned.split('.').next().unwrap().len();
+                let simple = !unsigned.contains(['e', 'E']) && digits <= 8 && whole <= 7;
+                proptest::prop_assert_eq!(plain.is_some(), simple, "{}", text);
+            }
         }
     }
 }

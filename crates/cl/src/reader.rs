@@ -4,7 +4,7 @@ use std::io::BufRead;
 
 use kinpost_diag::{Diagnostic, Severity};
 
-use crate::number::{parse_number, scan_number, scan_plain_number};
+use crate::number::{PLAIN_CHUNK, parse_number, plain_number, scan_number};
 use crate::words::suggest;
 use crate::{ClEvent, FeedUnit, Motion, SpindleDir, Statement, Units, Vec3};
 
@@ -26,7 +26,18 @@ struct Segment {
     text_end: usize,
 }
 
-/// What [`ClReader::read_statement`] found.
+/// What [`ClReader::begin_statement`] found.
+enum Begin {
+    /// A plain `GOTO` line, read and parsed: `count` values, `end` the
+    /// length of its text (in `raw`).
+    PlainGoto { count: usize, end: usize },
+    /// A plain line, now in `raw`.
+    PlainLine,
+    /// Nothing yet: `read_lines` reads the statement.
+    Lines,
+}
+
+/// What [`ClReader::read_lines`] found.
 enum Read {
     /// End of input.
     Eof,
@@ -68,10 +79,6 @@ pub struct ClReader<R> {
     /// read by the fast path, which is ASCII): then it is not copied to
     /// `text`. See [`text_bytes`](Self::text_bytes).
     text_in_raw: Option<usize>,
-    /// The values of a plain `GOTO` line read by the fast path, and their
-    /// number (0 if the statement was not read so).
-    plain_goto_values: [f64; 9],
-    plain_goto_count: usize,
     segments: Vec<Segment>,
     /// Comma-separated fields of the current statement's arguments.
     fields: Vec<Span>,
@@ -97,8 +104,6 @@ impl<R: BufRead> ClReader<R> {
             raw: Vec::with_capacity(256),
             text: String::with_capacity(256),
             text_in_raw: None,
-            plain_goto_values: [0.0; 9],
-            plain_goto_count: 0,
             segments: Vec::with_capacity(4),
             fields: Vec::with_capacity(16),
             line: 0,
@@ -191,26 +196,42 @@ impl<R: BufRead> ClReader<R> {
     /// An `Err` is an error diagnostic (never a warning): the input cannot be
     /// posted as it is. See the type's documentation for what happens after.
     pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
+        if self.finished {
+            return Ok(None);
+        }
+        // The bulk of a CL file, a plain `GOTO` line, is read and turned
+        // into its event right here; everything else is left to
+        // `next_statement_general`, out of line, so that this stays small.
+        let mut values = [0.0; 9];
+        match self.begin_statement(&mut values)? {
+            Begin::PlainGoto { count, end } => self.plain_goto_statement(values, count, end),
+            begun => self.next_statement_general(begun, values),
+        }
+    }
+
+    /// [`next_statement`](Self::next_statement) after `begin_statement`
+    /// found something else than a plain `GOTO` line.
+    #[inline(never)]
+    fn next_statement_general(
+        &mut self,
+        mut begun: Begin,
+        mut values: [f64; 9],
+    ) -> Result<Option<Statement>, Diagnostic> {
         loop {
-            if self.finished {
-                return Ok(None);
-            }
-            match self.read_statement()? {
+            let read = match begun {
+                Begin::PlainGoto { count, end } => {
+                    return self.plain_goto_statement(values, count, end);
+                }
+                Begin::PlainLine => Read::Statement,
+                Begin::Lines => self.read_lines()?,
+            };
+            match read {
                 Read::Eof => return Ok(None),
                 Read::Comment(line, text) => {
                     return Ok(Some(Statement {
                         line,
                         event: ClEvent::Comment(text),
                     }));
-                }
-                Read::Statement if self.plain_goto_count != 0 => {
-                    // The bulk of a CL file, read by `plain_goto`: the event
-                    // is built right in the result.
-                    let count = std::mem::take(&mut self.plain_goto_count);
-                    let args = (5, self.text_in_raw.unwrap_or(0));
-                    let event = self.goto_with(args, self.plain_goto_values, count)?;
-                    let line = self.line;
-                    return Ok(Some(Statement { line, event }));
                 }
                 Read::Statement => {
                     if let Some(event) = self.interpret()? {
@@ -219,7 +240,34 @@ impl<R: BufRead> ClReader<R> {
                     }
                 }
             }
+            if self.finished {
+                return Ok(None);
+            }
+            begun = self.begin_statement(&mut values)?;
         }
+    }
+
+    /// The statement of a plain `GOTO` line read by `begin_statement`: its
+    /// `count` values and the length of its text.
+    #[inline(always)]
+    fn plain_goto_statement(
+        &mut self,
+        values: [f64; 9],
+        count: usize,
+        end: usize,
+    ) -> Result<Option<Statement>, Diagnostic> {
+        let (point, axis, motion) = self.goto_move((5, end), values, count)?;
+        Ok(Some(Statement {
+            line: self.line,
+            // `self.reference` read straight into the result (the optimizer
+            // copied it around through the stack otherwise).
+            event: ClEvent::Goto {
+                point,
+                axis,
+                reference: self.reference,
+                motion,
+            },
+        }))
     }
 
     // ----- lines -----
@@ -242,24 +290,23 @@ impl<R: BufRead> ClReader<R> {
         }
     }
 
-    /// Reads physical lines until a logical statement is complete.
+    /// Starts the next statement: the fast paths, on the input buffer as it
+    /// is. A whole line in the buffer that is ASCII without `$` (no comment,
+    /// no continuation, no UTF-8 to check) is a statement on its own; a plain
+    /// `GOTO` line is also parsed, its values into `values`. Anything else is
+    /// left to [`read_lines`](Self::read_lines), which handles it exactly as
+    /// before.
     #[inline(always)]
-    fn read_statement(&mut self) -> Result<Read, Diagnostic> {
+    fn begin_statement(&mut self, values: &mut [f64; 9]) -> Result<Begin, Diagnostic> {
         self.raw.clear();
         self.text.clear();
         self.segments.clear();
         self.text_in_raw = None;
-        self.plain_goto_count = 0;
-        // Fast path: a whole line in the input buffer that is ASCII without
-        // `$` (no comment, no continuation, no UTF-8 to check) is a statement
-        // on its own. Anything else takes the general path below, which
-        // handles it exactly as before.
         match self.input.fill_buf() {
             Ok(buf) => {
-                if let Some((count, end)) = plain_goto(buf, &mut self.plain_goto_values) {
-                    let n = end + usize::from(buf[end] == b'\r');
+                if let Some(PlainGoto { count, end, next }) = plain_goto(buf, values) {
                     self.raw.extend_from_slice(&buf[..end]);
-                    self.input.consume(n + 1);
+                    self.input.consume(next);
                     self.line += 1;
                     self.segments.push(Segment {
                         line: self.line,
@@ -269,8 +316,7 @@ impl<R: BufRead> ClReader<R> {
                         text_end: end,
                     });
                     self.text_in_raw = Some(end);
-                    self.plain_goto_count = count;
-                    return Ok(Read::Statement);
+                    return Ok(Begin::PlainGoto { count, end });
                 }
                 if let Some(n) = plain_line(buf) {
                     let line = &buf[..n];
@@ -290,13 +336,19 @@ impl<R: BufRead> ClReader<R> {
                         text_end,
                     });
                     self.text_in_raw = Some(text_end);
-                    return Ok(Read::Statement);
+                    return Ok(Begin::PlainLine);
                 }
             }
-            // `read_until` below retries.
+            // `read_until` in `read_lines` retries.
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
             Err(e) => return Err(self.read_error(e)),
         }
+        Ok(Begin::Lines)
+    }
+
+    /// Reads physical lines until a logical statement is complete (the
+    /// general path, after `begin_statement`).
+    fn read_lines(&mut self) -> Result<Read, Diagnostic> {
         loop {
             let mut start = self.raw.len();
             match self.input.read_until(b'\n', &mut self.raw) {
@@ -644,36 +696,36 @@ impl<R: BufRead> ClReader<R> {
                 self.fields.len()
             }
         };
-        self.goto_with(args, v, count)
+        let (point, axis, motion) = self.goto_move(args, v, count)?;
+        Ok(ClEvent::Goto {
+            point,
+            axis,
+            reference: self.reference,
+            motion,
+        })
     }
 
-    /// A `GOTO` with `count` values (the first 9 in `v`).
+    /// A `GOTO` with `count` values (the first 9 in `v`): its point, tool
+    /// axis and motion, the new modal state set (the reference direction is
+    /// then `self.reference`).
     #[inline(always)]
-    fn goto_with(&mut self, args: Span, v: [f64; 9], count: usize) -> Result<ClEvent, Diagnostic> {
+    fn goto_move(
+        &mut self,
+        args: Span,
+        v: [f64; 9],
+        count: usize,
+    ) -> Result<(Vec3, Vec3, Motion), Diagnostic> {
         if !matches!(count, 3 | 6 | 9) {
-            self.split(args);
-            let extra = match count {
-                0..=2 => args,
-                4 | 5 => (self.fields[3].0, args.1),
-                7 | 8 => (self.fields[6].0, args.1),
-                _ => (self.fields[9].0, args.1),
-            };
-            return Err(self.error(
-                extra,
-                format!(
-                    "GOTO has {count} value{}, expected 3 (x,y,z), 6 (x,y,z,i,j,k) or 9 (x,y,z,i,j,k,u,v,w)",
-                    if count == 1 { "" } else { "s" }
-                ),
-            ));
+            return Err(self.goto_count_error(args, count));
         }
         let point = [v[0], v[1], v[2]];
         let axis = if count >= 6 {
             match normalize([v[3], v[4], v[5]]) {
                 Some(axis) => axis,
                 None => {
-                    self.split(args);
-                    return Err(self.error(
-                        (self.fields[3].0, self.fields[5].1),
+                    return Err(self.goto_error(
+                        args,
+                        3,
                         "the tool axis (i,j,k) is zero or not finite",
                     ));
                 }
@@ -682,15 +734,15 @@ impl<R: BufRead> ClReader<R> {
             match self.axis {
                 Some(axis) => axis,
                 None => {
-                    self.split(args);
-                    return Err(self.error(
-                        (self.fields[0].0, self.fields[2].1),
+                    return Err(self.goto_error(
+                        args,
+                        0,
                         "GOTO/x,y,z before any tool axis is known: give the first GOTO as x,y,z,i,j,k (or set a default tool axis for a 3-axis file)",
                     ));
                 }
             }
         };
-        let reference = if count == 9 {
+        if count == 9 {
             let r = normalize([v[6], v[7], v[8]]);
             let problem = match r {
                 None => Some("the reference direction (u,v,w) is zero or not finite"),
@@ -701,26 +753,48 @@ impl<R: BufRead> ClReader<R> {
                 }
             };
             if let Some(message) = problem {
-                self.split(args);
-                return Err(self.error((self.fields[6].0, self.fields[8].1), message));
+                return Err(self.goto_error(args, 6, message));
             }
-            r
-        } else {
-            self.reference
-        };
+            self.reference = r;
+        }
+        // Only now, when nothing can fail: a failed statement has no effect.
+        // (The reference direction is kept as it is unless given.)
         self.axis = Some(axis);
-        self.reference = reference;
         let motion = if std::mem::take(&mut self.rapid) {
             Motion::Rapid
         } else {
             Motion::Feed
         };
-        Ok(ClEvent::Goto {
-            point,
-            axis,
-            reference,
-            motion,
-        })
+        Ok((point, axis, motion))
+    }
+
+    /// The error for a `GOTO` with `count` values, not 3, 6 or 9 (out of
+    /// line: `goto_move` is on the hot path).
+    #[cold]
+    #[inline(never)]
+    fn goto_count_error(&mut self, args: Span, count: usize) -> Diagnostic {
+        self.split(args);
+        let extra = match count {
+            0..=2 => args,
+            4 | 5 => (self.fields[3].0, args.1),
+            7 | 8 => (self.fields[6].0, args.1),
+            _ => (self.fields[9].0, args.1),
+        };
+        self.error(
+            extra,
+            format!(
+                "GOTO has {count} value{}, expected 3 (x,y,z), 6 (x,y,z,i,j,k) or 9 (x,y,z,i,j,k,u,v,w)",
+                if count == 1 { "" } else { "s" }
+            ),
+        )
+    }
+
+    /// The error about the values `first..first + 3` of a `GOTO`.
+    #[cold]
+    #[inline(never)]
+    fn goto_error(&mut self, args: Span, first: usize, message: &str) -> Diagnostic {
+        self.split(args);
+        self.error((self.fields[first].0, self.fields[first + 2].1), message)
     }
 
     fn fedrat(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
@@ -1179,31 +1253,52 @@ fn trim_end_ascii(line: &[u8]) -> usize {
 }
 
 /// A plain `GOTO` line at the start of `buf`, the common case: `GOTO/`,
-/// then numbers [`scan_plain_number`] takes, separated by commas, then the
-/// line end (`\n` or `\r\n`), nothing else (no blanks). Returns the number
-/// of values (at most 9, in `v`) and the length of the line without its
-/// `\r\n` or `\n`; `None` for anything else.
+/// then numbers [`plain_number`] takes, separated by commas, then the line
+/// end (`\n` or `\r\n`), nothing else (no blanks). Returns the number of
+/// values (at most 9, in `v`) and the length of the line without and with
+/// its line end; `None` for anything else, and near the end of `buf` (fewer
+/// than [`PLAIN_CHUNK`] bytes from the start of a number).
 ///
 /// As the numbers are read, the line is checked on the way: it is ASCII
 /// without `$` (the bytes taken are digits, signs, points and commas).
 #[inline(always)]
-fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<(usize, usize)> {
-    if !buf.starts_with(b"GOTO/") {
-        return None;
-    }
-    let mut i = 5;
-    let mut count = 0;
-    loop {
-        let (x, end) = scan_plain_number(buf, i)?;
-        *v.get_mut(count)? = x;
-        count += 1;
-        match *buf.get(end)? {
-            b',' => i = end + 1,
-            b'\n' => return Some((count, end)),
-            b'\r' if buf.get(end + 1) == Some(&b'\n') => return Some((count, end)),
+fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<PlainGoto> {
+    let mut rest = buf.strip_prefix(b"GOTO/")?;
+    // The count of values is what `slots` has left, not a counter: one
+    // instruction less per number.
+    let mut slots = v.iter_mut();
+    while let Some(slot) = slots.next() {
+        let chunk = rest.first_chunk::<PLAIN_CHUNK>()?;
+        let (x, len) = plain_number(chunk)?;
+        *slot = x;
+        // `len` is at most 10: the byte after the number is in the chunk.
+        let line_end = match chunk[len] {
+            b',' => {
+                rest = &rest[len + 1..];
+                continue;
+            }
+            b'\n' => 1,
+            b'\r' if rest.get(len + 1) == Some(&b'\n') => 2,
             _ => return None,
-        }
+        };
+        let end = buf.len() - rest.len() + len;
+        return Some(PlainGoto {
+            count: 9 - slots.len(),
+            end,
+            next: end + line_end,
+        });
     }
+    None // more than 9 values
+}
+
+/// A plain `GOTO` line found by [`plain_goto`].
+struct PlainGoto {
+    /// The number of values.
+    count: usize,
+    /// The length of the line without its line end.
+    end: usize,
+    /// The length of the line with its line end.
+    next: usize,
 }
 
 fn is_word_byte(c: u8) -> bool {

@@ -609,3 +609,36 @@ proptest::proptest! {
         proptest::prop_assert_eq!(transcript(text.as_bytes()), general);
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+
+    /// `GOTO` values as CAM systems write them read as the very bits of
+    /// `str::parse::<f64>`, through the fast paths (whole input in memory)
+    /// and through the general path (a one-byte buffer).
+    #[test]
+    fn goto_values_are_bit_identical_to_std(
+        values in proptest::collection::vec(
+            "[-+]?(0{0,2}[0-9]{1,7}(\\.[0-9]{0,8})?|\\.[0-9]{1,8})([eE][-+]?[0-9]{1,2})?",
+            3,
+        ),
+        crlf in proptest::bool::ANY,
+    ) {
+        let line_end = if crlf { "\r\n" } else { "\n" };
+        let text = format!("GOTO/{}{line_end}GOTO/1,2,3{line_end}", values.join(","));
+        let expected: Vec<u64> = values.iter().map(|v| v.parse::<f64>().unwrap().to_bits()).collect();
+        let fast = ClReader::new(text.as_bytes(), "t.cls").with_default_axis([0.0, 0.0, 1.0]);
+        let general = ClReader::new(std::io::BufReader::with_capacity(1, text.as_bytes()), "t.cls")
+            .with_default_axis([0.0, 0.0, 1.0]);
+        for mut reader in [fast.map(|s| s.map(|s| s.event)).collect::<Vec<_>>(), general.map(|s| s.map(|s| s.event)).collect()] {
+            proptest::prop_assert_eq!(reader.len(), 2);
+            match reader.remove(0) {
+                Ok(ClEvent::Goto { point, .. }) => {
+                    let bits: Vec<u64> = point.iter().map(|v| v.to_bits()).collect();
+                    proptest::prop_assert_eq!(&bits, &expected, "{}", text);
+                }
+                other => proptest::prop_assert!(false, "{other:?}"),
+            }
+        }
+    }
+}
