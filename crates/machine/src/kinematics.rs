@@ -163,17 +163,25 @@ struct Turn {
     point: V3,
     /// xx, xy, xz, yy, yz, zz of `dir`.
     dir2: [f64; 6],
+    /// `Some(k)` when `dir` is ±e_k exactly (most machines): the rotation
+    /// then turns two coordinates only.
+    aligned: Option<usize>,
 }
 
 impl Turn {
     fn new(axis: usize, slot: usize, dir: V3, point: V3) -> Turn {
         let (x, y, z) = (dir.x, dir.y, dir.z);
+        let zeros = [x, y, z].iter().filter(|&&v| v == 0.0).count();
+        let aligned = (zeros == 2)
+            .then(|| dir.iamax())
+            .filter(|&k| dir[k].abs() == 1.0);
         Turn {
             axis,
             slot,
             dir,
             point,
             dir2: [x * x, x * y, x * z, y * y, y * z, z * z],
+            aligned,
         }
     }
 
@@ -181,27 +189,88 @@ impl Turn {
     /// (Rodrigues: `c·I + s·[w]× + (1 − c)·w wᵀ`, as
     /// [`rotation_cs`](crate::subproblems::rotation_cs)).
     #[inline(always)]
-    fn rotation(&self, c: f64, s: f64) -> Rot {
+    fn rotation(&self, c: f64, s: f64) -> Turned {
         let v = 1.0 - c;
+        if let Some(k) = self.aligned {
+            // Rodrigues' terms for w = ±e_k: `c + 1·v` on the diagonal at k
+            // (not exactly 1), `c` at the other two, `∓s` off the diagonal
+            // (`w_k·s` below), zeros elsewhere.
+            return Turned::Axis {
+                k,
+                c,
+                s: self.dir[k] * s,
+                d: c + v,
+            };
+        }
         let (x, y, z) = (self.dir.x * s, self.dir.y * s, self.dir.z * s);
         let [xx, xy, xz, yy, yz, zz] = self.dir2;
-        Rot([
+        Turned::Matrix(Rot([
             [c + xx * v, xy * v - z, xz * v + y],
             [xy * v + z, c + yy * v, yz * v - x],
             [xz * v - y, yz * v + x, c + zz * v],
-        ])
+        ]))
     }
 
     /// `m·(x − point) + point`: the point `x` turned about the line.
     #[inline(always)]
-    fn move_point(&self, m: &Rot, x: &V3) -> V3 {
+    fn move_point(&self, m: &Turned, x: &V3) -> V3 {
         m.apply(&(x - self.point)) + self.point
     }
 
     /// The inverse of [`Turn::move_point`].
     #[inline(always)]
-    fn unmove_point(&self, m: &Rot, x: &V3) -> V3 {
+    fn unmove_point(&self, m: &Turned, x: &V3) -> V3 {
         m.apply_t(&(x - self.point)) + self.point
+    }
+}
+
+/// The rotation of a [`Turn`] for some angle.
+#[derive(Debug, Clone, Copy)]
+enum Turned {
+    /// About the coordinate axis `k`: cosine, sine (signed by the
+    /// direction) and the diagonal term `d = c + (1 − c)` at `k`. The
+    /// products are those of the full matrix without its zero terms: the
+    /// same values, up to the sign of a zero result.
+    Axis {
+        k: usize,
+        c: f64,
+        s: f64,
+        d: f64,
+    },
+    Matrix(Rot),
+}
+
+impl Turned {
+    const IDENTITY: Turned = Turned::Matrix(Rot::IDENTITY);
+
+    /// `self · v`.
+    #[inline(always)]
+    fn apply(&self, v: &V3) -> V3 {
+        match *self {
+            Turned::Axis { k, c, s, d } => about_axis(k, c, s, d, v),
+            Turned::Matrix(ref m) => m.apply(v),
+        }
+    }
+
+    /// `selfᵀ · v`: the turn back, by `−s`.
+    #[inline(always)]
+    fn apply_t(&self, v: &V3) -> V3 {
+        match *self {
+            Turned::Axis { k, c, s, d } => about_axis(k, c, -s, d, v),
+            Turned::Matrix(ref m) => m.apply_t(v),
+        }
+    }
+}
+
+/// `v` turned about the coordinate axis `k` (cosine `c`, sine `s`, diagonal
+/// term `d`): the rows of [`Turn::rotation`] with their zero terms left out,
+/// each sum in the same order.
+#[inline(always)]
+fn about_axis(k: usize, c: f64, s: f64, d: f64, v: &V3) -> V3 {
+    match k {
+        0 => V3::new(d * v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        1 => V3::new(c * v.x + s * v.z, d * v.y, c * v.z - s * v.x),
+        _ => V3::new(c * v.x - s * v.y, s * v.x + c * v.y, d * v.z),
     }
 }
 
@@ -232,7 +301,7 @@ enum LinearSolve {
 }
 
 /// The rotation matrices of the free rotary slots, for some angles.
-type Rots = [Rot; 3];
+type Rots = [Turned; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
@@ -497,6 +566,9 @@ impl Kinematics {
         let mut point = self.tip;
         let mut axis = self.tip_axis;
         let mut reference = self.tip_reference;
+        // (A machine without a reference direction returns none: not
+        // turned.)
+        let with_reference = self.r0.is_some();
         for step in self.steps.iter().rev() {
             match step {
                 Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
@@ -505,7 +577,9 @@ impl Kinematics {
                     let m = t.rotation(c, s);
                     point = t.move_point(&m, &point);
                     axis = m.apply(&axis);
-                    reference = m.apply(&reference);
+                    if with_reference {
+                        reference = m.apply(&reference);
+                    }
                 }
             }
         }
@@ -779,7 +853,7 @@ impl Kinematics {
         out: &mut Vec<Solution>,
     ) {
         let mut joints = self.fixed;
-        let mut rots = [Rot::IDENTITY; 3];
+        let mut rots = [Turned::IDENTITY; 3];
         let mut ranges = [SlotRange::default(); 3];
         for k in 0..N {
             let (slot, a) = (&self.slots[k], &mut b.angles[k]);

@@ -183,13 +183,13 @@ impl Sp2 {
     }
 
     /// The solutions for `q`, as [`sp2`] has them but before the `atan2`s.
-    #[inline]
+    #[inline(always)]
     pub fn solve_xy(&self, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
         let none = Sp2Xy {
             theta1: None,
             theta2: None,
         };
-        let (w1, w2, w12) = (&self.w1, &self.w2, self.w12);
+        let (w1, w12) = (&self.w1, self.w12);
         if self.cross2 < 1e-24 {
             return ([none; 2], 0);
         }
@@ -205,26 +205,36 @@ impl Sp2 {
         // projections that do not depend on the intersection point `z`.
         let q_off_w1 = q - w1 * w1q;
         let q_on_w1 = q_off_w1.norm_squared() < FREE_EPS * FREE_EPS;
-        let solve = |g: f64| {
-            let z = w1 * a + w2 * b + self.cross * g;
-            let z_off_w1 = z - w1 * w1.dot(&z);
-            let z_off_w2 = z - w2 * w2.dot(&z);
-            let free = |v: &Vector3<f64>| v.norm_squared() < FREE_EPS * FREE_EPS;
-            Sp2Xy {
-                theta1: (!(free(&z_off_w1) || q_on_w1))
-                    .then(|| (z_off_w1.dot(&q_off_w1), w1.dot(&z_off_w1.cross(&q_off_w1)))),
-                theta2: (!(self.p_on_w2 || free(&z_off_w2))).then(|| {
-                    (
-                        self.p_off_w2.dot(&z_off_w2),
-                        w2.dot(&self.p_off_w2.cross(&z_off_w2)),
-                    )
-                }),
-            }
-        };
         if g == 0.0 {
-            ([solve(0.0), none], 1)
+            ([self.at(a, b, 0.0, &q_off_w1, q_on_w1), none], 1)
         } else {
-            ([solve(g), solve(-g)], 2)
+            (
+                [
+                    self.at(a, b, g, &q_off_w1, q_on_w1),
+                    self.at(a, b, -g, &q_off_w1, q_on_w1),
+                ],
+                2,
+            )
+        }
+    }
+
+    /// The angles for the intersection point `z = a·w1 + b·w2 + g·(w1 × w2)`.
+    #[inline(always)]
+    fn at(&self, a: f64, b: f64, g: f64, q_off_w1: &Vector3<f64>, q_on_w1: bool) -> Sp2Xy {
+        let (w1, w2) = (&self.w1, &self.w2);
+        let z = w1 * a + w2 * b + self.cross * g;
+        let z_off_w1 = z - w1 * w1.dot(&z);
+        let z_off_w2 = z - w2 * w2.dot(&z);
+        let free = |v: &Vector3<f64>| v.norm_squared() < FREE_EPS * FREE_EPS;
+        Sp2Xy {
+            theta1: (!(free(&z_off_w1) || q_on_w1))
+                .then(|| (z_off_w1.dot(q_off_w1), w1.dot(&z_off_w1.cross(q_off_w1)))),
+            theta2: (!(self.p_on_w2 || free(&z_off_w2))).then(|| {
+                (
+                    self.p_off_w2.dot(&z_off_w2),
+                    w2.dot(&self.p_off_w2.cross(&z_off_w2)),
+                )
+            }),
         }
     }
 }
