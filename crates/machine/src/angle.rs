@@ -26,11 +26,14 @@ pub(crate) fn sin_cos_deg(deg: f64) -> (f64, f64) {
     // library `round` on baseline x86-64); r = deg − 90k is exact (Sterbenz:
     // deg lies within a factor 2 of 90k when k ≠ 0) and |r| ≤ 45 + ε.
     const ROUND: f64 = 6_755_399_441_055_744.0;
-    let k = (deg * (1.0 / 90.0) + ROUND) - ROUND;
+    let rounded = deg * (1.0 / 90.0) + ROUND;
+    let k = rounded - ROUND;
     let r = deg - 90.0 * k;
     let x = r * (std::f64::consts::PI / 180.0);
     let (s, c) = (sin_kernel(x), cos_kernel(x));
-    match (k as i64) & 3 {
+    // The quadrant k mod 4 from the low bits of 1.5·2^52 + k (|k| < 2^51;
+    // 2^51 is 0 mod 4): no float-to-integer conversion, which saturates.
+    match rounded.to_bits() & 3 {
         0 => (s, c),
         1 => (c, -s),
         2 => (-s, -c),
@@ -107,7 +110,9 @@ pub(crate) fn atan2_rad(y: f64, x: f64) -> f64 {
     } else {
         PI_2_HI - (atan_01(ax / ay) - PI_2_LO)
     };
-    if x.is_sign_negative() {
+    // (x = −0 counts as +0, as the library has it: atan2(±y, −0) = ±π/2
+    // exactly, where π − (π/2 − lo) would be an ulp off.)
+    if x < 0.0 {
         a = PI_HI - (a - PI_LO);
     }
     if y.is_sign_negative() {
@@ -184,6 +189,10 @@ mod tests {
         assert_eq!(atan2_deg(0.0, -1.0), 180.0);
         assert_eq!(atan2_deg(-1.0, 0.0), -90.0);
         assert_eq!(atan2_deg(1.0, 1.0), 45.0);
+        // −0 is +0 for x (as in the library).
+        assert_eq!(atan2_deg(1.0, -0.0), 90.0);
+        assert_eq!(atan2_deg(-1.0, -0.0), -90.0);
+        assert_eq!(atan2_rad(-2.0, -0.0), -std::f64::consts::FRAC_PI_2);
     }
 
     #[test]

@@ -46,7 +46,7 @@ mod singular;
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{FREE_EPS, Sp2, rotation, rotation_cs, sp1_xy, unit_xy};
+use crate::subproblems::{FREE_EPS, Sp2, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -171,10 +171,7 @@ struct Turn {
 impl Turn {
     fn new(axis: usize, slot: usize, dir: V3, point: V3) -> Turn {
         let (x, y, z) = (dir.x, dir.y, dir.z);
-        let zeros = [x, y, z].iter().filter(|&&v| v == 0.0).count();
-        let aligned = (zeros == 2)
-            .then(|| dir.iamax())
-            .filter(|&k| dir[k].abs() == 1.0);
+        let aligned = coordinate_axis(&dir).map(|(k, _)| k);
         Turn {
             axis,
             slot,
@@ -322,7 +319,10 @@ pub struct Kinematics {
     a0: Vector3<f64>,
     r0: Option<Vector3<f64>>,
     fixed: Joints,
-    limits: [Option<[f64; 2]>; MAX_AXES],
+    /// The free linear axes with their travel widened by the 1e-9 slack of
+    /// [`Axis::accepts`](crate::Axis::accepts) (infinite without limits:
+    /// the values tested are finite).
+    free_lin_bounds: Vec<(usize, [f64; 2])>,
     /// Free rotary axes in effective-chain order: (axis index, signed direction).
     free_rot: Vec<(usize, Vector3<f64>)>,
     /// The free rotary axes by slot.
@@ -529,6 +529,16 @@ impl Kinematics {
         let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
         let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
         let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
+        let free_lin_bounds = free_lin
+            .iter()
+            .map(|&i| {
+                let bounds = match limits[i] {
+                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
+                    None => [f64::NEG_INFINITY, f64::INFINITY],
+                };
+                (i, bounds)
+            })
+            .collect();
         Kinematics {
             n,
             steps,
@@ -548,7 +558,7 @@ impl Kinematics {
             a0: machine.tool.axis,
             r0: machine.tool.reference,
             fixed,
-            limits,
+            free_lin_bounds,
             free_rot,
             between,
             free_lin,
@@ -987,11 +997,13 @@ impl Kinematics {
         }
         // Linear axes: their values do not change between equivalents. A
         // branch outside the linear travel is given once.
+        // (`Axis::accepts` with the bounds worked out once; the solved
+        // values are finite, see `solve_linear`.)
         let violation = self
-            .free_lin
+            .free_lin_bounds
             .iter()
-            .find(|&&i| !accepts(self.limits[i], joints[i]))
-            .map(|&i| Violation {
+            .find(|&&(i, [lo, hi])| !(joints[i] >= lo && joints[i] <= hi))
+            .map(|&(i, _)| Violation {
                 axis: i,
                 value: joints[i],
             });
@@ -1212,13 +1224,6 @@ struct SlotRange {
 impl SlotRange {
     fn has_equivalent(&self) -> bool {
         self.first <= self.last
-    }
-}
-
-fn accepts(limits: Option<[f64; 2]>, v: f64) -> bool {
-    match limits {
-        None => v.is_finite(),
-        Some([lo, hi]) => v >= lo - 1e-9 && v <= hi + 1e-9,
     }
 }
 

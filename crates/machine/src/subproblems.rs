@@ -11,6 +11,14 @@ use nalgebra::{Matrix3, Vector3};
 /// taken as zero: the vector lies on the axis and the angle is free.
 pub const FREE_EPS: f64 = 1e-12;
 
+/// `Some((k, σ))` when `v` is exactly `σ·e_k` (σ = ±1): two components
+/// zero and the third ±1, as the axes of most machines are.
+pub(crate) fn coordinate_axis(v: &Vector3<f64>) -> Option<(usize, f64)> {
+    let zeros = v.iter().filter(|&&c| c == 0.0).count();
+    let k = v.iamax();
+    (zeros == 2 && v[k].abs() == 1.0).then_some((k, v[k]))
+}
+
 /// Rotation matrix about unit `w` by `theta` radians (Rodrigues' formula).
 #[inline]
 pub fn rotation(w: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
@@ -160,6 +168,21 @@ pub struct Sp2 {
     /// turns it), and whether that leaves nothing (`θ2` free).
     p_off_w2: Vector3<f64>,
     p_on_w2: bool,
+    /// Axes along coordinate axes (see [`Aligned`]).
+    aligned: Option<Aligned>,
+}
+
+/// `w1 = σ1·e_i`, `w2 = σ2·e_j` (i ≠ j), hence `w1 × w2 = σ3·e_k`: every
+/// dot and cross product of [`Sp2::solve_xy`] with them has one or two
+/// non-zero terms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Aligned {
+    i: usize,
+    j: usize,
+    k: usize,
+    s1: f64,
+    s2: f64,
+    s3: f64,
 }
 
 impl Sp2 {
@@ -168,6 +191,20 @@ impl Sp2 {
         let cross = w1.cross(w2);
         let w2p = w2.dot(p);
         let p_off_w2 = p - w2 * w2p;
+        let aligned = match (coordinate_axis(w1), coordinate_axis(w2)) {
+            (Some((i, s1)), Some((j, s2))) if i != j => {
+                let k = 3 - i - j;
+                Some(Aligned {
+                    i,
+                    j,
+                    k,
+                    s1,
+                    s2,
+                    s3: cross[k],
+                })
+            }
+            _ => None,
+        };
         Sp2 {
             w1: *w1,
             w2: *w2,
@@ -179,6 +216,7 @@ impl Sp2 {
             p2: p.norm_squared(),
             p_off_w2,
             p_on_w2: p_off_w2.norm_squared() < FREE_EPS * FREE_EPS,
+            aligned,
         }
     }
 
@@ -189,6 +227,9 @@ impl Sp2 {
             theta1: None,
             theta2: None,
         };
+        if let Some(al) = &self.aligned {
+            return self.solve_aligned(al, q, slack);
+        }
         let (w1, w12) = (&self.w1, self.w12);
         if self.cross2 < 1e-24 {
             return ([none; 2], 0);
@@ -215,6 +256,74 @@ impl Sp2 {
                 ],
                 2,
             )
+        }
+    }
+
+    /// [`Sp2::solve_xy`] for axes along coordinate axes: the same
+    /// arithmetic without the terms that are products with a zero
+    /// component of `w1`, `w2` or `w1 × w2` (every sum left has one or two
+    /// terms), hence the same values up to the sign of a zero result. With
+    /// `w1·w2 = 0` and `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`,
+    /// `g² = |p|² − a² − b²` (Murray, Li, Sastry eq. 3.51–3.53), and
+    /// `z = σ1·a·e_i + σ2·b·e_j + σ3·g·e_k`.
+    #[inline(always)]
+    fn solve_aligned(&self, al: &Aligned, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
+        let none = Sp2Xy {
+            theta1: None,
+            theta2: None,
+        };
+        let Aligned {
+            i,
+            j,
+            k,
+            s1,
+            s2,
+            s3,
+        } = *al;
+        let a = s1 * q[i];
+        let b = self.w2p;
+        let g2 = self.p2 - a * a - b * b;
+        if g2 < -slack {
+            return ([none; 2], 0);
+        }
+        let g = g2.max(0.0).sqrt();
+        // q off w1 is q with its component i zero; p off w2 has its
+        // component j zero.
+        let q_on_w1 = q[j] * q[j] + q[k] * q[k] < FREE_EPS * FREE_EPS;
+        let po = &self.p_off_w2;
+        // The cyclic successors of i and j: (u × v)_i = u_n1·v_n2 − u_n2·v_n1.
+        let (n1, n2) = ((i + 1) % 3, (i + 2) % 3);
+        let (m1, m2) = ((j + 1) % 3, (j + 2) % 3);
+        let solve = |g: f64| {
+            // z off w1 (zero at i) and z off w2 (zero at j).
+            let mut z1 = [0.0; 3];
+            z1[j] = s2 * b;
+            z1[k] = s3 * g;
+            let mut z2 = [0.0; 3];
+            z2[i] = s1 * a;
+            z2[k] = s3 * g;
+            let q1 = |m: usize| if m == i { 0.0 } else { q[m] };
+            let free1 = b * b + g * g < FREE_EPS * FREE_EPS;
+            let free2 = a * a + g * g < FREE_EPS * FREE_EPS;
+            Sp2Xy {
+                theta1: (!(free1 || q_on_w1)).then(|| {
+                    (
+                        z1[j] * q[j] + z1[k] * q[k],
+                        s1 * (z1[n1] * q1(n2) - z1[n2] * q1(n1)),
+                    )
+                }),
+                theta2: (!(self.p_on_w2 || free2)).then(|| {
+                    (
+                        po[i] * z2[i] + po[k] * z2[k],
+                        s2 * (po[m1] * z2[m2] - po[m2] * z2[m1]),
+                    )
+                }),
+            }
+        };
+        if g == 0.0 {
+            ([solve(0.0), none], 1)
+        } else {
+            ([solve(g), solve(-g)], 2)
         }
     }
 
@@ -313,6 +422,37 @@ mod tests {
             };
             let fast = Sp2::new(&w1, &w2, &p).solve_xy(&q, 1e-12);
             prop_assert_eq!(fast, sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
+        }
+
+        /// Axes along coordinate axes take the shortcut of
+        /// [`Sp2::solve_aligned`]: the same values as from scratch (`==`:
+        /// up to the sign of a zero), for reachable, unreachable and
+        /// singular targets.
+        #[test]
+        fn aligned_sp2_is_sp2(
+            i in 0usize..3, dj in 1usize..3, s1 in prop_oneof![Just(1.0), Just(-1.0)],
+            s2 in prop_oneof![Just(1.0), Just(-1.0)], p in unit(), q in unit(),
+            on_axis in 0usize..5, t1 in -3.1..3.1f64, t2 in -3.1..3.1f64,
+            quarter in 0usize..4,
+        ) {
+            let axis = |k: usize, s: f64| {
+                let mut v = Vector3::zeros();
+                v[k] = s;
+                v
+            };
+            let (w1, w2) = (axis(i, s1), axis((i + dj) % 3, s2));
+            let p = if on_axis == 1 { w2 } else { p };
+            // Exact quarter turns as well (zeros in the solution).
+            let right = std::f64::consts::FRAC_PI_2 * quarter as f64;
+            let q = match on_axis {
+                2 => w1,
+                3 => rotation(&w1, t1) * rotation(&w2, t2) * p,
+                4 => rotation(&w1, right) * rotation(&w2, -right) * axis(3 - i - (i + dj) % 3, 1.0),
+                _ => q,
+            };
+            let sp2 = Sp2::new(&w1, &w2, &p);
+            prop_assert!(sp2.aligned.is_some());
+            prop_assert_eq!(sp2.solve_xy(&q, 1e-12), sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
         }
 
         #[test]
