@@ -174,7 +174,7 @@ pub struct Sp2 {
 
 /// `w1 = σ1·e_i`, `w2 = σ2·e_j` (i ≠ j), hence `w1 × w2 = σ3·e_k`: every
 /// dot and cross product of [`Sp2::solve_xy`] with them has one or two
-/// non-zero terms.
+/// non-zero terms, worked out here.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Aligned {
     i: usize,
@@ -183,6 +183,13 @@ struct Aligned {
     s1: f64,
     s2: f64,
     s3: f64,
+    /// The signs of the cross products' components i and j: `σ1` and `σ2`,
+    /// negated when `(i, j, k)` (resp. `(j, k, i)`) is not cyclic.
+    t1: f64,
+    t2: f64,
+    /// The components i and k of `p` off `w2` (its component j is zero).
+    po_i: f64,
+    po_k: f64,
 }
 
 impl Sp2 {
@@ -194,6 +201,7 @@ impl Sp2 {
         let aligned = match (coordinate_axis(w1), coordinate_axis(w2)) {
             (Some((i, s1)), Some((j, s2))) if i != j => {
                 let k = 3 - i - j;
+                let cyclic = j == (i + 1) % 3;
                 Some(Aligned {
                     i,
                     j,
@@ -201,6 +209,10 @@ impl Sp2 {
                     s1,
                     s2,
                     s3: cross[k],
+                    t1: if cyclic { s1 } else { -s1 },
+                    t2: if cyclic { s2 } else { -s2 },
+                    po_i: p_off_w2[i],
+                    po_k: p_off_w2[k],
                 })
             }
             _ => None,
@@ -260,64 +272,41 @@ impl Sp2 {
     }
 
     /// [`Sp2::solve_xy`] for axes along coordinate axes: the same
-    /// arithmetic without the terms that are products with a zero
-    /// component of `w1`, `w2` or `w1 × w2` (every sum left has one or two
-    /// terms), hence the same values up to the sign of a zero result. With
-    /// `w1·w2 = 0` and `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`,
-    /// `g² = |p|² − a² − b²` (Murray, Li, Sastry eq. 3.51–3.53), and
-    /// `z = σ1·a·e_i + σ2·b·e_j + σ3·g·e_k`.
+    /// arithmetic without the products with a zero component of `w1`, `w2`
+    /// or `w1 × w2` (every sum left has one or two terms), hence the same
+    /// values up to the sign of a zero result. With `w1·w2 = 0` and
+    /// `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`, `g² = |p|² − a² − b²`
+    /// (Murray, Li, Sastry §3.3.2), `z = σ1·a·e_i + σ2·b·e_j + σ3·g·e_k`.
     #[inline(always)]
     fn solve_aligned(&self, al: &Aligned, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
         let none = Sp2Xy {
             theta1: None,
             theta2: None,
         };
-        let Aligned {
-            i,
-            j,
-            k,
-            s1,
-            s2,
-            s3,
-        } = *al;
-        let a = s1 * q[i];
+        let a = al.s1 * q[al.i];
         let b = self.w2p;
         let g2 = self.p2 - a * a - b * b;
         if g2 < -slack {
             return ([none; 2], 0);
         }
         let g = g2.max(0.0).sqrt();
-        // q off w1 is q with its component i zero; p off w2 has its
-        // component j zero.
-        let q_on_w1 = q[j] * q[j] + q[k] * q[k] < FREE_EPS * FREE_EPS;
-        let po = &self.p_off_w2;
-        // The cyclic successors of i and j: (u × v)_i = u_n1·v_n2 − u_n2·v_n1.
-        let (n1, n2) = ((i + 1) % 3, (i + 2) % 3);
-        let (m1, m2) = ((j + 1) % 3, (j + 2) % 3);
+        // q off w1: q with its component i zero.
+        let (qj, qk) = (q[al.j], q[al.k]);
+        let q_on_w1 = qj * qj + qk * qk < FREE_EPS * FREE_EPS;
+        let (po_i, po_k) = (al.po_i, al.po_k);
+        let (zb, za) = (al.s2 * b, al.s1 * a);
         let solve = |g: f64| {
-            // z off w1 (zero at i) and z off w2 (zero at j).
-            let mut z1 = [0.0; 3];
-            z1[j] = s2 * b;
-            z1[k] = s3 * g;
-            let mut z2 = [0.0; 3];
-            z2[i] = s1 * a;
-            z2[k] = s3 * g;
-            let q1 = |m: usize| if m == i { 0.0 } else { q[m] };
+            // z off w1 is (zb, zg) at (j, k); z off w2 is (za, zg) at (i, k).
+            let zg = al.s3 * g;
             let free1 = b * b + g * g < FREE_EPS * FREE_EPS;
             let free2 = a * a + g * g < FREE_EPS * FREE_EPS;
             Sp2Xy {
-                theta1: (!(free1 || q_on_w1)).then(|| {
-                    (
-                        z1[j] * q[j] + z1[k] * q[k],
-                        s1 * (z1[n1] * q1(n2) - z1[n2] * q1(n1)),
-                    )
-                }),
-                theta2: (!(self.p_on_w2 || free2)).then(|| {
-                    (
-                        po[i] * z2[i] + po[k] * z2[k],
-                        s2 * (po[m1] * z2[m2] - po[m2] * z2[m1]),
-                    )
-                }),
+                // (z off w1 · q off w1, w1 · (z off w1 × q off w1))
+                theta1: (!(free1 || q_on_w1))
+                    .then_some((zb * qj + zg * qk, al.t1 * (zb * qk - zg * qj))),
+                // (p off w2 · z off w2, w2 · (p off w2 × z off w2))
+                theta2: (!(self.p_on_w2 || free2))
+                    .then_some((po_i * za + po_k * zg, al.t2 * (po_k * za - po_i * zg))),
             }
         };
         if g == 0.0 {
