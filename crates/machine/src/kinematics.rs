@@ -871,16 +871,16 @@ impl Kinematics {
             joints[slot.axis] = ranges[k].raw;
             rots[k] = slot.turn.rotation(a.cos, a.sin);
         }
-        if let Some(joints) = self.solve_linear(&joints, &rots, point) {
+        if self.solve_linear(&mut joints, &rots, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
-    /// With every rotary angle set in `joints` (and their rotations in
-    /// `rots`), solves the free linear axes so that the tool point lands on
-    /// `target` (part frame).
-    fn solve_linear(&self, joints: &Joints, rots: &Rots, target: &V3) -> Option<Joints> {
-        let mut q = *joints;
+    /// With every rotary angle set in `q` (and their rotations in `rots`),
+    /// solves the free linear axes so that the tool point lands on `target`
+    /// (part frame), in place (no copies of the joints in and out); `false`
+    /// when they cannot.
+    fn solve_linear(&self, q: &mut Joints, rots: &Rots, target: &V3) -> bool {
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
@@ -905,7 +905,7 @@ impl Kinematics {
             for (k, &i) in self.free_lin.iter().enumerate() {
                 q[i] = rows[k].dot(&rhs);
             }
-            return self.free_lin.iter().all(|&i| q[i].is_finite()).then_some(q);
+            return self.free_lin.iter().all(|&i| q[i].is_finite());
         }
 
         // The tool point with the free linear axes at zero, and the column
@@ -936,7 +936,7 @@ impl Kinematics {
                 let c12 = c[1].cross(&c[2]);
                 let det = c[0].dot(&c12);
                 if det.abs() < 1e-12 {
-                    return None;
+                    return false;
                 }
                 [
                     rhs.dot(&c12) / det,
@@ -950,7 +950,9 @@ impl Kinematics {
                 // tells whether the point is reachable at all.
                 let j = nalgebra::DMatrix::from_fn(3, m, |r, k| c[k][r]);
                 let b = nalgebra::DVector::from_column_slice(rhs.as_slice());
-                let x = j.svd(true, true).solve(&b, 1e-12).ok()?;
+                let Ok(x) = j.svd(true, true).solve(&b, 1e-12) else {
+                    return false;
+                };
                 let mut out = [0.0; 3];
                 out[..m].copy_from_slice(x.as_slice());
                 out
@@ -962,12 +964,9 @@ impl Kinematics {
             moved += c[k] * values[k];
         }
         if m < 3 && (moved - rhs).norm() > 1e-9 * (1.0 + rhs.norm()) {
-            return None;
+            return false;
         }
-        if !values.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        Some(q)
+        values.iter().all(|v| v.is_finite())
     }
 
     /// Appends the solution `joints` with every 360° equivalent of its
