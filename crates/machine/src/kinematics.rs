@@ -48,7 +48,7 @@ pub use chord::{lever_over, midpoint_bound};
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{FREE_EPS, Sp2, rotation, rotation_cs, sp1_xy, unit_xy};
+use crate::subproblems::{FREE_EPS, Sp2, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -165,17 +165,22 @@ struct Turn {
     point: V3,
     /// xx, xy, xz, yy, yz, zz of `dir`.
     dir2: [f64; 6],
+    /// `Some(k)` when `dir` is ±e_k exactly (most machines): the rotation
+    /// then turns two coordinates only.
+    aligned: Option<usize>,
 }
 
 impl Turn {
     fn new(axis: usize, slot: usize, dir: V3, point: V3) -> Turn {
         let (x, y, z) = (dir.x, dir.y, dir.z);
+        let aligned = coordinate_axis(&dir).map(|(k, _)| k);
         Turn {
             axis,
             slot,
             dir,
             point,
             dir2: [x * x, x * y, x * z, y * y, y * z, z * z],
+            aligned,
         }
     }
 
@@ -183,27 +188,88 @@ impl Turn {
     /// (Rodrigues: `c·I + s·[w]× + (1 − c)·w wᵀ`, as
     /// [`rotation_cs`](crate::subproblems::rotation_cs)).
     #[inline(always)]
-    fn rotation(&self, c: f64, s: f64) -> Rot {
+    fn rotation(&self, c: f64, s: f64) -> Turned {
         let v = 1.0 - c;
+        if let Some(k) = self.aligned {
+            // Rodrigues' terms for w = ±e_k: `c + 1·v` on the diagonal at k
+            // (not exactly 1), `c` at the other two, `∓s` off the diagonal
+            // (`w_k·s` below), zeros elsewhere.
+            return Turned::Axis {
+                k,
+                c,
+                s: self.dir[k] * s,
+                d: c + v,
+            };
+        }
         let (x, y, z) = (self.dir.x * s, self.dir.y * s, self.dir.z * s);
         let [xx, xy, xz, yy, yz, zz] = self.dir2;
-        Rot([
+        Turned::Matrix(Rot([
             [c + xx * v, xy * v - z, xz * v + y],
             [xy * v + z, c + yy * v, yz * v - x],
             [xz * v - y, yz * v + x, c + zz * v],
-        ])
+        ]))
     }
 
     /// `m·(x − point) + point`: the point `x` turned about the line.
     #[inline(always)]
-    fn move_point(&self, m: &Rot, x: &V3) -> V3 {
+    fn move_point(&self, m: &Turned, x: &V3) -> V3 {
         m.apply(&(x - self.point)) + self.point
     }
 
     /// The inverse of [`Turn::move_point`].
     #[inline(always)]
-    fn unmove_point(&self, m: &Rot, x: &V3) -> V3 {
+    fn unmove_point(&self, m: &Turned, x: &V3) -> V3 {
         m.apply_t(&(x - self.point)) + self.point
+    }
+}
+
+/// The rotation of a [`Turn`] for some angle.
+#[derive(Debug, Clone, Copy)]
+enum Turned {
+    /// About the coordinate axis `k`: cosine, sine (signed by the
+    /// direction) and the diagonal term `d = c + (1 − c)` at `k`. The
+    /// products are those of the full matrix without its zero terms: the
+    /// same values, up to the sign of a zero result.
+    Axis {
+        k: usize,
+        c: f64,
+        s: f64,
+        d: f64,
+    },
+    Matrix(Rot),
+}
+
+impl Turned {
+    const IDENTITY: Turned = Turned::Matrix(Rot::IDENTITY);
+
+    /// `self · v`.
+    #[inline(always)]
+    fn apply(&self, v: &V3) -> V3 {
+        match *self {
+            Turned::Axis { k, c, s, d } => about_axis(k, c, s, d, v),
+            Turned::Matrix(ref m) => m.apply(v),
+        }
+    }
+
+    /// `selfᵀ · v`: the turn back, by `−s`.
+    #[inline(always)]
+    fn apply_t(&self, v: &V3) -> V3 {
+        match *self {
+            Turned::Axis { k, c, s, d } => about_axis(k, c, -s, d, v),
+            Turned::Matrix(ref m) => m.apply_t(v),
+        }
+    }
+}
+
+/// `v` turned about the coordinate axis `k` (cosine `c`, sine `s`, diagonal
+/// term `d`): the rows of [`Turn::rotation`] with their zero terms left out,
+/// each sum in the same order.
+#[inline(always)]
+fn about_axis(k: usize, c: f64, s: f64, d: f64, v: &V3) -> V3 {
+    match k {
+        0 => V3::new(d * v.x, c * v.y - s * v.z, s * v.y + c * v.z),
+        1 => V3::new(c * v.x + s * v.z, d * v.y, c * v.z - s * v.x),
+        _ => V3::new(c * v.x - s * v.y, s * v.x + c * v.y, d * v.z),
     }
 }
 
@@ -234,7 +300,7 @@ enum LinearSolve {
 }
 
 /// The rotation matrices of the free rotary slots, for some angles.
-type Rots = [Rot; 3];
+type Rots = [Turned; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
@@ -255,7 +321,10 @@ pub struct Kinematics {
     a0: Vector3<f64>,
     r0: Option<Vector3<f64>>,
     fixed: Joints,
-    limits: [Option<[f64; 2]>; MAX_AXES],
+    /// The free linear axes with their travel widened by the 1e-9 slack of
+    /// [`Axis::accepts`](crate::Axis::accepts) (infinite without limits:
+    /// the values tested are finite).
+    free_lin_bounds: Vec<(usize, [f64; 2])>,
     /// Free rotary axes in effective-chain order: (axis index, signed direction).
     free_rot: Vec<(usize, Vector3<f64>)>,
     /// The free rotary axes by slot.
@@ -462,6 +531,16 @@ impl Kinematics {
         let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
         let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
         let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
+        let free_lin_bounds = free_lin
+            .iter()
+            .map(|&i| {
+                let bounds = match limits[i] {
+                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
+                    None => [f64::NEG_INFINITY, f64::INFINITY],
+                };
+                (i, bounds)
+            })
+            .collect();
         Kinematics {
             n,
             steps,
@@ -481,7 +560,7 @@ impl Kinematics {
             a0: machine.tool.axis,
             r0: machine.tool.reference,
             fixed,
-            limits,
+            free_lin_bounds,
             free_rot,
             between,
             free_lin,
@@ -496,26 +575,46 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
+        self.chain::<false>(q).0
+    }
+
+    /// The forward kinematics, and with `LEVER` the largest distance from
+    /// the tool point to the point of a free rotary axis line (see
+    /// [`Kinematics::fk_lever`]).
+    #[inline(always)]
+    fn chain<const LEVER: bool>(&self, q: &[f64]) -> (Pose, f64) {
         let mut point = self.tip;
         let mut axis = self.tip_axis;
         let mut reference = self.tip_reference;
+        let mut lever2: f64 = 0.0;
+        // (A machine without a reference direction returns none: not
+        // turned.)
+        let with_reference = self.r0.is_some();
         for step in self.steps.iter().rev() {
             match step {
                 Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
                 Step::Rotary(t) => {
+                    if LEVER {
+                        // A turn about the line keeps the distance to its
+                        // point.
+                        lever2 = lever2.max((point - t.point).norm_squared());
+                    }
                     let (s, c) = sin_cos_deg(q[t.axis]);
                     let m = t.rotation(c, s);
                     point = t.move_point(&m, &point);
                     axis = m.apply(&axis);
-                    reference = m.apply(&reference);
+                    if with_reference {
+                        reference = m.apply(&reference);
+                    }
                 }
             }
         }
-        Pose {
+        let pose = Pose {
             point,
             axis,
             reference: self.r0.map(|_| reference),
-        }
+        };
+        (pose, if LEVER { lever2.sqrt() } else { 0.0 })
     }
 
     /// Inverse kinematics: every solution branch of `pose` and its 360°
@@ -781,7 +880,7 @@ impl Kinematics {
         out: &mut Vec<Solution>,
     ) {
         let mut joints = self.fixed;
-        let mut rots = [Rot::IDENTITY; 3];
+        let mut rots = [Turned::IDENTITY; 3];
         let mut ranges = [SlotRange::default(); 3];
         for k in 0..N {
             let (slot, a) = (&self.slots[k], &mut b.angles[k]);
@@ -789,16 +888,16 @@ impl Kinematics {
             joints[slot.axis] = ranges[k].raw;
             rots[k] = slot.turn.rotation(a.cos, a.sin);
         }
-        if let Some(joints) = self.solve_linear(&joints, &rots, point) {
+        if self.solve_linear(&mut joints, &rots, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
-    /// With every rotary angle set in `joints` (and their rotations in
-    /// `rots`), solves the free linear axes so that the tool point lands on
-    /// `target` (part frame).
-    fn solve_linear(&self, joints: &Joints, rots: &Rots, target: &V3) -> Option<Joints> {
-        let mut q = *joints;
+    /// With every rotary angle set in `q` (and their rotations in `rots`),
+    /// solves the free linear axes so that the tool point lands on `target`
+    /// (part frame), in place (no copies of the joints in and out); `false`
+    /// when they cannot.
+    fn solve_linear(&self, q: &mut Joints, rots: &Rots, target: &V3) -> bool {
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
@@ -823,7 +922,7 @@ impl Kinematics {
             for (k, &i) in self.free_lin.iter().enumerate() {
                 q[i] = rows[k].dot(&rhs);
             }
-            return self.free_lin.iter().all(|&i| q[i].is_finite()).then_some(q);
+            return self.free_lin.iter().all(|&i| q[i].is_finite());
         }
 
         // The tool point with the free linear axes at zero, and the column
@@ -854,7 +953,7 @@ impl Kinematics {
                 let c12 = c[1].cross(&c[2]);
                 let det = c[0].dot(&c12);
                 if det.abs() < 1e-12 {
-                    return None;
+                    return false;
                 }
                 [
                     rhs.dot(&c12) / det,
@@ -868,7 +967,9 @@ impl Kinematics {
                 // tells whether the point is reachable at all.
                 let j = nalgebra::DMatrix::from_fn(3, m, |r, k| c[k][r]);
                 let b = nalgebra::DVector::from_column_slice(rhs.as_slice());
-                let x = j.svd(true, true).solve(&b, 1e-12).ok()?;
+                let Ok(x) = j.svd(true, true).solve(&b, 1e-12) else {
+                    return false;
+                };
                 let mut out = [0.0; 3];
                 out[..m].copy_from_slice(x.as_slice());
                 out
@@ -880,12 +981,9 @@ impl Kinematics {
             moved += c[k] * values[k];
         }
         if m < 3 && (moved - rhs).norm() > 1e-9 * (1.0 + rhs.norm()) {
-            return None;
+            return false;
         }
-        if !values.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        Some(q)
+        values.iter().all(|v| v.is_finite())
     }
 
     /// Appends the solution `joints` with every 360° equivalent of its
@@ -915,11 +1013,13 @@ impl Kinematics {
         }
         // Linear axes: their values do not change between equivalents. A
         // branch outside the linear travel is given once.
+        // (`Axis::accepts` with the bounds worked out once; the solved
+        // values are finite, see `solve_linear`.)
         let violation = self
-            .free_lin
+            .free_lin_bounds
             .iter()
-            .find(|&&i| !accepts(self.limits[i], joints[i]))
-            .map(|&i| Violation {
+            .find(|&&(i, [lo, hi])| !(joints[i] >= lo && joints[i] <= hi))
+            .map(|&(i, _)| Violation {
                 axis: i,
                 value: joints[i],
             });
@@ -1140,13 +1240,6 @@ struct SlotRange {
 impl SlotRange {
     fn has_equivalent(&self) -> bool {
         self.first <= self.last
-    }
-}
-
-fn accepts(limits: Option<[f64; 2]>, v: f64) -> bool {
-    match limits {
-        None => v.is_finite(),
-        Some([lo, hi]) => v >= lo - 1e-9 && v <= hi + 1e-9,
     }
 }
 

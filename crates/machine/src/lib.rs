@@ -14,6 +14,7 @@
 //! ```
 
 pub mod angle;
+pub use angle::angle_between;
 pub mod builtin;
 mod file;
 mod kinematics;

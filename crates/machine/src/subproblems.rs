@@ -11,6 +11,14 @@ use nalgebra::{Matrix3, Vector3};
 /// taken as zero: the vector lies on the axis and the angle is free.
 pub const FREE_EPS: f64 = 1e-12;
 
+/// `Some((k, σ))` when `v` is exactly `σ·e_k` (σ = ±1): two components
+/// zero and the third ±1, as the axes of most machines are.
+pub(crate) fn coordinate_axis(v: &Vector3<f64>) -> Option<(usize, f64)> {
+    let zeros = v.iter().filter(|&&c| c == 0.0).count();
+    let k = v.iamax();
+    (zeros == 2 && v[k].abs() == 1.0).then_some((k, v[k]))
+}
+
 /// Rotation matrix about unit `w` by `theta` radians (Rodrigues' formula).
 #[inline]
 pub fn rotation(w: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
@@ -160,6 +168,28 @@ pub struct Sp2 {
     /// turns it), and whether that leaves nothing (`θ2` free).
     p_off_w2: Vector3<f64>,
     p_on_w2: bool,
+    /// Axes along coordinate axes (see [`Aligned`]).
+    aligned: Option<Aligned>,
+}
+
+/// `w1 = σ1·e_i`, `w2 = σ2·e_j` (i ≠ j), hence `w1 × w2 = σ3·e_k`: every
+/// dot and cross product of [`Sp2::solve_xy`] with them has one or two
+/// non-zero terms, worked out here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Aligned {
+    i: usize,
+    j: usize,
+    k: usize,
+    s1: f64,
+    s2: f64,
+    s3: f64,
+    /// The signs of the cross products' components i and j: `σ1` and `σ2`,
+    /// negated when `(i, j, k)` (resp. `(j, k, i)`) is not cyclic.
+    t1: f64,
+    t2: f64,
+    /// The components i and k of `p` off `w2` (its component j is zero).
+    po_i: f64,
+    po_k: f64,
 }
 
 impl Sp2 {
@@ -168,6 +198,25 @@ impl Sp2 {
         let cross = w1.cross(w2);
         let w2p = w2.dot(p);
         let p_off_w2 = p - w2 * w2p;
+        let aligned = match (coordinate_axis(w1), coordinate_axis(w2)) {
+            (Some((i, s1)), Some((j, s2))) if i != j => {
+                let k = 3 - i - j;
+                let cyclic = j == (i + 1) % 3;
+                Some(Aligned {
+                    i,
+                    j,
+                    k,
+                    s1,
+                    s2,
+                    s3: cross[k],
+                    t1: if cyclic { s1 } else { -s1 },
+                    t2: if cyclic { s2 } else { -s2 },
+                    po_i: p_off_w2[i],
+                    po_k: p_off_w2[k],
+                })
+            }
+            _ => None,
+        };
         Sp2 {
             w1: *w1,
             w2: *w2,
@@ -179,17 +228,21 @@ impl Sp2 {
             p2: p.norm_squared(),
             p_off_w2,
             p_on_w2: p_off_w2.norm_squared() < FREE_EPS * FREE_EPS,
+            aligned,
         }
     }
 
     /// The solutions for `q`, as [`sp2`] has them but before the `atan2`s.
-    #[inline]
+    #[inline(always)]
     pub fn solve_xy(&self, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
         let none = Sp2Xy {
             theta1: None,
             theta2: None,
         };
-        let (w1, w2, w12) = (&self.w1, &self.w2, self.w12);
+        if let Some(al) = &self.aligned {
+            return self.solve_aligned(al, q, slack);
+        }
+        let (w1, w12) = (&self.w1, self.w12);
         if self.cross2 < 1e-24 {
             return ([none; 2], 0);
         }
@@ -205,26 +258,81 @@ impl Sp2 {
         // projections that do not depend on the intersection point `z`.
         let q_off_w1 = q - w1 * w1q;
         let q_on_w1 = q_off_w1.norm_squared() < FREE_EPS * FREE_EPS;
+        if g == 0.0 {
+            ([self.at(a, b, 0.0, &q_off_w1, q_on_w1), none], 1)
+        } else {
+            (
+                [
+                    self.at(a, b, g, &q_off_w1, q_on_w1),
+                    self.at(a, b, -g, &q_off_w1, q_on_w1),
+                ],
+                2,
+            )
+        }
+    }
+
+    /// [`Sp2::solve_xy`] for axes along coordinate axes: the same
+    /// arithmetic without the products with a zero component of `w1`, `w2`
+    /// or `w1 × w2` (every sum left has one or two terms), hence the same
+    /// values up to the sign of a zero result. With `w1·w2 = 0` and
+    /// `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`, `g² = |p|² − a² − b²`
+    /// (Murray, Li, Sastry §3.3.2), `z = σ1·a·e_i + σ2·b·e_j + σ3·g·e_k`.
+    #[inline(always)]
+    fn solve_aligned(&self, al: &Aligned, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
+        let none = Sp2Xy {
+            theta1: None,
+            theta2: None,
+        };
+        let a = al.s1 * q[al.i];
+        let b = self.w2p;
+        let g2 = self.p2 - a * a - b * b;
+        if g2 < -slack {
+            return ([none; 2], 0);
+        }
+        let g = g2.max(0.0).sqrt();
+        // q off w1: q with its component i zero.
+        let (qj, qk) = (q[al.j], q[al.k]);
+        let q_on_w1 = qj * qj + qk * qk < FREE_EPS * FREE_EPS;
+        let (po_i, po_k) = (al.po_i, al.po_k);
+        let (zb, za) = (al.s2 * b, al.s1 * a);
         let solve = |g: f64| {
-            let z = w1 * a + w2 * b + self.cross * g;
-            let z_off_w1 = z - w1 * w1.dot(&z);
-            let z_off_w2 = z - w2 * w2.dot(&z);
-            let free = |v: &Vector3<f64>| v.norm_squared() < FREE_EPS * FREE_EPS;
+            // z off w1 is (zb, zg) at (j, k); z off w2 is (za, zg) at (i, k).
+            let zg = al.s3 * g;
+            let free1 = b * b + g * g < FREE_EPS * FREE_EPS;
+            let free2 = a * a + g * g < FREE_EPS * FREE_EPS;
             Sp2Xy {
-                theta1: (!(free(&z_off_w1) || q_on_w1))
-                    .then(|| (z_off_w1.dot(&q_off_w1), w1.dot(&z_off_w1.cross(&q_off_w1)))),
-                theta2: (!(self.p_on_w2 || free(&z_off_w2))).then(|| {
-                    (
-                        self.p_off_w2.dot(&z_off_w2),
-                        w2.dot(&self.p_off_w2.cross(&z_off_w2)),
-                    )
-                }),
+                // (z off w1 · q off w1, w1 · (z off w1 × q off w1))
+                theta1: (!(free1 || q_on_w1))
+                    .then_some((zb * qj + zg * qk, al.t1 * (zb * qk - zg * qj))),
+                // (p off w2 · z off w2, w2 · (p off w2 × z off w2))
+                theta2: (!(self.p_on_w2 || free2))
+                    .then_some((po_i * za + po_k * zg, al.t2 * (po_k * za - po_i * zg))),
             }
         };
         if g == 0.0 {
             ([solve(0.0), none], 1)
         } else {
             ([solve(g), solve(-g)], 2)
+        }
+    }
+
+    /// The angles for the intersection point `z = a·w1 + b·w2 + g·(w1 × w2)`.
+    #[inline(always)]
+    fn at(&self, a: f64, b: f64, g: f64, q_off_w1: &Vector3<f64>, q_on_w1: bool) -> Sp2Xy {
+        let (w1, w2) = (&self.w1, &self.w2);
+        let z = w1 * a + w2 * b + self.cross * g;
+        let z_off_w1 = z - w1 * w1.dot(&z);
+        let z_off_w2 = z - w2 * w2.dot(&z);
+        let free = |v: &Vector3<f64>| v.norm_squared() < FREE_EPS * FREE_EPS;
+        Sp2Xy {
+            theta1: (!(free(&z_off_w1) || q_on_w1))
+                .then(|| (z_off_w1.dot(q_off_w1), w1.dot(&z_off_w1.cross(q_off_w1)))),
+            theta2: (!(self.p_on_w2 || free(&z_off_w2))).then(|| {
+                (
+                    self.p_off_w2.dot(&z_off_w2),
+                    w2.dot(&self.p_off_w2.cross(&z_off_w2)),
+                )
+            }),
         }
     }
 }
@@ -303,6 +411,37 @@ mod tests {
             };
             let fast = Sp2::new(&w1, &w2, &p).solve_xy(&q, 1e-12);
             prop_assert_eq!(fast, sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
+        }
+
+        /// Axes along coordinate axes take the shortcut of
+        /// [`Sp2::solve_aligned`]: the same values as from scratch (`==`:
+        /// up to the sign of a zero), for reachable, unreachable and
+        /// singular targets.
+        #[test]
+        fn aligned_sp2_is_sp2(
+            i in 0usize..3, dj in 1usize..3, s1 in prop_oneof![Just(1.0), Just(-1.0)],
+            s2 in prop_oneof![Just(1.0), Just(-1.0)], p in unit(), q in unit(),
+            on_axis in 0usize..5, t1 in -3.1..3.1f64, t2 in -3.1..3.1f64,
+            quarter in 0usize..4,
+        ) {
+            let axis = |k: usize, s: f64| {
+                let mut v = Vector3::zeros();
+                v[k] = s;
+                v
+            };
+            let (w1, w2) = (axis(i, s1), axis((i + dj) % 3, s2));
+            let p = if on_axis == 1 { w2 } else { p };
+            // Exact quarter turns as well (zeros in the solution).
+            let right = std::f64::consts::FRAC_PI_2 * quarter as f64;
+            let q = match on_axis {
+                2 => w1,
+                3 => rotation(&w1, t1) * rotation(&w2, t2) * p,
+                4 => rotation(&w1, right) * rotation(&w2, -right) * axis(3 - i - (i + dj) % 3, 1.0),
+                _ => q,
+            };
+            let sp2 = Sp2::new(&w1, &w2, &p);
+            prop_assert!(sp2.aligned.is_some());
+            prop_assert_eq!(sp2.solve_xy(&q, 1e-12), sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
         }
 
         #[test]

@@ -25,7 +25,7 @@
 //! the motion `ρ ≤ (ρ(0) + 2V) / (1 − 3W)` (for `3W < 1`). The midpoint of
 //! the motion is within `max|p''| / 8` of the midpoint of the chord.
 
-use super::{Kinematics, Step};
+use super::Kinematics;
 use crate::model::Pose;
 
 /// Upper bound of the lever over a straight joint motion of rotary travel
@@ -54,30 +54,7 @@ impl Kinematics {
     /// largest distance from the tool point to the reference point of a free
     /// rotary axis (0 without one).
     pub fn fk_lever(&self, q: &[f64]) -> (Pose, f64) {
-        let mut point = self.tip;
-        let mut axis = self.tip_axis;
-        let mut reference = self.tip_reference;
-        let mut lever2: f64 = 0.0;
-        for step in self.steps.iter().rev() {
-            match step {
-                Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
-                Step::Rotary(t) => {
-                    // A turn about the line keeps the distance to its point.
-                    lever2 = lever2.max((point - t.point).norm_squared());
-                    let (s, c) = crate::angle::sin_cos_deg(q[t.axis]);
-                    let m = t.rotation(c, s);
-                    point = t.move_point(&m, &point);
-                    axis = m.apply(&axis);
-                    reference = m.apply(&reference);
-                }
-            }
-        }
-        let pose = Pose {
-            point,
-            axis,
-            reference: self.r0.map(|_| reference),
-        };
-        (pose, lever2.sqrt())
+        self.chain::<true>(q)
     }
 
     /// The travel of the straight joint motion from `a` to `b`: summed over

@@ -12,6 +12,7 @@
 use nalgebra::Vector3;
 
 use super::Kinematics;
+use crate::angle::atan2_rad;
 use crate::subproblems::{rotation, sp1_cs};
 
 /// The tool-axis direction at which one rotary angle becomes free.
@@ -24,11 +25,13 @@ pub struct Singularity {
 }
 
 impl Singularity {
-    /// Angle between `axis` (unit) and the nearer of ±direction, radians.
+    /// Angle between `axis` (unit) and the nearer of ±direction, radians
+    /// (`atan2` of the cross and the absolute dot product, within 2 ulp of
+    /// the library's).
     pub fn distance(&self, axis: &Vector3<f64>) -> f64 {
         let c = self.direction.dot(axis).abs();
         let s = self.direction.cross(axis).norm();
-        s.atan2(c)
+        atan2_rad(s, c)
     }
 }
 
