@@ -40,7 +40,7 @@ pub(crate) struct Node {
 
 /// One CL point as the planner hands it over.
 pub(crate) struct Target<'a> {
-    pub node: Node,
+    pub node: &'a Node,
     pub motion: Motion,
     pub line: usize,
     /// CL feed rate, mm/min.
@@ -176,7 +176,7 @@ impl<W: Write> Emitter<W> {
                 self.reconfigure(machine, kin, &last, t)?;
             } else if linearize
                 && let Some(bound) =
-                    chord_settles(kin, &last.node, &t.node, last.lever, &self.settings)
+                    chord_settles(kin, &last.node, t.node, last.lever, &self.settings)
             {
                 let p = &mut self.planning;
                 p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
@@ -184,7 +184,7 @@ impl<W: Write> Emitter<W> {
                 let (from, lever, from_line) = (last.node, last.lever, last.line);
                 self.inserted.clear();
                 let mut inserted = std::mem::take(&mut self.inserted);
-                let result = self.linearize(kin, &from, &t.node, lever, 0, &mut inserted);
+                let result = self.linearize(kin, &from, t.node, lever, 0, &mut inserted);
                 match result {
                     Ok(()) => {}
                     // A move that starts a segment may be a repositioning
@@ -208,7 +208,7 @@ impl<W: Write> Emitter<W> {
         self.block(
             machine,
             kin,
-            &t.node,
+            t.node,
             t.motion,
             Some(t.line),
             t.line,
@@ -300,7 +300,7 @@ impl<W: Write> Emitter<W> {
         last: &Last,
         t: &Target,
     ) -> Result<(), PostError> {
-        let (from, to) = (&last.node, &t.node);
+        let (from, to) = (&last.node, t.node);
         if !self.settings.reconfigure {
             return Err((t.at)(format!(
                 "no continuous motion reaches this point from CL line {} inside the travel ({}); \

@@ -341,7 +341,7 @@ impl PathPlan {
             machine,
             kin,
             &Target {
-                node: d.node,
+                node: &d.node,
                 motion: p.motion,
                 line: p.line,
                 feed: p.feed,

@@ -579,7 +579,9 @@ impl<W: Write> Job<'_, W> {
             reader.statement_diagnostic(Severity::Error, message).into()
         };
         let six_axis = pose.reference.is_some() && self.machine.unlocks_with_reference();
-        self.open(six_axis)?;
+        if self.setup.is_none() {
+            self.open(six_axis)?;
+        }
         let Some(s) = self.setup.as_mut() else {
             unreachable!("`open` sets the job up")
         };
