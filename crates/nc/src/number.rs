@@ -176,7 +176,9 @@ impl Formatter {
         // Below 2^51, adding 1.5 * 2^52 rounds `p` to an integer (to
         // nearest) that the low bits of the sum hold; NaN and larger values
         // take the slow path.
-        if p.abs() >= ROUND_LIMIT || p.is_nan() {
+        // One unordered comparison: NaN fails it too.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(p.abs() < ROUND_LIMIT) {
             return self.units_slow(value);
         }
         let sum = p + ROUND_MAGIC;
