@@ -7,7 +7,7 @@ use std::sync::Arc;
 use minijinja::{Environment, Value};
 
 use crate::dialect::{CommentSyntax, Dialect, DialectKind, Numbering, TemplateKind};
-use crate::number::{ENCODE_MAX, Formatter, write_u64};
+use crate::number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 use crate::template;
 use crate::{AxisSpec, Block, Motion, NcError, ProgramInfo};
 
@@ -43,9 +43,28 @@ struct Word {
     suffix_len: usize,
     fmt: Formatter,
     modal: bool,
+    /// The pressure word (a CSV column: empty while NaN).
+    pressure: bool,
+    /// The bits of the value [`NcWriter::quantize_axes`] last rounded for
+    /// this word's axis and its units (initially, and after a value that
+    /// cannot be written, those of 0.0: always right).
+    memo: (u64, i64),
     /// Last written value in units; meaningful when `known`.
     last: i64,
     known: bool,
+}
+
+impl Word {
+    /// The units of `v`, remembered by [`NcWriter::quantize_axes`] or
+    /// worked out.
+    #[inline(always)]
+    fn units(&self, v: f64) -> Result<i64, crate::NumberError> {
+        if self.memo.0 == v.to_bits() {
+            Ok(self.memo.1)
+        } else {
+            self.fmt.units(v)
+        }
+    }
 }
 
 fn padded<const N: usize>(s: &str) -> ([u8; N], usize) {
@@ -70,6 +89,8 @@ impl Word {
             suffix_len,
             fmt: wf.number.formatter(),
             modal,
+            pressure: false,
+            memo: (0, 0),
             last: 0,
             known: false,
         }
@@ -79,6 +100,68 @@ impl Word {
 /// Room for one word in the line buffer: fixed-size copies of lead, number
 /// and suffix.
 const WORD_ROOM: usize = MAX_LEAD + ENCODE_MAX + MAX_SUFFIX;
+
+/// Longest text copied with one fixed-size move by [`put_text`].
+const SHORT_TEXT: usize = 16;
+
+/// A fixed piece of a block (motion word, separator, line end): padded for
+/// a fixed-size copy when it is short.
+struct Text {
+    padded: [u8; SHORT_TEXT],
+    full: Box<[u8]>,
+}
+
+impl Text {
+    fn new(s: &str) -> Text {
+        let (padded, _) = padded(s);
+        Text {
+            padded,
+            full: s.as_bytes().into(),
+        }
+    }
+
+    fn is_empty(&self) -> bool {
+        self.full.is_empty()
+    }
+}
+
+impl std::ops::Deref for Text {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        &self.full
+    }
+}
+
+/// Writes `t` at `at` (and up to [`SHORT_TEXT`] bytes past its end when it
+/// is short); returns where it ends.
+#[inline(always)]
+fn put_text(buf: &mut [u8], at: usize, t: &Text) -> usize {
+    let len = t.full.len();
+    if len <= SHORT_TEXT {
+        buf[at..at + SHORT_TEXT].copy_from_slice(&t.padded);
+    } else {
+        buf[at..at + len].copy_from_slice(&t.full);
+    }
+    at + len
+}
+
+/// One word at `at`: lead (or prefix alone), number, suffix; returns where
+/// it ends. Uses (overwrites) [`WORD_ROOM`] bytes from `at`.
+#[inline(always)]
+fn put_word(buf: &mut [u8], at: usize, w: &Word, n: i64, first: bool) -> usize {
+    let Some(room) = buf[at..].first_chunk_mut::<WORD_ROOM>() else {
+        unreachable!("the line buffer has room for every word")
+    };
+    let (lead, lead_len) = if first {
+        (&w.first, w.first_len)
+    } else {
+        (&w.lead, w.lead_len)
+    };
+    room[..MAX_LEAD].copy_from_slice(lead);
+    let end = w.fmt.encode_into(n, room, lead_len.min(MAX_LEAD));
+    room[end..end + MAX_SUFFIX].copy_from_slice(&w.suffix);
+    at + end + w.suffix_len
+}
 
 /// The line being formatted: a buffer with room for the longest block, so
 /// that words are written with fixed-size copies.
@@ -102,24 +185,10 @@ impl Line {
         self.len = end;
     }
 
-    #[inline]
-    fn put_padded<const N: usize>(&mut self, s: &[u8; N], len: usize) {
-        self.bytes[self.len..self.len + N].copy_from_slice(s);
-        self.len += len;
-    }
-
     /// One word: lead (or prefix alone), number, suffix.
     #[inline(always)]
     fn put_word(&mut self, w: &Word, n: i64, first: bool) {
-        if first {
-            self.put_padded(&w.first, w.first_len);
-        } else {
-            self.put_padded(&w.lead, w.lead_len);
-        }
-        self.len = w.fmt.encode_into(n, &mut self.bytes, self.len);
-        if w.suffix_len > 0 {
-            self.put_padded(&w.suffix, w.suffix_len);
-        }
+        self.len = put_word(&mut self.bytes, self.len, w, n, first);
     }
 
     fn as_slice(&self) -> &[u8] {
@@ -145,12 +214,14 @@ pub struct NcWriter<W: Write> {
     axis_specs: Vec<AxisSpec>,
     /// Number format per machine axis (machine order).
     formats: Vec<Formatter>,
-    /// Per machine axis, the bits of the value [`NcWriter::quantize_axes`]
-    /// last rounded and its units: the block that follows does not round
-    /// them again.
-    memo: Vec<Option<(u64, i64)>>,
+    /// Machine axes that no word writes (locked axes a dialect leaves
+    /// out, the pressure word of an NC dialect).
+    unworded: Vec<usize>,
     /// Words written in a block, in output order.
     words: Vec<Word>,
+    /// An NC dialect with an axis word that is not modal: every block is
+    /// written, and [`NcWriter::plain_block`] writes it in one pass.
+    plain: bool,
     /// The pressure word of an NC dialect, written on its own line (see
     /// [`AxisSpec::pressure`]).
     pressure: Option<PressureWord>,
@@ -158,14 +229,17 @@ pub struct NcWriter<W: Write> {
     /// Whether the dialect's feed word is modal (feed per minute).
     feed_modal: bool,
     last_feed: Option<i64>,
-    feed_rapid: Box<[u8]>,
-    motion_rapid: Box<[u8]>,
-    motion_feed: Box<[u8]>,
+    /// The bits of the last feed value worked out and its units (initially
+    /// those of 0.0): a feed that does not change is not rounded again.
+    feed_memo: (u64, i64),
+    feed_rapid: Text,
+    motion_rapid: Text,
+    motion_feed: Text,
     motion_modal: bool,
     motion_state: Option<Motion>,
-    after_axes: Box<[u8]>,
-    sep: Box<[u8]>,
-    eol: Box<[u8]>,
+    after_axes: Text,
+    sep: Text,
+    eol: Text,
     numbering: Numbering,
     next_number: u64,
     comment: CommentSyntax,
@@ -182,10 +256,6 @@ struct PressureWord {
     word: Word,
     name: String,
     writable: bool,
-}
-
-fn bytes(s: &str) -> Box<[u8]> {
-    s.as_bytes().into()
 }
 
 impl<W: Write> NcWriter<W> {
@@ -231,9 +301,14 @@ impl<W: Write> NcWriter<W> {
             .filter(|&i| !words_kind || dialect.block.write_fixed || !axes[i].fixed)
             .map(|i| {
                 let wf = dialect.word_format(&axes[i]);
-                Word::new(i, sep, &wf, wf.modal && words_kind)
+                Word {
+                    pressure: axes[i].pressure,
+                    ..Word::new(i, sep, &wf, wf.modal && words_kind)
+                }
             })
             .collect::<Vec<_>>();
+        // Some axis word is written in every block: no block is skipped.
+        let plain = words_kind && words.iter().any(|w| !w.modal);
         let feed = Word::new(
             usize::MAX,
             sep,
@@ -261,21 +336,25 @@ impl<W: Write> NcWriter<W> {
             units: vec![0; words.len()],
             names: axes.iter().map(|a| a.name.clone()).collect(),
             axis_specs: axes.to_vec(),
-            memo: vec![None; formats.len()],
+            unworded: (0..axes.len())
+                .filter(|i| !words.iter().any(|w| w.index == *i))
+                .collect(),
             formats,
             words,
+            plain,
             pressure,
             feed_modal: feed.modal,
             feed,
             last_feed: None,
-            feed_rapid: bytes(&dialect.feed.rapid),
-            motion_rapid: bytes(&m.rapid),
-            motion_feed: bytes(&m.feed),
+            feed_memo: (0, 0),
+            feed_rapid: Text::new(&dialect.feed.rapid),
+            motion_rapid: Text::new(&m.rapid),
+            motion_feed: Text::new(&m.feed),
             motion_modal: m.modal,
             motion_state: m.initial,
-            after_axes: bytes(&dialect.block.after_axes),
-            sep: bytes(sep),
-            eol: bytes(&dialect.block.line_end),
+            after_axes: Text::new(&dialect.block.after_axes),
+            sep: Text::new(sep),
+            eol: Text::new(&dialect.block.line_end),
             numbering: dialect.numbering.clone(),
             next_number: dialect.numbering.start,
             comment: dialect.comment.clone(),
@@ -301,28 +380,28 @@ impl<W: Write> NcWriter<W> {
     /// copied unchanged (the block fails on it).
     #[inline]
     pub fn quantize_axes(&mut self, axes: &[f64], written: &mut [f64]) {
-        for (i, (&v, w)) in axes.iter().zip(written.iter_mut()).enumerate() {
-            let f = &self.formats[i];
-            match f.units(v) {
-                Ok(n) => {
-                    self.memo[i] = Some((v.to_bits(), n));
-                    *w = f.value_of_units(n);
-                }
-                Err(_) => {
-                    self.memo[i] = None;
-                    *w = v;
-                }
+        let n = axes.len().min(written.len());
+        let (axes, written) = (&axes[..n], &mut written[..n]);
+        // Each word remembers the units of its axis.
+        for w in &mut self.words {
+            if w.index < n {
+                let v = axes[w.index];
+                written[w.index] = match w.fmt.units(v) {
+                    Ok(u) => {
+                        w.memo = (v.to_bits(), u);
+                        w.fmt.value_of_units(u)
+                    }
+                    Err(_) => {
+                        w.memo = (0, 0);
+                        v
+                    }
+                };
             }
         }
-    }
-
-    /// The units of `v` for machine axis `index`, remembered by
-    /// [`NcWriter::quantize_axes`] or worked out.
-    #[inline(always)]
-    fn units_of(&self, index: usize, v: f64) -> Result<i64, crate::NumberError> {
-        match self.memo[index] {
-            Some((bits, n)) if bits == v.to_bits() => Ok(n),
-            _ => self.formats[index].units(v),
+        for &i in &self.unworded {
+            if i < n {
+                written[i] = self.formats[i].quantize(axes[i]);
+            }
         }
     }
 
@@ -595,11 +674,14 @@ impl<W: Write> NcWriter<W> {
         {
             self.pressure_line(block.axes)?;
         }
+        if self.plain {
+            return self.plain_block(block);
+        }
         // Pass 1: quantize, decide what is written.
         let mut any = false;
         for (k, w) in self.words.iter().enumerate() {
             let v = block.axes[w.index];
-            let n = match self.units_of(w.index, v) {
+            let n = match w.units(v) {
                 Ok(n) => n,
                 Err(e) => return Err(self.bad_value(w.index, v, e)),
             };
@@ -616,7 +698,7 @@ impl<W: Write> NcWriter<W> {
         if block.motion == Motion::Feed
             && let Some(f) = block.feed
         {
-            let n = match self.feed.fmt.units(f) {
+            let n = match self.feed_units(f) {
                 Ok(n) => n,
                 Err(e) => return Err(self.bad_value(usize::MAX, f, e)),
             };
@@ -682,6 +764,103 @@ impl<W: Write> NcWriter<W> {
         line.put(&self.eol);
         self.blocks += 1;
         self.out.write_all(line.as_slice())
+    }
+
+    /// [`NcWriter::block`] (after the pressure line) for a dialect in which
+    /// every block is written: words are formatted as their values are
+    /// looked up. Nothing changes (the block number included) when a value
+    /// cannot be written.
+    #[inline(always)]
+    fn plain_block(&mut self, block: &Block) -> io::Result<()> {
+        let write_motion = !self.motion_word(block.motion).is_empty()
+            && (!self.motion_modal || self.motion_state != Some(block.motion));
+        let number_before = self.next_number;
+        let mut len = 0;
+        if self.numbering.enabled {
+            let mut number = std::mem::take(&mut self.buf);
+            number.clear();
+            self.number_into(&mut number);
+            self.line.len = 0;
+            self.line.put(&number);
+            len = self.line.len;
+            self.buf = number;
+        }
+        let buf = &mut self.line.bytes[..];
+        let mut first = true;
+        if write_motion {
+            len = put_text(
+                buf,
+                len,
+                match block.motion {
+                    Motion::Rapid => &self.motion_rapid,
+                    Motion::Feed => &self.motion_feed,
+                },
+            );
+            first = false;
+        }
+        for w in &self.words {
+            let v = block.axes[w.index];
+            let n = match w.units(v) {
+                Ok(n) => n,
+                Err(e) => {
+                    self.next_number = number_before;
+                    return Err(self.bad_value(w.index, v, e));
+                }
+            };
+            len = put_word(buf, len, w, n, first);
+            first = false;
+        }
+        let mut feed_units = None;
+        if block.motion == Motion::Feed
+            && let Some(f) = block.feed
+        {
+            let n = match self.feed_units(f) {
+                Ok(n) => n,
+                Err(e) => {
+                    self.next_number = number_before;
+                    return Err(self.bad_value(usize::MAX, f, e));
+                }
+            };
+            if !(self.feed.modal && self.last_feed == Some(n)) {
+                feed_units = Some(n);
+            }
+        }
+        let buf = &mut self.line.bytes[..];
+        if !self.after_axes.is_empty() {
+            len = put_text(buf, len, &self.sep);
+            len = put_text(buf, len, &self.after_axes);
+        }
+        if let Some(n) = feed_units {
+            len = put_word(buf, len, &self.feed, n, false);
+            self.last_feed = Some(n);
+        }
+        if block.motion == Motion::Rapid && !self.feed_rapid.is_empty() {
+            len = put_text(buf, len, &self.sep);
+            len = put_text(buf, len, &self.feed_rapid);
+        }
+        len = put_text(buf, len, &self.eol);
+        self.line.len = len;
+        self.motion_state = Some(block.motion);
+        self.blocks += 1;
+        self.out.write_all(self.line.as_slice())
+    }
+
+    /// The units of feed value `f`, remembered while it does not change.
+    #[inline(always)]
+    fn feed_units(&mut self, f: f64) -> Result<i64, crate::NumberError> {
+        if self.feed_memo.0 == f.to_bits() {
+            return Ok(self.feed_memo.1);
+        }
+        let n = self.feed.fmt.units(f)?;
+        self.feed_memo = (f.to_bits(), n);
+        Ok(n)
+    }
+
+    fn motion_word(&self, motion: Motion) -> &[u8] {
+        match motion {
+            Motion::Rapid => &self.motion_rapid,
+            Motion::Feed => &self.motion_feed,
+        }
     }
 
     /// The pressure word on its own line, when the block's pressure differs
@@ -762,49 +941,45 @@ impl<W: Write> NcWriter<W> {
         if !self.csv_header_done {
             self.csv_header()?;
         }
-        let mut line = std::mem::replace(&mut self.line, Line::new(0));
-        line.len = 0;
+        let buf = &mut self.line.bytes[..];
+        let mut len = 0;
         if let Some(l) = block.cl_line {
-            self.buf.clear();
-            write_u64(&mut self.buf, l as u64, 1);
-            line.put(&self.buf);
+            len = encode_u64(buf, len, l as u64);
         }
-        line.put(&self.sep);
-        line.put(block.motion.as_str().as_bytes());
+        len = put_text(buf, len, &self.sep);
+        let motion: &[u8; 8] = match block.motion {
+            Motion::Rapid => b"rapid\0\0\0",
+            Motion::Feed => b"feed\0\0\0\0",
+        };
+        buf[len..len + 8].copy_from_slice(motion);
+        len += block.motion.as_str().len();
         for w in &self.words {
             let v = block.axes[w.index];
-            if v.is_nan() && self.axis_specs[w.index].pressure {
+            if w.pressure && v.is_nan() {
                 // No pressure programmed: an empty field.
-                line.put(&self.sep);
+                len = put_text(buf, len, &self.sep);
                 continue;
             }
-            let n = match self.units_of(w.index, v) {
+            let n = match w.units(v) {
                 Ok(n) => n,
-                Err(e) => {
-                    self.line = line;
-                    return Err(self.bad_value(w.index, v, e));
-                }
+                Err(e) => return Err(self.bad_value(w.index, v, e)),
             };
-            line.put_word(w, n, false);
+            len = put_word(buf, len, w, n, false);
         }
-        line.put(&self.sep);
+        len = put_text(&mut self.line.bytes, len, &self.sep);
         if block.motion == Motion::Feed
             && let Some(f) = block.feed
         {
-            let n = match self.feed.fmt.units(f) {
+            let n = match self.feed_units(f) {
                 Ok(n) => n,
-                Err(e) => {
-                    self.line = line;
-                    return Err(self.bad_value(usize::MAX, f, e));
-                }
+                Err(e) => return Err(self.bad_value(usize::MAX, f, e)),
             };
-            line.put_word(&self.feed, n, true);
+            len = put_word(&mut self.line.bytes, len, &self.feed, n, true);
         }
-        line.put(&self.eol);
+        len = put_text(&mut self.line.bytes, len, &self.eol);
+        self.line.len = len;
         self.blocks += 1;
-        let result = self.out.write_all(line.as_slice());
-        self.line = line;
-        result
+        self.out.write_all(self.line.as_slice())
     }
 
     /// Flushes and returns the output.
