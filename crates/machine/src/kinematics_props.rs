@@ -287,7 +287,17 @@ proptest! {
             kin.ik_all_branches(&pose, Some(&q), &mut fast)
                 .map_err(|e| TestCaseError::fail(format!("{e} at {q:?}\n{m:?}")))?;
             for s in &fast {
-                prop_assert!(same_pose(&pose, &reference_fk(&m, &s.joints[..n]), three), "{s:?}\n{m:?}");
+                // Double precision reaches the pose relative to the values
+                // involved: a branch whose linear axes lie near a direction
+                // they lose (random chains have such poses, and no travel
+                // limits) solves to values of 1e8 mm, exact to their size.
+                let size: f64 = m.axes.iter().enumerate().filter(|(_, a)| !a.is_rotary()).map(|(i, _)| s.joints[i].abs()).sum();
+                let mut got = reference_fk(&m, &s.joints[..n]);
+                if size > 1e6 {
+                    prop_assert!((got.point - pose.point).norm() <= 1e-9 * size, "{s:?}\n{m:?}");
+                    got.point = pose.point;
+                }
+                prop_assert!(same_pose(&pose, &got, three), "{s:?}\n{m:?}");
             }
             // `q` is among them: its angles (the linear values follow from
             // the pose, which every solution reaches; compared directly they
