@@ -713,16 +713,7 @@ impl<W: Write> NcWriter<W> {
         }
 
         // Pass 2: format.
-        if self.numbering.enabled {
-            let mut number = std::mem::take(&mut self.buf);
-            number.clear();
-            self.number_into(&mut number);
-            self.line.len = 0;
-            self.line.put(&number);
-            self.buf = number;
-        } else {
-            self.line.len = 0;
-        }
+        self.start_line();
         let line = &mut self.line;
         let mut first = true;
         if write_motion {
@@ -766,6 +757,21 @@ impl<W: Write> NcWriter<W> {
         self.out.write_all(line.as_slice())
     }
 
+    /// Starts the motion block line: empty, or the block number when
+    /// numbering is on. Returns its length.
+    #[inline(always)]
+    fn start_line(&mut self) -> usize {
+        self.line.len = 0;
+        if self.numbering.enabled {
+            let mut number = std::mem::take(&mut self.buf);
+            number.clear();
+            self.number_into(&mut number);
+            self.line.put(&number);
+            self.buf = number;
+        }
+        self.line.len
+    }
+
     /// [`NcWriter::block`] (after the pressure line) for a dialect in which
     /// every block is written: words are formatted as their values are
     /// looked up. Nothing changes (the block number included) when a value
@@ -775,16 +781,7 @@ impl<W: Write> NcWriter<W> {
         let write_motion = !self.motion_word(block.motion).is_empty()
             && (!self.motion_modal || self.motion_state != Some(block.motion));
         let number_before = self.next_number;
-        let mut len = 0;
-        if self.numbering.enabled {
-            let mut number = std::mem::take(&mut self.buf);
-            number.clear();
-            self.number_into(&mut number);
-            self.line.len = 0;
-            self.line.put(&number);
-            len = self.line.len;
-            self.buf = number;
-        }
+        let mut len = self.start_line();
         let buf = &mut self.line.bytes[..];
         let mut first = true;
         if write_motion {
