@@ -23,6 +23,57 @@ const STEP_FLOOR_DEG: f64 = 1.0;
 /// No rotary axis turns by half a turn or more between two points of a cut.
 const STEP_CEILING_DEG: f64 = 179.0;
 
+/// Most rotary axes the planner's fast path handles (others go through
+/// [`Costs::transition`]).
+pub(crate) const MAX_ROTARY: usize = 3;
+
+/// Cost of a branch switch inside a cut, for the planner's fast path.
+pub(crate) const CUT_BRANCH_SWITCH: f64 = BRANCH_SWITCH;
+
+/// What [`Costs::transition`] allows the rotary axes on a cut, for the
+/// planner's fast path (see [`Costs::cut_rule`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CutRule {
+    /// Indices of the rotary axes (the first `n`).
+    pub axes: [usize; MAX_ROTARY],
+    pub n: usize,
+    /// Which one is the singular axis.
+    singular: [bool; MAX_ROTARY],
+    step_rate: f64,
+}
+
+/// Per-axis step limits of one cut link (see [`CutRule::limits`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CutLimits {
+    /// On the same branch.
+    pub same: [f64; MAX_ROTARY],
+    /// Switching branch.
+    pub switch: [f64; MAX_ROTARY],
+}
+
+impl CutRule {
+    /// The limits of a [`Link::Cut`]: exactly those [`Costs::transition`]
+    /// compares the steps with.
+    #[inline]
+    pub fn limits(&self, turn_deg: f64, across_singular: bool) -> CutLimits {
+        let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
+        let switching = if across_singular {
+            bound
+        } else {
+            STEP_FLOOR_DEG
+        };
+        let mut same = [bound; MAX_ROTARY];
+        let mut switch = [switching; MAX_ROTARY];
+        for k in 0..MAX_ROTARY {
+            if self.singular[k] && across_singular {
+                same[k] = 180.0 + 1e-9;
+                switch[k] = 180.0 + 1e-9;
+            }
+        }
+        CutLimits { same, switch }
+    }
+}
+
 /// How two consecutive points are connected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Link {
@@ -58,6 +109,8 @@ struct Limited {
 #[derive(Debug, Clone)]
 pub struct Costs {
     rotary: Vec<Rotary>,
+    /// The rotary axes with a preference (in the order of `rotary`).
+    preferring: Vec<Rotary>,
     limited: Vec<Limited>,
     /// Largest rotary step per degree of tool-axis turn on a continuous
     /// path outside the singular cone: 1 / sin(cone).
@@ -71,13 +124,18 @@ impl Costs {
     /// direction, if the machine has one.
     pub fn new(machine: &Machine, cone_deg: f64, singular_axis: Option<usize>) -> Costs {
         let free = |i: &usize| machine.axes[*i].is_free();
-        let rotary = machine
+        let rotary: Vec<Rotary> = machine
             .free_rotary_axes()
             .map(|i| Rotary {
                 index: i,
                 wrap: machine.axes[i].wrap,
                 prefer: machine.axes[i].prefer,
             })
+            .collect();
+        let preferring = rotary
+            .iter()
+            .filter(|r| r.prefer.is_some())
+            .cloned()
             .collect();
         let limited = (0..machine.axes.len())
             .filter(free)
@@ -104,6 +162,7 @@ impl Costs {
         let step_rate = 1.0 / cone_deg.max(0.1).to_radians().sin();
         Costs {
             rotary,
+            preferring,
             limited,
             step_rate,
             singular_axis,
@@ -121,7 +180,9 @@ impl Costs {
                 cost += NEAR_LIMIT * x * x;
             }
         }
-        for r in &self.rotary {
+        // Axes without a preference would add PREFERENCE · 0 = +0, which
+        // leaves the (non-negative or NaN) sum as it is: they are left out.
+        for r in &self.preferring {
             let v = q[r.index];
             cost += PREFERENCE
                 * match r.prefer {
@@ -132,6 +193,28 @@ impl Costs {
                 };
         }
         cost
+    }
+
+    /// The rotary axes [`Costs::transition`] adds the steps of, in its
+    /// order, and what a cut allows them, when there are 1 to
+    /// [`MAX_ROTARY`] of them (else `None`).
+    pub(crate) fn cut_rule(&self) -> Option<CutRule> {
+        let n = self.rotary.len();
+        if n == 0 || n > MAX_ROTARY {
+            return None;
+        }
+        let mut axes = [0; MAX_ROTARY];
+        let mut singular = [false; MAX_ROTARY];
+        for (k, r) in self.rotary.iter().enumerate() {
+            axes[k] = r.index;
+            singular[k] = self.singular_axis == Some(r.index);
+        }
+        Some(CutRule {
+            axes,
+            n,
+            singular,
+            step_rate: self.step_rate,
+        })
     }
 
     /// Cost of moving from `a` (branch `ba`) to `b` (branch `bb`) and whether
@@ -261,5 +344,66 @@ mod tests {
         let (near, _) = costs.transition(&from, 0, &joints(0.0, 710.0), 0, Link::Free);
         let (principal, _) = costs.transition(&from, 0, &joints(0.0, -10.0), 0, Link::Free);
         assert!(principal < near);
+    }
+
+    #[test]
+    fn unary_leaves_out_only_what_adds_nothing() {
+        // The sum over every rotary axis, as before axes without a
+        // preference were left out: the same bits.
+        let reference = |c: &Costs, q: &Joints| {
+            let mut cost = 0.0;
+            for l in &c.limited {
+                let d = (q[l.index] - l.lo).min(l.hi - q[l.index]);
+                if d < l.margin {
+                    let x = (l.margin - d.max(0.0)) / l.margin;
+                    cost += NEAR_LIMIT * x * x;
+                }
+            }
+            for r in &c.rotary {
+                let v = q[r.index];
+                cost += PREFERENCE
+                    * match r.prefer {
+                        None => 0.0,
+                        Some(Prefer::Zero) => v.abs(),
+                        Some(Prefer::Positive) => (-v).max(0.0),
+                        Some(Prefer::Negative) => v.max(0.0),
+                    };
+            }
+            cost
+        };
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let prefs = [
+            None,
+            Some(Prefer::Zero),
+            Some(Prefer::Positive),
+            Some(Prefer::Negative),
+        ];
+        for name in ["trunnion-ac", "mts1600", "head-head-bc", "table-head-bc"] {
+            for round in 0..64 {
+                let mut m = builtin::load(name).unwrap().unwrap();
+                for a in m.axes.iter_mut().filter(|a| a.is_rotary()) {
+                    a.prefer = prefs[(next() % 4) as usize];
+                }
+                let costs = Costs::new(&m, 0.5, None);
+                for _ in 0..64 {
+                    let mut q = [0.0; MAX_AXES];
+                    for v in &mut q {
+                        *v = match next() % 4 {
+                            0 => (next() % 9) as f64 * 45.0 - 180.0,
+                            1 => -0.0,
+                            _ => (next() % 2_000_000) as f64 * 1e-3 - 1000.0,
+                        };
+                    }
+                    let (a, b) = (costs.unary(&q), reference(&costs, &q));
+                    assert_eq!(a.to_bits(), b.to_bits(), "{name} {round} {q:?}");
+                }
+            }
+        }
     }
 }

@@ -7,24 +7,32 @@
 
 use kinpost_machine::{Joints, Solution};
 
-use crate::cost::{Costs, Link};
+use crate::cost::{CUT_BRANCH_SWITCH, Costs, CutLimits, CutRule, Link, MAX_ROTARY};
 
 /// Cost added to a move that is not continuous, so that a retract and
 /// reconfiguration is only chosen where no continuous sequence exists.
 pub const RECONFIGURE: f64 = 1e9;
 
-/// One candidate configuration of one point.
+/// One candidate configuration of one point and how it is reached.
 #[derive(Debug, Clone, Copy)]
 struct Node {
     joints: Joints,
-    branch: u8,
-    /// Cheapest cost of a sequence ending here.
-    cost: f64,
-    /// Index in `nodes` of the predecessor on that sequence (`u32::MAX`:
-    /// the anchor).
+    /// Index in `nodes` of the predecessor on the cheapest sequence ending
+    /// here (`u32::MAX`: the anchor).
     back: u32,
+    branch: u8,
     /// Whether the move from that predecessor is continuous.
     continuous: bool,
+}
+
+/// A node of the last layer, as the next push reads it: only the rotary
+/// values that the cost of a cut looks at, the branch and the cost.
+#[derive(Debug, Clone, Copy)]
+struct Tip {
+    rotary: [f64; MAX_ROTARY],
+    /// Cheapest cost of a sequence ending here.
+    cost: f64,
+    branch: u8,
 }
 
 /// A decided point: the configuration chosen and how it is reached.
@@ -42,9 +50,18 @@ pub struct Choice {
 pub struct Trellis {
     costs: Costs,
     lag: usize,
+    /// The rotary axes of a cut, when the fast path handles them (else every
+    /// pair goes through [`Costs::transition`]).
+    rule: Option<CutRule>,
     nodes: Vec<Node>,
     /// Index in `nodes` of the first node of each layer.
     layers: Vec<u32>,
+    /// The nodes of the last layer, in order, as the next push reads them.
+    tips: Vec<Tip>,
+    /// The layer being pushed (swapped with `tips` once it has a node).
+    next: Vec<Tip>,
+    /// Index in `tips` of the first of the cheapest (by `total_cmp`).
+    cheapest: usize,
     /// The configuration before the first layer (the last decided point),
     /// if any.
     anchor: Option<(Joints, u8)>,
@@ -55,10 +72,14 @@ impl Trellis {
     /// decision (1: decide point by point).
     pub fn new(costs: Costs, lag: usize) -> Trellis {
         Trellis {
+            rule: costs.cut_rule(),
             costs,
             lag: lag.max(1),
             nodes: Vec::new(),
             layers: Vec::new(),
+            tips: Vec::new(),
+            next: Vec::new(),
+            cheapest: 0,
             anchor: None,
         }
     }
@@ -90,10 +111,7 @@ impl Trellis {
     /// anchor.
     pub fn best_last(&self) -> Option<&Joints> {
         match self.layers.last() {
-            Some(&first) => self.nodes[first as usize..]
-                .iter()
-                .min_by(|a, b| a.cost.total_cmp(&b.cost))
-                .map(|n| &n.joints),
+            Some(&first) => Some(&self.nodes[first as usize + self.cheapest].joints),
             None => self.anchor(),
         }
     }
@@ -103,21 +121,65 @@ impl Trellis {
     /// program starts from home (all zero), as a free move. Returns `false`
     /// (and adds nothing) when no candidate is valid.
     pub fn push(&mut self, candidates: &[Solution], link: Link) -> bool {
-        if !candidates.iter().any(Solution::is_valid) {
+        let first = self.nodes.len();
+        let previous = self.layers.last().map(|&s| s as usize);
+        self.next.clear();
+        match (previous, link, &self.rule) {
+            (
+                Some(p),
+                Link::Cut {
+                    turn_deg,
+                    across_singular,
+                },
+                Some(rule),
+            ) => {
+                let limits = rule.limits(turn_deg, across_singular);
+                let layer = Layer {
+                    costs: &self.costs,
+                    tips: &self.tips,
+                    previous: p,
+                    nodes: &mut self.nodes,
+                    next: &mut self.next,
+                };
+                match rule.n {
+                    1 => layer.cut::<1>(candidates, &rule.axes, &limits),
+                    2 => layer.cut::<2>(candidates, &rule.axes, &limits),
+                    _ => layer.cut::<3>(candidates, &rule.axes, &limits),
+                }
+            }
+            _ => self.push_general(candidates, previous, link),
+        }
+        if self.next.is_empty() {
             return false;
         }
-        let first = self.nodes.len() as u32;
-        let previous = self.layers.last().map(|&s| s as usize..first as usize);
+        let mut cheapest = 0;
+        for (k, t) in self.next.iter().enumerate().skip(1) {
+            if t.cost.total_cmp(&self.next[cheapest].cost).is_lt() {
+                cheapest = k;
+            }
+        }
+        self.cheapest = cheapest;
+        std::mem::swap(&mut self.tips, &mut self.next);
+        self.layers.push(first as u32);
+        true
+    }
+
+    /// Any other push, through [`Costs::transition`].
+    fn push_general(&mut self, candidates: &[Solution], previous: Option<usize>, link: Link) {
         for s in candidates.iter().filter(|s| s.is_valid()) {
             let unary = self.costs.unary(&s.joints);
             let mut best = (f64::INFINITY, u32::MAX, true);
-            match &previous {
-                Some(range) => {
-                    for k in range.clone() {
-                        let p = &self.nodes[k];
-                        let (c, continuous) = self
-                            .costs
-                            .transition(&p.joints, p.branch, &s.joints, s.branch, link);
+            match previous {
+                Some(first) => {
+                    for (k, p) in self.tips.iter().enumerate() {
+                        let k = first + k;
+                        let (c, continuous) = self.costs.transition(
+                            &self.nodes[k].joints,
+                            p.branch,
+                            &s.joints,
+                            s.branch,
+                            link,
+                        );
                         let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
                         // Strictly less: ties keep the earlier candidate.
                         if total < best.0 {
@@ -140,16 +202,24 @@ impl Trellis {
                     );
                 }
             }
+            let mut rotary = [0.0; MAX_ROTARY];
+            if let Some(rule) = &self.rule {
+                for (v, &i) in rotary.iter_mut().zip(&rule.axes[..rule.n]) {
+                    *v = s.joints[i];
+                }
+            }
+            self.next.push(Tip {
+                rotary,
+                cost: best.0 + unary,
+                branch: s.branch,
+            });
             self.nodes.push(Node {
                 joints: s.joints,
-                branch: s.branch,
-                cost: best.0 + unary,
                 back: best.1,
+                branch: s.branch,
                 continuous: best.2,
             });
         }
-        self.layers.push(first);
-        true
     }
 
     /// Decides every waiting point: the cheapest sequence, in path order,
@@ -158,12 +228,13 @@ impl Trellis {
         let Some(&last) = self.layers.last() else {
             return;
         };
-        let mut best = last as usize;
-        for k in last as usize..self.nodes.len() {
-            if self.nodes[k].cost < self.nodes[best].cost {
+        let mut best = 0;
+        for k in 1..self.tips.len() {
+            if self.tips[k].cost < self.tips[best].cost {
                 best = k;
             }
         }
+        let best = last as usize + best;
         let start = out.len();
         let mut k = best as u32;
         while k != u32::MAX {
@@ -181,12 +252,78 @@ impl Trellis {
         self.anchor = Some((n.joints, n.branch));
         self.nodes.clear();
         self.layers.clear();
+        self.tips.clear();
     }
 
     /// Sets the configuration the machine is in (e.g. after points decided
     /// outside the trellis).
     pub fn set_anchor(&mut self, joints: Joints, branch: u8) {
         self.anchor = Some((joints, branch));
+    }
+}
+
+/// A push of a cut onto a previous layer, on the fast path.
+struct Layer<'a> {
+    costs: &'a Costs,
+    /// The previous layer.
+    tips: &'a [Tip],
+    /// Index in `nodes` of its first node.
+    previous: usize,
+    nodes: &'a mut Vec<Node>,
+    next: &'a mut Vec<Tip>,
+}
+
+impl Layer<'_> {
+    /// `N` rotary axes (`axes`): the same sums and comparisons as
+    /// [`Costs::transition`], in the same order, with the limits of the link
+    /// worked out once.
+    #[inline]
+    fn cut<const N: usize>(
+        self,
+        candidates: &[Solution],
+        axes: &[usize; MAX_ROTARY],
+        limits: &CutLimits,
+    ) {
+        for s in candidates.iter().filter(|s| s.is_valid()) {
+            let unary = self.costs.unary(&s.joints);
+            let mut v = [0.0; MAX_ROTARY];
+            for k in 0..N {
+                v[k] = s.joints[axes[k]];
+            }
+            let mut best = (f64::INFINITY, u32::MAX, true);
+            for (k, p) in self.tips.iter().enumerate() {
+                let switch = p.branch != s.branch;
+                let limit = if switch { &limits.switch } else { &limits.same };
+                let mut c = 0.0;
+                let mut continuous = true;
+                for r in 0..N {
+                    let step = (v[r] - p.rotary[r]).abs();
+                    if step > limit[r] {
+                        continuous = false;
+                    }
+                    c += step;
+                }
+                if switch {
+                    c += CUT_BRANCH_SWITCH;
+                }
+                let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
+                // Strictly less: ties keep the earlier candidate.
+                if total < best.0 {
+                    best = (total, (self.previous + k) as u32, continuous);
+                }
+            }
+            self.next.push(Tip {
+                rotary: v,
+                cost: best.0 + unary,
+                branch: s.branch,
+            });
+            self.nodes.push(Node {
+                joints: s.joints,
+                back: best.1,
+                branch: s.branch,
+                continuous: best.2,
+            });
+        }
     }
 }
 
