@@ -5,7 +5,7 @@
 //! closed-form branch, for running close to a travel limit and for values
 //! the user does not prefer.
 
-use kinpost_machine::{Joints, Machine, Prefer, Wrap, wrap180};
+use kinpost_machine::{Joints, MAX_AXES, Machine, Prefer, Wrap, wrap180};
 
 /// Cost of switching the orientation branch between two points of a cut.
 const BRANCH_SWITCH: f64 = 1.0;
@@ -112,6 +112,11 @@ pub struct Costs {
     /// The rotary axes with a preference (in the order of `rotary`).
     preferring: Vec<Rotary>,
     limited: Vec<Limited>,
+    /// `limited` by axis index, for a quick test whether any axis is within
+    /// its margin (axes without limits: -inf, +inf, 0, never within).
+    lo: [f64; MAX_AXES],
+    hi: [f64; MAX_AXES],
+    margin: [f64; MAX_AXES],
     /// Largest rotary step per degree of tool-axis turn on a continuous
     /// path outside the singular cone: 1 / sin(cone).
     step_rate: f64,
@@ -155,7 +160,15 @@ impl Costs {
                     margin,
                 })
             })
-            .collect();
+            .collect::<Vec<Limited>>();
+        let mut lo = [f64::NEG_INFINITY; MAX_AXES];
+        let mut hi = [f64::INFINITY; MAX_AXES];
+        let mut margin = [0.0; MAX_AXES];
+        for l in &limited {
+            lo[l.index] = l.lo;
+            hi[l.index] = l.hi;
+            margin[l.index] = l.margin;
+        }
         // Outside the cone a rotary angle changes at most 1/sin(cone) times
         // as fast as the tool axis turns; a cone of zero (no pole handling)
         // still bounds the rate by that of a 0.1° cone.
@@ -164,14 +177,16 @@ impl Costs {
             rotary,
             preferring,
             limited,
+            lo,
+            hi,
+            margin,
             step_rate,
             singular_axis,
         }
     }
 
-    /// Cost of being at `q` for one point: closeness to the travel limits
-    /// and distance from the preferred values.
-    pub fn unary(&self, q: &Joints) -> f64 {
+    /// The cost of closeness to the travel limits.
+    fn near_limits(&self, q: &Joints) -> f64 {
         let mut cost = 0.0;
         for l in &self.limited {
             let d = (q[l.index] - l.lo).min(l.hi - q[l.index]);
@@ -179,6 +194,23 @@ impl Costs {
                 let x = (l.margin - d.max(0.0)) / l.margin;
                 cost += NEAR_LIMIT * x * x;
             }
+        }
+        cost
+    }
+
+    /// Cost of being at `q` for one point: closeness to the travel limits
+    /// and distance from the preferred values.
+    pub fn unary(&self, q: &Joints) -> f64 {
+        let mut cost = 0.0;
+        // min(a, b) < m exactly when a < m or b < m (min ignores one NaN;
+        // with both NaN neither holds): the same test for every axis at
+        // once, without branches, before the loop that adds.
+        let mut near = false;
+        for (((&v, &lo), &hi), &m) in q.iter().zip(&self.lo).zip(&self.hi).zip(&self.margin) {
+            near |= (v - lo < m) | (hi - v < m);
+        }
+        if near {
+            cost = self.near_limits(q);
         }
         // Axes without a preference would add PREFERENCE · 0 = +0, which
         // leaves the (non-negative or NaN) sum as it is: they are left out.
@@ -391,12 +423,16 @@ mod tests {
                     a.prefer = prefs[(next() % 4) as usize];
                 }
                 let costs = Costs::new(&m, 0.5, None);
-                for _ in 0..64 {
+                for _ in 0..256 {
                     let mut q = [0.0; MAX_AXES];
                     for v in &mut q {
-                        *v = match next() % 4 {
+                        *v = match next() % 8 {
                             0 => (next() % 9) as f64 * 45.0 - 180.0,
                             1 => -0.0,
+                            2 => {
+                                [f64::NAN, f64::INFINITY, f64::NEG_INFINITY][(next() % 3) as usize]
+                            }
+                            3 => (next() % 4000) as f64 * 0.1 - 200.0,
                             _ => (next() % 2_000_000) as f64 * 1e-3 - 1000.0,
                         };
                     }
