@@ -35,6 +35,31 @@ struct Tip {
     branch: u8,
 }
 
+/// Adds candidate `s` to the layer being built: its node (for the
+/// decision) and its tip (for the next push). `best`: the cost of the
+/// cheapest sequence into it, its predecessor and whether that move is
+/// continuous.
+#[inline(always)]
+fn add_node(
+    nodes: &mut Vec<Node>,
+    next: &mut Vec<Tip>,
+    s: &Solution,
+    rotary: [f64; MAX_ROTARY],
+    best: (f64, u32, bool),
+) {
+    next.push(Tip {
+        rotary,
+        cost: best.0,
+        branch: s.branch,
+    });
+    nodes.push(Node {
+        joints: s.joints,
+        back: best.1,
+        branch: s.branch,
+        continuous: best.2,
+    });
+}
+
 /// A decided point: the configuration chosen and how it is reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Choice {
@@ -208,17 +233,13 @@ impl Trellis {
                     *v = s.joints[i];
                 }
             }
-            self.next.push(Tip {
+            add_node(
+                &mut self.nodes,
+                &mut self.next,
+                s,
                 rotary,
-                cost: best.0 + unary,
-                branch: s.branch,
-            });
-            self.nodes.push(Node {
-                joints: s.joints,
-                back: best.1,
-                branch: s.branch,
-                continuous: best.2,
-            });
+                (best.0 + unary, best.1, best.2),
+            );
         }
     }
 
@@ -312,17 +333,13 @@ impl Layer<'_> {
                     best = (total, (self.previous + k) as u32, continuous);
                 }
             }
-            self.next.push(Tip {
-                rotary: v,
-                cost: best.0 + unary,
-                branch: s.branch,
-            });
-            self.nodes.push(Node {
-                joints: s.joints,
-                back: best.1,
-                branch: s.branch,
-                continuous: best.2,
-            });
+            add_node(
+                self.nodes,
+                self.next,
+                s,
+                v,
+                (best.0 + unary, best.1, best.2),
+            );
         }
     }
 }
