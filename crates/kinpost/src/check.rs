@@ -2,8 +2,8 @@
 //! run back through the forward kinematics and compared with the CL pose it
 //! was made from.
 
+pub use kinpost_machine::angle_between;
 use kinpost_machine::{Kinematics, Machine, Pose};
-use nalgebra::Vector3;
 
 /// How far a block may put the tool from its CL pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,12 +97,6 @@ pub fn pose_error(want: &Pose, got: &Pose) -> (f64, f64) {
     )
 }
 
-/// Angle between two unit vectors, accurate for small angles (atan2 of the
-/// cross and dot products).
-pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
-}
-
 /// Running maxima of the check.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CheckStats {
@@ -146,6 +140,7 @@ impl CheckStats {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Vector3;
 
     #[test]
     fn tolerance_of_mts1600_at_3_decimals() {
