@@ -574,7 +574,7 @@ fn chord_settles(
     settings: &EmitSettings,
 ) -> Option<f64> {
     let n = kin.axis_count();
-    let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n], false);
+    let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n]);
     let bound = midpoint_bound(lever, w, v) + CHORD_SLACK_MM;
     (bound <= settings.lintol).then_some(bound)
 }

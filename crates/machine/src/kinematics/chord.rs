@@ -59,18 +59,11 @@ impl Kinematics {
 
     /// The travel of the straight joint motion from `a` to `b`: summed over
     /// the free rotary axes in radians, and over the free linear axes in mm.
-    /// With `periodic`, a rotary axis travels the shortest way to an
-    /// equivalent of its target (the configurations are the same).
     #[inline]
-    pub fn joint_travel(&self, a: &[f64], b: &[f64], periodic: bool) -> (f64, f64) {
+    pub fn joint_travel(&self, a: &[f64], b: &[f64]) -> (f64, f64) {
         let mut w = 0.0;
         for &(i, _) in &self.free_rot {
-            let d = b[i] - a[i];
-            w += if periodic {
-                super::wrap180(d).abs()
-            } else {
-                d.abs()
-            };
+            w += (b[i] - a[i]).abs();
         }
         let mut v = 0.0;
         for &i in &self.free_lin {
