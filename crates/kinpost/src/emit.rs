@@ -176,7 +176,7 @@ impl<W: Write> Emitter<W> {
                 self.reconfigure(machine, kin, &last, t)?;
             } else if linearize
                 && let Some(bound) =
-                    chord_settles(kin, &last.node, t.node, last.lever, &self.settings)
+                    chord_settles(kin, &last.node, t.node, last.lever, self.settings.lintol)
             {
                 let p = &mut self.planning;
                 p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
@@ -184,7 +184,7 @@ impl<W: Write> Emitter<W> {
                 let (from, lever, from_line) = (last.node, last.lever, last.line);
                 self.inserted.clear();
                 let mut inserted = std::mem::take(&mut self.inserted);
-                let result = self.linearize(kin, &from, t.node, lever, 0, &mut inserted);
+                let result = self.split(kin, &from, t.node, lever, 0, &mut inserted);
                 match result {
                     Ok(()) => {}
                     // A move that starts a segment may be a repositioning
@@ -230,12 +230,26 @@ impl<W: Write> Emitter<W> {
         depth: u32,
         out: &mut Vec<Node>,
     ) -> Result<(), &'static str> {
-        let n = self.n;
-        if let Some(bound) = chord_settles(kin, a, b, lever, &self.settings) {
+        if let Some(bound) = chord_settles(kin, a, b, lever, self.settings.lintol) {
             let p = &mut self.planning;
             p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
             return Ok(());
         }
+        self.split(kin, a, b, lever, depth, out)
+    }
+
+    /// [`Emitter::linearize`] for a segment the chord bound did not settle:
+    /// the midpoint's forward kinematics decides, and the halves recurse.
+    fn split(
+        &mut self,
+        kin: &Kinematics,
+        a: &Node,
+        b: &Node,
+        lever: f64,
+        depth: u32,
+        out: &mut Vec<Node>,
+    ) -> Result<(), &'static str> {
+        let n = self.n;
         let mut mid = a.joints;
         for (m, v) in mid.iter_mut().zip(&b.joints).take(n) {
             *m = 0.5 * (*m + v);
@@ -465,9 +479,10 @@ impl<W: Write> Emitter<W> {
             values,
             lever,
         });
-        // The pressure column, if any, follows the axes.
+        // The pressure column, if any, follows the axes (a copy of fixed
+        // length: no call to memcpy).
         let mut row = [f64::NAN; MAX_AXES + 1];
-        row[..n].copy_from_slice(&values[..n]);
+        row[..MAX_AXES].copy_from_slice(&values);
         row[n] = self.pressure;
         self.writer.block(&Block {
             cl_line,
@@ -566,17 +581,11 @@ impl<W: Write> Emitter<W> {
 /// midpoint: the bound, when it is within the linearization tolerance.
 /// `lever`: a bound of the lever at `a`.
 #[inline]
-fn chord_settles(
-    kin: &Kinematics,
-    a: &Node,
-    b: &Node,
-    lever: f64,
-    settings: &EmitSettings,
-) -> Option<f64> {
+fn chord_settles(kin: &Kinematics, a: &Node, b: &Node, lever: f64, lintol: f64) -> Option<f64> {
     let n = kin.axis_count();
     let (w, v) = kin.joint_travel(&a.joints[..n], &b.joints[..n]);
     let bound = midpoint_bound(lever, w, v) + CHORD_SLACK_MM;
-    (bound <= settings.lintol).then_some(bound)
+    (bound <= lintol).then_some(bound)
 }
 
 /// Distance from `p` to the segment `a`–`b`.
