@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 use proptest::prelude::*;
 
 mod rng;
-use rng::{Rng, random_body, vec_toml};
+use rng::{Rng, random_body, singular_allowance, vec_toml};
 
 /// A random serial machine: 3 linear and 2 rotary axes in random chain order
 /// and sides, non-intersecting rotary lines, a tilted part frame.
@@ -114,19 +114,7 @@ fn posts_within_tolerance(seed: u64) -> Result<(), TestCaseError> {
             dp <= summary.tolerance_mm + 1e-8,
             "line {line}: {dp} mm\n{toml}"
         );
-        // Inside the singular cone the post holds the free angle and points
-        // the nearest axis it can, off by no more than the cone; it reports
-        // every such point in a stretch.
-        let held = summary
-            .planning
-            .singular_stretches
-            .iter()
-            .any(|s| (s.first_line..=s.last_line).contains(&line));
-        let held = if held {
-            kinpost::DEFAULT_SINGULAR_CONE_DEG.to_radians()
-        } else {
-            0.0
-        };
+        let held = singular_allowance(&summary, line);
         prop_assert!(
             da <= summary.tolerance_rad + held + 1e-9,
             "line {line}: {da} rad\n{toml}"

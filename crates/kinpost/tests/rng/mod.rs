@@ -1,5 +1,6 @@
 //! A small deterministic generator for the property tests that build
-//! random machines (seeded by proptest), and TOML for the vectors they write.
+//! random machines (seeded by proptest), TOML for the vectors they write,
+//! and what those tests allow the post at singular points.
 
 use nalgebra::Vector3;
 
@@ -108,4 +109,22 @@ pub fn random_body(rng: &mut Rng, name: &str, linear: [Vector3<f64>; 3], limits:
         vec_toml(&x),
         vec_toml(&z)
     )
+}
+
+/// How far beyond the check's tolerance the post may turn the tool axis off
+/// the CL at CL line `line`: inside the singular cone it holds the free angle
+/// and points the nearest axis it can, off by no more than the (default)
+/// cone, and it reports every such point in a stretch; elsewhere nothing.
+#[allow(dead_code)]
+pub fn singular_allowance(summary: &kinpost::Summary, line: usize) -> f64 {
+    let held = summary
+        .planning
+        .singular_stretches
+        .iter()
+        .any(|s| (s.first_line..=s.last_line).contains(&line));
+    if held {
+        kinpost::DEFAULT_SINGULAR_CONE_DEG.to_radians()
+    } else {
+        0.0
+    }
 }
