@@ -4,10 +4,13 @@
 //! [sinumerik|csv|...] [N]`. The criterion benchmark `benches/write.rs` is
 //! the measurement of record.
 
-use std::hint::black_box;
 use std::io;
 
-use kinpost_nc::{AxisSpec, Block, Dialect, Motion, NcWriter};
+use kinpost_nc::{Dialect, NcWriter};
+
+#[path = "../benches/write_gen.rs"]
+mod write_gen;
+use write_gen::{axes, write_block};
 
 fn main() {
     let name = std::env::args()
@@ -18,14 +21,7 @@ fn main() {
         .and_then(|a| a.parse().ok())
         .unwrap_or(50_000);
     let dialect = Dialect::builtin(&name).expect("a built-in dialect");
-    let axes = [
-        AxisSpec::linear("X"),
-        AxisSpec::endless("A"),
-        AxisSpec::linear("Y"),
-        AxisSpec::linear("Z"),
-        AxisSpec::rotary("B"),
-        AxisSpec::rotary("C").fixed(),
-    ];
+    let axes = axes();
     let mut w = NcWriter::new(&dialect, &axes, io::sink());
     // The path first, so that a profile of the loop is the writer's alone.
     let path: Vec<[f64; 6]> = (0..n)
@@ -49,16 +45,7 @@ fn main() {
 /// The profiled loop (`--toggle-collect=*write_path*` counts it alone).
 #[inline(never)]
 fn write_path<W: io::Write>(w: &mut NcWriter<W>, path: &[[f64; 6]]) {
-    let mut written = [0.0; 6];
     for (k, v) in path.iter().enumerate() {
-        w.quantize_axes(black_box(v), &mut written);
-        w.block(&Block {
-            cl_line: Some(k + 4),
-            motion: Motion::Feed,
-            axes: black_box(v),
-            feed: Some(2000.0),
-        })
-        .unwrap();
-        black_box(&written);
+        write_block(w, k + 4, v, 2000.0);
     }
 }
