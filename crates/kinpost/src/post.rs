@@ -2,8 +2,9 @@
 //! inverse kinematics (every branch) → planner → NC blocks, each block run
 //! back through the forward kinematics before it is written.
 //!
-//! Everything streams: one statement is read, planned, checked and written
-//! before the next is read, so memory does not grow with the program.
+//! Statements are read one at a time; CL points wait in the planner (see
+//! `path.rs`) until it decides, at the latest every [`PLANNER_LAG`] points,
+//! so memory is bounded by that window, not by the program.
 
 use std::io::{BufRead, Write};
 use std::time::Instant;
