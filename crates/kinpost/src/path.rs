@@ -11,7 +11,7 @@ use std::io::Write;
 use std::ops::Range;
 
 use kinpost_diag::Diagnostic;
-use kinpost_machine::angle::atan2_deg;
+use kinpost_machine::angle::{atan2_deg, atan2_rad};
 use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
@@ -76,9 +76,9 @@ pub(crate) struct PathPlan {
     free: bool,
     /// Tool axis and reference of the last point.
     previous_axes: Option<(Vector3<f64>, Option<Vector3<f64>>)>,
-    /// Angle between the tool axis of the last point in the trellis and the
-    /// singular direction, degrees.
-    planned_pole_deg: f64,
+    /// Distance from the tool axis of the last point in the trellis to the
+    /// singular direction (`None`: no singularity, or no point yet).
+    planned_pole: Option<Pole>,
     segment: u64,
     break_pending: bool,
     /// The last point written: its node, branch and segment.
@@ -113,7 +113,7 @@ impl PathPlan {
             across: false,
             free: true,
             previous_axes: None,
-            planned_pole_deg: f64::INFINITY,
+            planned_pole: None,
             segment: 0,
             break_pending: true,
             last: None,
@@ -176,10 +176,9 @@ impl PathPlan {
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
             .map_err(|e| PointError::Ik(e.to_string()))?;
         // Angle between the tool axis and the singular direction.
-        let pole = self
-            .singularity
-            .map_or(f64::INFINITY, |s| s.distance(&pose.axis));
-        let singular = pole < self.cone_rad || self.solutions.iter().all(|s| s.singular);
+        let pole = self.singularity.map(|s| Pole(s.sin_cos(&pose.axis)));
+        let in_cone = pole.is_some_and(|p| p.within(self.cone_rad));
+        let singular = in_cone || self.solutions.iter().all(|s| s.singular);
         if singular {
             if !self.solutions.iter().any(Solution::is_valid) {
                 return Err(PointError::Rejected(rejection(&self.solutions)));
@@ -189,12 +188,13 @@ impl PathPlan {
             // The tool axis swept past the pole between the two points (its
             // distances to the pole add up to the turn): the branches meet
             // there, as across singular points.
-            let pole_deg = pole.to_degrees();
-            let cone_deg = self.cone_rad.to_degrees();
-            if self.planned_pole_deg + pole_deg <= self.turn + 2.0 * cone_deg + 1e-9 {
+            let limit = self.turn + 2.0 * self.cone_rad.to_degrees() + 1e-9;
+            if let (Some(a), Some(b)) = (self.planned_pole, pole)
+                && Pole::sum_within(a, b, limit)
+            {
                 self.across = true;
             }
-            self.planned_pole_deg = pole_deg;
+            self.planned_pole = pole;
             let link = if self.free {
                 Link::Free
             } else {
@@ -501,6 +501,45 @@ impl PathPlan {
     }
 }
 
+/// The angle between a tool axis and the singular direction, kept as its
+/// sine and cosine terms ([`Singularity::sin_cos`]): most decisions are
+/// settled by a lower bound, without the `atan2` of
+/// [`Singularity::distance`], which is exact (the same bits) where the
+/// bound does not settle them.
+#[derive(Debug, Clone, Copy)]
+struct Pole((f64, f64));
+
+impl Pole {
+    /// Relative slack of the lower bound: far above the rounding of the
+    /// bound and of `atan2` (a few ulp each).
+    const SLACK: f64 = 1e-12;
+
+    /// The angle, radians (as [`Singularity::distance`]).
+    fn exact_rad(self) -> f64 {
+        let (s, c) = self.0;
+        atan2_rad(s, c)
+    }
+
+    /// A lower bound of the angle, radians: its sine `s / √(s² + c²)` is at
+    /// least `s / max(s² + c², 1)`, and an angle of [0, π/2] is at least its
+    /// sine.
+    fn lower_rad(self) -> f64 {
+        let (s, c) = self.0;
+        s / (s * s + c * c).max(1.0) * (1.0 - Self::SLACK)
+    }
+
+    /// Whether the angle is below `cone_rad`.
+    fn within(self, cone_rad: f64) -> bool {
+        self.lower_rad() < cone_rad && self.exact_rad() < cone_rad
+    }
+
+    /// Whether the two angles, in degrees, add up to at most `limit`.
+    fn sum_within(a: Pole, b: Pole, limit: f64) -> bool {
+        (a.lower_rad() + b.lower_rad()).to_degrees() <= limit
+            && a.exact_rad().to_degrees() + b.exact_rad().to_degrees() <= limit
+    }
+}
+
 /// Angle between unit vectors, degrees (the turn of the tool axis between
 /// two points). Small turns, as between the points of a CL path, are
 /// `2·asin(|a − b| / 2)` by the series of asin (relative error below 1e-13
@@ -541,6 +580,43 @@ mod tests {
                 (got - want).abs() <= 1e-12 * want + 1e-13,
                 "{deg}: {got} vs {want}"
             );
+        }
+    }
+
+    fn unit(v: [f64; 3]) -> Vector3<f64> {
+        Vector3::from(v).normalize()
+    }
+
+    proptest::proptest! {
+        /// The pole tests decide as the exact angles of
+        /// `Singularity::distance` do, also at their limits (the cone and
+        /// the sum set to the exact values, or an ulp off them).
+        #[test]
+        fn pole_tests_agree_with_the_exact_angles(
+            d in proptest::array::uniform3(-1.0f64..1.0),
+            a in proptest::array::uniform3(-1.0f64..1.0),
+            b in proptest::array::uniform3(-1.0f64..1.0),
+            near in 0.0f64..1e-3,
+            ulps in -2i64..=2,
+        ) {
+            proptest::prop_assume!(Vector3::from(d).norm() > 1e-3);
+            let s = Singularity { axis: 0, direction: unit(d) };
+            // Tool axes anywhere, or within `near` of the pole.
+            let a = unit(a);
+            let b = (s.direction + near * unit(b)).normalize();
+            let nudge = |x: f64| f64::from_bits((x.to_bits() as i64 + ulps) as u64);
+            let (pa, pb) = (Pole(s.sin_cos(&a)), Pole(s.sin_cos(&b)));
+            for (pole, axis) in [(pa, &a), (pb, &b)] {
+                let exact = s.distance(axis);
+                proptest::prop_assert_eq!(pole.exact_rad().to_bits(), exact.to_bits());
+                for cone in [nudge(exact), 1e-3, 0.0, exact * 2.0] {
+                    proptest::prop_assert_eq!(pole.within(cone), exact < cone);
+                }
+            }
+            let sum = s.distance(&a).to_degrees() + s.distance(&b).to_degrees();
+            for limit in [nudge(sum), sum * 0.5, 0.0, f64::INFINITY] {
+                proptest::prop_assert_eq!(Pole::sum_within(pa, pb, limit), sum <= limit);
+            }
         }
     }
 }

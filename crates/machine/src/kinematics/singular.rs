@@ -29,9 +29,20 @@ impl Singularity {
     /// (`atan2` of the cross and the absolute dot product, within 2 ulp of
     /// the library's).
     pub fn distance(&self, axis: &Vector3<f64>) -> f64 {
-        let c = self.direction.dot(axis).abs();
-        let s = self.direction.cross(axis).norm();
+        let (s, c) = self.sin_cos(axis);
         atan2_rad(s, c)
+    }
+
+    /// The sine and cosine terms of [`Singularity::distance`] (`|d × a|`
+    /// and `|d · a|`), for a caller that can often decide without the angle:
+    /// the angle is at least `s / max(s² + c², 1)` (its sine, for unit
+    /// vectors), and `atan2_rad(s, c)` is the distance exactly.
+    #[inline]
+    pub fn sin_cos(&self, axis: &Vector3<f64>) -> (f64, f64) {
+        (
+            self.direction.cross(axis).norm(),
+            self.direction.dot(axis).abs(),
+        )
     }
 }
 
