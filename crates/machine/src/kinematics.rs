@@ -293,8 +293,9 @@ enum Step {
 enum LinearSolve {
     /// Three free linear axes with no free rotary axis between them: their
     /// columns are constant inside the outermost of them, and so are the
-    /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic).
-    Constant([V3; 3]),
+    /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic), by column;
+    /// `axes`: the machine-file index of each column's axis.
+    Constant { rows: [V3; 3], axes: [usize; 3] },
     /// Columns that depend on the angles, or fewer than three axes.
     General,
 }
@@ -512,7 +513,10 @@ impl Kinematics {
             }
         }
         let linear_solve = match cramer_rows(&columns) {
-            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant(rows),
+            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant {
+                rows,
+                axes: [free_lin[0], free_lin[1], free_lin[2]],
+            },
             _ => LinearSolve::General,
         };
 
@@ -909,7 +913,7 @@ impl Kinematics {
         }
         let inner = &self.steps[self.split..];
         let m = self.free_lin.len();
-        if let LinearSolve::Constant(rows) = &self.linear_solve {
+        if let LinearSolve::Constant { rows, axes } = &self.linear_solve {
             // The tool point with the free linear axes at zero.
             let mut point = self.tip;
             for step in self.inner_fixed.iter().rev() {
@@ -919,10 +923,12 @@ impl Kinematics {
                 }
             }
             let rhs = y - point;
-            for (k, &i) in self.free_lin.iter().enumerate() {
-                q[i] = rows[k].dot(&rhs);
+            // Three axes, known here: no loops over `free_lin`.
+            let values = rows.map(|r| r.dot(&rhs));
+            for (&i, v) in axes.iter().zip(values) {
+                q[i] = v;
             }
-            return self.free_lin.iter().all(|&i| q[i].is_finite());
+            return values.iter().all(|v| v.is_finite());
         }
 
         // The tool point with the free linear axes at zero, and the column
@@ -1280,6 +1286,17 @@ fn turn_range(lo: f64, hi: f64, principal: f64) -> (f64, f64) {
 /// Angle in degrees wrapped to (−180, 180].
 #[inline]
 pub fn wrap180(deg: f64) -> f64 {
+    // Inside (−180, 180) the formula below gives `deg` back to the bit
+    // (no turn, or one turn down and back up, both exact): skip it.
+    if deg.abs() < 180.0 {
+        return deg;
+    }
+    wrap180_by_turns(deg)
+}
+
+/// [`wrap180`] by the nearest whole turn.
+#[inline]
+fn wrap180_by_turns(deg: f64) -> f64 {
     let w = deg - 360.0 * turns_nearest(deg / 360.0);
     if w <= -180.0 {
         w + 360.0

@@ -325,6 +325,20 @@ proptest! {
         }
     }
 
+    /// `wrap180` skips its turn inside (−180°, 180°): the same bits as by
+    /// the turn, there and an ulp or two either side of the edges.
+    #[test]
+    fn wrap180_shortcut_is_the_turn(deg in -200.0..200.0f64, edge in 0usize..3, ulps in -3i64..=3) {
+        let deg = match edge {
+            0 => deg,
+            1 => f64::from_bits((180.0f64.to_bits() as i64 + ulps) as u64),
+            _ => -f64::from_bits((180.0f64.to_bits() as i64 + ulps) as u64),
+        };
+        for d in [deg, deg * 1e-300, deg / 360.0] {
+            prop_assert_eq!(wrap180(d).to_bits(), wrap180_by_turns(d).to_bits(), "{}", d);
+        }
+    }
+
     /// The arc test never contradicts the turn count it stands in for.
     #[test]
     fn arc_test_agrees_with_turn_range(
