@@ -48,7 +48,9 @@ pub use chord::{lever_over, midpoint_bound};
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{FREE_EPS, Sp2, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy};
+use crate::subproblems::{
+    FREE_EPS, Sp2, Sp2Xy, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy,
+};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -118,8 +120,6 @@ type V3 = Vector3<f64>;
 struct Rot([[f64; 3]; 3]);
 
 impl Rot {
-    const IDENTITY: Rot = Rot([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
-
     fn from_matrix(m: &Matrix3<f64>) -> Rot {
         Rot(std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])))
     }
@@ -240,7 +240,13 @@ enum Turned {
 }
 
 impl Turned {
-    const IDENTITY: Turned = Turned::Matrix(Rot::IDENTITY);
+    /// No turn (a placeholder).
+    const NONE: Turned = Turned::Axis {
+        k: 0,
+        c: 1.0,
+        s: 0.0,
+        d: 1.0,
+    };
 
     /// `self · v`.
     #[inline(always)]
@@ -299,9 +305,6 @@ enum LinearSolve {
     /// Columns that depend on the angles, or fewer than three axes.
     General,
 }
-
-/// The rotation matrices of the free rotary slots, for some angles.
-type Rots = [Turned; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
@@ -677,14 +680,10 @@ impl Kinematics {
         all_branches: bool,
     ) -> Result<(), IkError> {
         out.clear();
-        let mut branches = [Branch::default(); 2];
-        let count = match if N == 2 {
-            self.orient_two(pose, &mut branches)
-        } else {
-            None
-        } {
-            Some(count) => count,
-            None => self.orient(pose, hint, &mut branches)?,
+        let two = if N == 2 { self.orient_two(pose) } else { None };
+        let (mut branches, count) = match two {
+            Some(found) => found,
+            None => self.orient_any(pose, hint)?,
         };
         // Branches whose rotary angles fit the travel first; the others are
         // only needed to say why nothing fits. An angle (its `atan2`) is
@@ -720,17 +719,43 @@ impl Kinematics {
     /// solutions and no angle is free (the usual pose): the number of
     /// branches. `None` otherwise, for [`Kinematics::orient`] to decide
     /// (from the very same subproblem).
+    /// (Generic only to fit [`Kinematics::solve_n`]: called with `N = 2`.)
     #[inline(always)]
-    fn orient_two(&self, pose: &Pose, branches: &mut [Branch; 2]) -> Option<usize> {
+    fn orient_two<const N: usize>(&self, pose: &Pose) -> Option<([Branch<N>; 2], usize)> {
         let (sols, n) = self
             .sp2
             .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
-        for (b, s) in branches.iter_mut().zip(&sols[..n]) {
-            let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
-            b.angles[0] = SlotAngle::from_xy(x1, y1);
-            b.angles[1] = SlotAngle::from_xy(x2, y2);
+        if n == 0 {
+            return None;
         }
-        (n > 0).then_some(n)
+        let branch = |s: &Sp2Xy| {
+            let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
+            let angles = [SlotAngle::from_xy(x1, y1), SlotAngle::from_xy(x2, y2)];
+            Some(Branch::new(std::array::from_fn(|k| angles[k])))
+        };
+        let first = branch(&sols[0])?;
+        // A second branch only when there is one (the first stands in
+        // otherwise, never solved).
+        let second = if n > 1 { branch(&sols[1])? } else { first };
+        Some(([first, second], n))
+    }
+
+    /// [`Kinematics::orient`] for `N` slots.
+    #[cold]
+    #[inline(never)]
+    fn orient_any<const N: usize>(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+    ) -> Result<([Branch<N>; 2], usize), IkError> {
+        let mut branches = [Branch::default(); 2];
+        let count = self.orient(pose, hint, &mut branches)?;
+        let slots = |b: &Branch<3>| Branch {
+            angles: std::array::from_fn(|k| b.angles[k]),
+            fits: b.fits,
+            singular: b.singular,
+        };
+        Ok((branches.each_ref().map(slots), count))
     }
 
     /// The orientation branches of `pose`, for any number of free rotary
@@ -741,7 +766,7 @@ impl Kinematics {
         &self,
         pose: &Pose,
         hint: Option<&[f64]>,
-        branches: &mut [Branch; 2],
+        branches: &mut [Branch<3>; 2],
     ) -> Result<usize, IkError> {
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
         let target = self.rw0 * pose.axis;
@@ -851,7 +876,7 @@ impl Kinematics {
     /// is first tried with the arc test, which leaves out its `atan2` when
     /// the answer is no.
     #[inline(always)]
-    fn fits<const N: usize>(&self, b: &mut Branch) -> bool {
+    fn fits<const N: usize>(&self, b: &mut Branch<N>) -> bool {
         if let Some(f) = b.fits {
             return f;
         }
@@ -877,20 +902,22 @@ impl Kinematics {
     #[inline(always)]
     fn solve_branch<const N: usize>(
         &self,
-        b: &mut Branch,
+        b: &mut Branch<N>,
         branch: u8,
         point: &V3,
         hint: Option<&[f64]>,
         out: &mut Vec<Solution>,
     ) {
         let mut joints = self.fixed;
-        let mut rots = [Turned::IDENTITY; 3];
-        let mut ranges = [SlotRange::default(); 3];
-        for k in 0..N {
-            let (slot, a) = (&self.slots[k], &mut b.angles[k]);
-            ranges[k] = slot.range(a.in_degrees(), hint);
-            joints[slot.axis] = ranges[k].raw;
-            rots[k] = slot.turn.rotation(a.cos, a.sin);
+        // Arrays of the slots there are: no setup of unused ones.
+        let mut ranges = [SlotRange::default(); N];
+        for ((slot, a), r) in self.slots.iter().zip(&mut b.angles).zip(&mut ranges) {
+            *r = slot.range(a.in_degrees(), hint);
+            joints[slot.axis] = r.raw;
+        }
+        let mut rots = [Turned::NONE; N];
+        for ((slot, a), r) in self.slots.iter().zip(&b.angles).zip(&mut rots) {
+            *r = slot.turn.rotation(a.cos, a.sin);
         }
         if self.solve_linear(&mut joints, &rots, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
@@ -901,7 +928,7 @@ impl Kinematics {
     /// solves the free linear axes so that the tool point lands on `target`
     /// (part frame), in place (no copies of the joints in and out); `false`
     /// when they cannot.
-    fn solve_linear(&self, q: &mut Joints, rots: &Rots, target: &V3) -> bool {
+    fn solve_linear(&self, q: &mut Joints, rots: &[Turned], target: &V3) -> bool {
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
@@ -999,12 +1026,12 @@ impl Kinematics {
     fn push_equivalents<const N: usize>(
         &self,
         mut joints: Joints,
-        ranges: &[SlotRange; 3],
+        ranges: &[SlotRange; N],
         branch: u8,
         singular: bool,
         out: &mut Vec<Solution>,
     ) {
-        if let Some(slot) = ranges[..N].iter().position(|r| !r.has_equivalent()) {
+        if let Some(slot) = ranges.iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
             out.push(Solution {
                 joints,
@@ -1029,10 +1056,7 @@ impl Kinematics {
                 axis: i,
                 value: joints[i],
             });
-        let mut turn = [0.0; 3];
-        for (t, r) in turn.iter_mut().zip(ranges) {
-            *t = r.first;
-        }
+        let mut turn: [f64; N] = ranges.map(|r| r.first);
         loop {
             for k in 0..N {
                 joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
@@ -1076,13 +1100,29 @@ fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
     Some(n.map(|v| v / det))
 }
 
-/// One solved orientation branch: the angle of every free rotary slot,
-/// known as cosine and sine first, in degrees once needed.
-#[derive(Clone, Copy, Default)]
-struct Branch {
-    angles: [SlotAngle; 3],
+/// One solved orientation branch: the angle of every free rotary slot
+/// (`N` of them), known as cosine and sine first, in degrees once needed.
+#[derive(Clone, Copy)]
+struct Branch<const N: usize> {
+    angles: [SlotAngle; N],
     fits: Option<bool>,
     singular: bool,
+}
+
+impl<const N: usize> Branch<N> {
+    fn new(angles: [SlotAngle; N]) -> Self {
+        Branch {
+            angles,
+            fits: None,
+            singular: false,
+        }
+    }
+}
+
+impl<const N: usize> Default for Branch<N> {
+    fn default() -> Self {
+        Branch::new([SlotAngle::default(); N])
+    }
 }
 
 /// The angle of one free rotary slot.
