@@ -48,9 +48,7 @@ pub use chord::{lever_over, midpoint_bound};
 pub use singular::Singularity;
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
-use crate::subproblems::{
-    FREE_EPS, Sp2, Sp2Xy, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy,
-};
+use crate::subproblems::{FREE_EPS, Sp2, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy};
 
 /// Joint values of one configuration, in machine-file axis order.
 pub type Joints = [f64; MAX_AXES];
@@ -240,14 +238,6 @@ enum Turned {
 }
 
 impl Turned {
-    /// No turn (a placeholder).
-    const NONE: Turned = Turned::Axis {
-        k: 0,
-        c: 1.0,
-        s: 0.0,
-        d: 1.0,
-    };
-
     /// `self · v`.
     #[inline(always)]
     fn apply(&self, v: &V3) -> V3 {
@@ -481,7 +471,6 @@ impl Kinematics {
                         Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
                         _ => None,
                     },
-                    turn: *t,
                 };
             }
         }
@@ -680,10 +669,15 @@ impl Kinematics {
         all_branches: bool,
     ) -> Result<(), IkError> {
         out.clear();
-        let two = if N == 2 { self.orient_two(pose) } else { None };
-        let (mut branches, count) = match two {
-            Some(found) => found,
-            None => self.orient_any(pose, hint)?,
+        let mut branches = [Branch::<N>::default(); 2];
+        let two = if N == 2 {
+            self.orient_two(pose, &mut branches)
+        } else {
+            None
+        };
+        let count = match two {
+            Some(count) => count,
+            None => self.orient_any(pose, hint, &mut branches)?,
         };
         // Branches whose rotary angles fit the travel first; the others are
         // only needed to say why nothing fits. An angle (its `atan2`) is
@@ -695,17 +689,19 @@ impl Kinematics {
         // the loops save.)
         let [b0, b1] = &mut branches;
         let second = count > 1;
-        if self.fits::<N>(b0) {
+        let fits0 = self.fits::<N>(b0);
+        if fits0 {
             self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
         }
-        if second && self.fits::<N>(b1) {
+        let fits1 = second && self.fits::<N>(b1);
+        if fits1 {
             self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
         }
         if all_branches || !out.iter().any(Solution::is_valid) {
-            if !self.fits::<N>(b0) {
+            if !fits0 {
                 self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
             }
-            if second && !self.fits::<N>(b1) {
+            if second && !fits1 {
                 self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
             }
         }
@@ -721,23 +717,20 @@ impl Kinematics {
     /// (from the very same subproblem).
     /// (Generic only to fit [`Kinematics::solve_n`]: called with `N = 2`.)
     #[inline(always)]
-    fn orient_two<const N: usize>(&self, pose: &Pose) -> Option<([Branch<N>; 2], usize)> {
+    fn orient_two<const N: usize>(
+        &self,
+        pose: &Pose,
+        branches: &mut [Branch<N>; 2],
+    ) -> Option<usize> {
         let (sols, n) = self
             .sp2
             .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
-        if n == 0 {
-            return None;
-        }
-        let branch = |s: &Sp2Xy| {
+        for (b, s) in branches.iter_mut().zip(&sols[..n]) {
             let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
-            let angles = [SlotAngle::from_xy(x1, y1), SlotAngle::from_xy(x2, y2)];
-            Some(Branch::new(std::array::from_fn(|k| angles[k])))
-        };
-        let first = branch(&sols[0])?;
-        // A second branch only when there is one (the first stands in
-        // otherwise, never solved).
-        let second = if n > 1 { branch(&sols[1])? } else { first };
-        Some(([first, second], n))
+            b.angles[0] = SlotAngle::from_xy(x1, y1);
+            b.angles[1] = SlotAngle::from_xy(x2, y2);
+        }
+        (n > 0).then_some(n)
     }
 
     /// [`Kinematics::orient`] for `N` slots.
@@ -747,15 +740,15 @@ impl Kinematics {
         &self,
         pose: &Pose,
         hint: Option<&[f64]>,
-    ) -> Result<([Branch<N>; 2], usize), IkError> {
-        let mut branches = [Branch::default(); 2];
-        let count = self.orient(pose, hint, &mut branches)?;
-        let slots = |b: &Branch<3>| Branch {
-            angles: std::array::from_fn(|k| b.angles[k]),
-            fits: b.fits,
-            singular: b.singular,
-        };
-        Ok((branches.each_ref().map(slots), count))
+        branches: &mut [Branch<N>; 2],
+    ) -> Result<usize, IkError> {
+        let mut all = [Branch::default(); 2];
+        let count = self.orient(pose, hint, &mut all)?;
+        for (b, a) in branches.iter_mut().zip(&all) {
+            b.angles.copy_from_slice(&a.angles[..N]);
+            b.singular = a.singular;
+        }
+        Ok(count)
     }
 
     /// The orientation branches of `pose`, for any number of free rotary
@@ -872,30 +865,24 @@ impl Kinematics {
     }
 
     /// Whether every rotary angle of the branch has an equivalent inside its
-    /// travel (decided once per branch). An angle not yet known in degrees
+    /// travel (asked once per branch). An angle not yet known in degrees
     /// is first tried with the arc test, which leaves out its `atan2` when
     /// the answer is no.
     #[inline(always)]
     fn fits<const N: usize>(&self, b: &mut Branch<N>) -> bool {
-        if let Some(f) = b.fits {
-            return f;
-        }
-        let mut f = true;
         for (slot, a) in self.slots[..N].iter().zip(&mut b.angles) {
             let Some(arc) = &slot.arc else {
                 continue;
             };
-            let inside = match (a.degrees, arc.contains(a.cos, a.sin)) {
-                (None, Some(inside)) => inside,
+            let inside = match arc.contains(a.cos, a.sin) {
+                Some(inside) if !a.has_degrees() => inside,
                 _ => slot.range(a.in_degrees(), None).has_equivalent(),
             };
             if !inside {
-                f = false;
-                break;
+                return false;
             }
         }
-        b.fits = Some(f);
-        f
+        true
     }
 
     /// The linear axes of one orientation branch, and its solutions.
@@ -915,27 +902,30 @@ impl Kinematics {
             *r = slot.range(a.in_degrees(), hint);
             joints[slot.axis] = r.raw;
         }
-        let mut rots = [Turned::NONE; N];
-        for ((slot, a), r) in self.slots.iter().zip(&b.angles).zip(&mut rots) {
-            *r = slot.turn.rotation(a.cos, a.sin);
-        }
-        if self.solve_linear(&mut joints, &rots, point) {
+        if self.solve_linear(&mut joints, &b.angles, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
-    /// With every rotary angle set in `q` (and their rotations in `rots`),
+    /// With every rotary angle set in `q` (and their cosines and sines in
+    /// `angles`, by slot),
     /// solves the free linear axes so that the tool point lands on `target`
     /// (part frame), in place (no copies of the joints in and out); `false`
     /// when they cannot.
-    fn solve_linear(&self, q: &mut Joints, rots: &[Turned], target: &V3) -> bool {
+    fn solve_linear(&self, q: &mut Joints, angles: &[SlotAngle], target: &V3) -> bool {
+        // Each free rotary axis is one step of the chain: its rotation is
+        // made where it is used.
+        let turned = |t: &Turn| {
+            let a = &angles[t.slot];
+            t.rotation(a.cos, a.sin)
+        };
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
             match step {
                 // Locked linear axes only: the split is at the first free one.
                 Step::Linear { axis, dir, .. } => y -= dir * q[*axis],
-                Step::Rotary(t) => y = t.unmove_point(&rots[t.slot], &y),
+                Step::Rotary(t) => y = t.unmove_point(&turned(t), &y),
             }
         }
         let inner = &self.steps[self.split..];
@@ -946,7 +936,7 @@ impl Kinematics {
             for step in self.inner_fixed.iter().rev() {
                 match step {
                     Step::Linear { axis, dir, .. } => point += dir * q[*axis],
-                    Step::Rotary(t) => point = t.move_point(&rots[t.slot], &point),
+                    Step::Rotary(t) => point = t.move_point(&turned(t), &point),
                 }
             }
             let rhs = y - point;
@@ -971,7 +961,7 @@ impl Kinematics {
                 } => c[*k] = *dir,
                 Step::Linear { axis, dir, .. } => point += dir * q[*axis],
                 Step::Rotary(t) => {
-                    let r = &rots[t.slot];
+                    let r = &turned(t);
                     point = t.move_point(r, &point);
                     for col in &mut c[..m] {
                         *col = r.apply(col);
@@ -1105,7 +1095,6 @@ fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
 #[derive(Clone, Copy)]
 struct Branch<const N: usize> {
     angles: [SlotAngle; N],
-    fits: Option<bool>,
     singular: bool,
 }
 
@@ -1113,7 +1102,6 @@ impl<const N: usize> Branch<N> {
     fn new(angles: [SlotAngle; N]) -> Self {
         Branch {
             angles,
-            fits: None,
             singular: false,
         }
     }
@@ -1134,7 +1122,10 @@ struct SlotAngle {
     /// `degrees` is known from the start.
     x: f64,
     y: f64,
-    degrees: Option<f64>,
+    /// NaN until known: a plain number, where an `Option` would add a tag
+    /// and its padding to every copy of a branch. (A NaN hint gives a NaN
+    /// `atan2`: taking it again changes nothing.)
+    degrees: f64,
 }
 
 impl Default for SlotAngle {
@@ -1144,7 +1135,7 @@ impl Default for SlotAngle {
             sin: 0.0,
             x: 1.0,
             y: 0.0,
-            degrees: Some(0.0),
+            degrees: 0.0,
         }
     }
 }
@@ -1158,7 +1149,7 @@ impl SlotAngle {
             sin,
             x,
             y,
-            degrees: None,
+            degrees: f64::NAN,
         }
     }
 
@@ -1172,21 +1163,34 @@ impl SlotAngle {
             sin,
             x: cos,
             y: sin,
-            degrees: Some(rad.to_degrees()),
+            degrees: rad.to_degrees(),
         }
     }
 
     /// The angle in degrees (its `atan2` taken once).
     #[inline]
     fn in_degrees(&mut self) -> f64 {
-        *self
-            .degrees
-            .get_or_insert_with(|| atan2_deg(self.y, self.x))
+        if !self.has_degrees() {
+            self.degrees = xy_degrees(self.x, self.y);
+        }
+        self.degrees
+    }
+
+    #[inline]
+    fn has_degrees(&self) -> bool {
+        !self.degrees.is_nan()
     }
 
     fn rotation(&self, w: &V3) -> Matrix3<f64> {
         rotation_cs(w, self.cos, self.sin)
     }
+}
+
+/// The angle of `(x, y)` in degrees, out of line: inlined, its code
+/// crowds the registers of the solver around it.
+#[inline(never)]
+fn xy_degrees(x: f64, y: f64) -> f64 {
+    atan2_deg(y, x)
 }
 
 /// The travel `[lo, hi]` of a rotary axis (less than a full turn and a
@@ -1229,25 +1233,13 @@ impl Arc {
 }
 
 /// A free rotary axis, by its slot.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Slot {
     /// Machine-file index of the axis.
     axis: usize,
     limits: Option<[f64; 2]>,
     /// The arc test of a travel of less than a full turn and a degree.
     arc: Option<Arc>,
-    turn: Turn,
-}
-
-impl Default for Slot {
-    fn default() -> Self {
-        Slot {
-            axis: 0,
-            limits: None,
-            arc: None,
-            turn: Turn::new(0, 0, V3::z(), V3::zeros()),
-        }
-    }
 }
 
 impl Slot {
