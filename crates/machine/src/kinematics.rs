@@ -908,45 +908,51 @@ impl Kinematics {
     }
 
     /// With every rotary angle set in `q` (and their cosines and sines in
-    /// `angles`, by slot),
-    /// solves the free linear axes so that the tool point lands on `target`
-    /// (part frame), in place (no copies of the joints in and out); `false`
-    /// when they cannot.
+    /// `angles`, by slot), solves the free linear axes so that the tool
+    /// point lands on `target` (part frame), in place (no copies of the
+    /// joints in and out); `false` when they cannot.
+    ///
+    /// (Inlined for the precomputed solve of most machines, the general one
+    /// out of line.)
+    #[inline(always)]
     fn solve_linear(&self, q: &mut Joints, angles: &[SlotAngle], target: &V3) -> bool {
-        // Each free rotary axis is one step of the chain: its rotation is
-        // made where it is used.
-        let turned = |t: &Turn| {
-            let a = &angles[t.slot];
-            t.rotation(a.cos, a.sin)
-        };
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
             match step {
                 // Locked linear axes only: the split is at the first free one.
                 Step::Linear { axis, dir, .. } => y -= dir * q[*axis],
-                Step::Rotary(t) => y = t.unmove_point(&turned(t), &y),
+                Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
             }
         }
+        let LinearSolve::Constant { rows, axes } = &self.linear_solve else {
+            return self.solve_linear_general(q, angles, &y);
+        };
+        // The tool point with the free linear axes at zero.
+        let mut point = self.tip;
+        for step in self.inner_fixed.iter().rev() {
+            match step {
+                Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                Step::Rotary(t) => point = t.move_point(&turned(angles, t), &point),
+            }
+        }
+        let rhs = y - point;
+        // Three axes, known here: no loops over `free_lin`.
+        let values = rows.map(|r| r.dot(&rhs));
+        for (&i, v) in axes.iter().zip(values) {
+            q[i] = v;
+        }
+        values.iter().all(|v| v.is_finite())
+    }
+
+    /// [`Kinematics::solve_linear`] inside the steps outside the linear
+    /// axes (`y`: the target there) when the columns depend on the angles
+    /// or there are fewer than three linear axes.
+    #[inline(never)]
+    fn solve_linear_general(&self, q: &mut Joints, angles: &[SlotAngle], y: &V3) -> bool {
+        let y = *y;
         let inner = &self.steps[self.split..];
         let m = self.free_lin.len();
-        if let LinearSolve::Constant { rows, axes } = &self.linear_solve {
-            // The tool point with the free linear axes at zero.
-            let mut point = self.tip;
-            for step in self.inner_fixed.iter().rev() {
-                match step {
-                    Step::Linear { axis, dir, .. } => point += dir * q[*axis],
-                    Step::Rotary(t) => point = t.move_point(&turned(t), &point),
-                }
-            }
-            let rhs = y - point;
-            // Three axes, known here: no loops over `free_lin`.
-            let values = rows.map(|r| r.dot(&rhs));
-            for (&i, v) in axes.iter().zip(values) {
-                q[i] = v;
-            }
-            return values.iter().all(|v| v.is_finite());
-        }
 
         // The tool point with the free linear axes at zero, and the column
         // of each free linear axis (how the point moves per unit of it).
@@ -961,7 +967,7 @@ impl Kinematics {
                 } => c[*k] = *dir,
                 Step::Linear { axis, dir, .. } => point += dir * q[*axis],
                 Step::Rotary(t) => {
-                    let r = &turned(t);
+                    let r = &turned(angles, t);
                     point = t.move_point(r, &point);
                     for col in &mut c[..m] {
                         *col = r.apply(col);
@@ -1075,6 +1081,15 @@ impl Kinematics {
             }
         }
     }
+}
+
+/// The rotation of the free rotary axis `t` for its angle in `angles`
+/// (each free rotary axis is one step of the chain: its rotation is made
+/// where it is used).
+#[inline(always)]
+fn turned(angles: &[SlotAngle], t: &Turn) -> Turned {
+    let a = &angles[t.slot];
+    t.rotation(a.cos, a.sin)
 }
 
 /// The rows of Cramer's rule for the columns `c`: `x_k = rows[k]·rhs` solves
