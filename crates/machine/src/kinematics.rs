@@ -290,8 +290,13 @@ enum LinearSolve {
     /// Three free linear axes with no free rotary axis between them: their
     /// columns are constant inside the outermost of them, and so are the
     /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic), by column;
-    /// `axes`: the machine-file index of each column's axis.
-    Constant { rows: [V3; 3], axes: [usize; 3] },
+    /// `axes`: the machine-file index of each column's axis, `bounds` its
+    /// travel (as `Kinematics::free_lin_bounds`).
+    Constant {
+        rows: [V3; 3],
+        axes: [usize; 3],
+        bounds: [[f64; 2]; 3],
+    },
     /// Columns that depend on the angles, or fewer than three axes.
     General,
 }
@@ -504,10 +509,21 @@ impl Kinematics {
                 columns[*k] = *dir;
             }
         }
+        let free_lin_bounds: Vec<(usize, [f64; 2])> = free_lin
+            .iter()
+            .map(|&i| {
+                let bounds = match limits[i] {
+                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
+                    None => [f64::NEG_INFINITY, f64::INFINITY],
+                };
+                (i, bounds)
+            })
+            .collect();
         let linear_solve = match cramer_rows(&columns) {
             Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant {
                 rows,
                 axes: [free_lin[0], free_lin[1], free_lin[2]],
+                bounds: std::array::from_fn(|k| free_lin_bounds[k].1),
             },
             _ => LinearSolve::General,
         };
@@ -527,16 +543,6 @@ impl Kinematics {
         let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
         let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
         let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
-        let free_lin_bounds = free_lin
-            .iter()
-            .map(|&i| {
-                let bounds = match limits[i] {
-                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
-                    None => [f64::NEG_INFINITY, f64::INFINITY],
-                };
-                (i, bounds)
-            })
-            .collect();
         Kinematics {
             n,
             steps,
@@ -925,7 +931,7 @@ impl Kinematics {
                 Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
             }
         }
-        let LinearSolve::Constant { rows, axes } = &self.linear_solve else {
+        let LinearSolve::Constant { rows, axes, .. } = &self.linear_solve else {
             return self.solve_linear_general(q, angles, &y);
         };
         // The tool point with the free linear axes at zero.
@@ -1042,16 +1048,7 @@ impl Kinematics {
         }
         // Linear axes: their values do not change between equivalents. A
         // branch outside the linear travel is given once.
-        // (`Axis::accepts` with the bounds worked out once; the solved
-        // values are finite, see `solve_linear`.)
-        let violation = self
-            .free_lin_bounds
-            .iter()
-            .find(|&&(i, [lo, hi])| !(joints[i] >= lo && joints[i] <= hi))
-            .map(|&(i, _)| Violation {
-                axis: i,
-                value: joints[i],
-            });
+        let violation = self.linear_violation(&joints);
         let mut turn: [f64; N] = ranges.map(|r| r.first);
         loop {
             for k in 0..N {
@@ -1090,6 +1087,33 @@ impl Kinematics {
 fn turned(angles: &[SlotAngle], t: &Turn) -> Turned {
     let a = &angles[t.slot];
     t.rotation(a.cos, a.sin)
+}
+
+impl Kinematics {
+    /// The first free linear axis of `q` outside its travel, in
+    /// machine-file order (`Axis::accepts` with the bounds worked out once;
+    /// the solved values are finite, see `solve_linear`).
+    #[inline(always)]
+    fn linear_violation(&self, q: &Joints) -> Option<Violation> {
+        let outside = |&(i, [lo, hi]): &(usize, [f64; 2])| !(q[i] >= lo && q[i] <= hi);
+        let axis = match &self.linear_solve {
+            // Three axes, known here: the first outside, tested without
+            // a loop over a `Vec`.
+            LinearSolve::Constant { axes, bounds, .. } => {
+                let out: [bool; 3] = std::array::from_fn(|k| outside(&(axes[k], bounds[k])));
+                out.iter().position(|&o| o).map(|k| axes[k])
+            }
+            LinearSolve::General => self
+                .free_lin_bounds
+                .iter()
+                .find(|b| outside(b))
+                .map(|b| b.0),
+        };
+        axis.map(|i| Violation {
+            axis: i,
+            value: q[i],
+        })
+    }
 }
 
 /// The rows of Cramer's rule for the columns `c`: `x_k = rows[k]·rhs` solves
