@@ -1168,11 +1168,13 @@ struct SlotAngle {
 }
 
 impl Default for SlotAngle {
+    /// A placeholder, all zeros (cheap to write): every slot of a branch
+    /// that is solved is set by the orientation first.
     fn default() -> Self {
         SlotAngle {
-            cos: 1.0,
+            cos: 0.0,
             sin: 0.0,
-            x: 1.0,
+            x: 0.0,
             y: 0.0,
             degrees: 0.0,
         }
