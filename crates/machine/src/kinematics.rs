@@ -665,8 +665,9 @@ impl Kinematics {
     }
 
     /// [`Kinematics::solve`] for `N` free rotary axes: one piece of code,
-    /// its loops over the rotary slots unrolled for each `N`.
-    #[inline(always)]
+    /// its loops over the rotary slots unrolled for each `N` (each its own
+    /// function: a frame of its own size).
+    #[inline(never)]
     fn solve_n<const N: usize>(
         &self,
         pose: &Pose,
