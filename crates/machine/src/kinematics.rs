@@ -118,8 +118,6 @@ type V3 = Vector3<f64>;
 struct Rot([[f64; 3]; 3]);
 
 impl Rot {
-    const IDENTITY: Rot = Rot([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
-
     fn from_matrix(m: &Matrix3<f64>) -> Rot {
         Rot(std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)])))
     }
@@ -240,8 +238,6 @@ enum Turned {
 }
 
 impl Turned {
-    const IDENTITY: Turned = Turned::Matrix(Rot::IDENTITY);
-
     /// `self · v`.
     #[inline(always)]
     fn apply(&self, v: &V3) -> V3 {
@@ -293,14 +289,17 @@ enum Step {
 enum LinearSolve {
     /// Three free linear axes with no free rotary axis between them: their
     /// columns are constant inside the outermost of them, and so are the
-    /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic).
-    Constant([V3; 3]),
+    /// rows of Cramer's rule (`(c_j × c_k) / det`, cyclic), by column;
+    /// `axes`: the machine-file index of each column's axis, `bounds` its
+    /// travel (as `Kinematics::free_lin_bounds`).
+    Constant {
+        rows: [V3; 3],
+        axes: [usize; 3],
+        bounds: [[f64; 2]; 3],
+    },
     /// Columns that depend on the angles, or fewer than three axes.
     General,
 }
-
-/// The rotation matrices of the free rotary slots, for some angles.
-type Rots = [Turned; 3];
 
 /// A machine compiled for fast kinematics.
 #[derive(Debug, Clone)]
@@ -477,7 +476,6 @@ impl Kinematics {
                         Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
                         _ => None,
                     },
-                    turn: *t,
                 };
             }
         }
@@ -511,8 +509,22 @@ impl Kinematics {
                 columns[*k] = *dir;
             }
         }
+        let free_lin_bounds: Vec<(usize, [f64; 2])> = free_lin
+            .iter()
+            .map(|&i| {
+                let bounds = match limits[i] {
+                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
+                    None => [f64::NEG_INFINITY, f64::INFINITY],
+                };
+                (i, bounds)
+            })
+            .collect();
         let linear_solve = match cramer_rows(&columns) {
-            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant(rows),
+            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant {
+                rows,
+                axes: [free_lin[0], free_lin[1], free_lin[2]],
+                bounds: std::array::from_fn(|k| free_lin_bounds[k].1),
+            },
             _ => LinearSolve::General,
         };
 
@@ -531,16 +543,6 @@ impl Kinematics {
         let w1 = free_rot.first().map_or_else(V3::zeros, |r| r.1);
         let sp2 = Sp2::new(&w1, &sp2_w2, &sp2_p);
         let axis_to_sp2 = Rot::from_matrix(&(c0t * machine.workpiece_rotation));
-        let free_lin_bounds = free_lin
-            .iter()
-            .map(|&i| {
-                let bounds = match limits[i] {
-                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
-                    None => [f64::NEG_INFINITY, f64::INFINITY],
-                };
-                (i, bounds)
-            })
-            .collect();
         Kinematics {
             n,
             steps,
@@ -663,8 +665,9 @@ impl Kinematics {
     }
 
     /// [`Kinematics::solve`] for `N` free rotary axes: one piece of code,
-    /// its loops over the rotary slots unrolled for each `N`.
-    #[inline(always)]
+    /// its loops over the rotary slots unrolled for each `N` (each its own
+    /// function: a frame of its own size).
+    #[inline(never)]
     fn solve_n<const N: usize>(
         &self,
         pose: &Pose,
@@ -673,14 +676,15 @@ impl Kinematics {
         all_branches: bool,
     ) -> Result<(), IkError> {
         out.clear();
-        let mut branches = [Branch::default(); 2];
-        let count = match if N == 2 {
+        let mut branches = [Branch::<N>::default(); 2];
+        let two = if N == 2 {
             self.orient_two(pose, &mut branches)
         } else {
             None
-        } {
+        };
+        let count = match two {
             Some(count) => count,
-            None => self.orient(pose, hint, &mut branches)?,
+            None => self.orient_any(pose, hint, &mut branches)?,
         };
         // Branches whose rotary angles fit the travel first; the others are
         // only needed to say why nothing fits. An angle (its `atan2`) is
@@ -692,17 +696,19 @@ impl Kinematics {
         // the loops save.)
         let [b0, b1] = &mut branches;
         let second = count > 1;
-        if self.fits::<N>(b0) {
+        let fits0 = self.fits::<N>(b0);
+        if fits0 {
             self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
         }
-        if second && self.fits::<N>(b1) {
+        let fits1 = second && self.fits::<N>(b1);
+        if fits1 {
             self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
         }
         if all_branches || !out.iter().any(Solution::is_valid) {
-            if !self.fits::<N>(b0) {
+            if !fits0 {
                 self.solve_branch::<N>(b0, 0, &pose.point, hint, out);
             }
-            if second && !self.fits::<N>(b1) {
+            if second && !fits1 {
                 self.solve_branch::<N>(b1, 1, &pose.point, hint, out);
             }
         }
@@ -716,8 +722,13 @@ impl Kinematics {
     /// solutions and no angle is free (the usual pose): the number of
     /// branches. `None` otherwise, for [`Kinematics::orient`] to decide
     /// (from the very same subproblem).
+    /// (Generic only to fit [`Kinematics::solve_n`]: called with `N = 2`.)
     #[inline(always)]
-    fn orient_two(&self, pose: &Pose, branches: &mut [Branch; 2]) -> Option<usize> {
+    fn orient_two<const N: usize>(
+        &self,
+        pose: &Pose,
+        branches: &mut [Branch<N>; 2],
+    ) -> Option<usize> {
         let (sols, n) = self
             .sp2
             .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
@@ -729,6 +740,24 @@ impl Kinematics {
         (n > 0).then_some(n)
     }
 
+    /// [`Kinematics::orient`] for `N` slots.
+    #[cold]
+    #[inline(never)]
+    fn orient_any<const N: usize>(
+        &self,
+        pose: &Pose,
+        hint: Option<&[f64]>,
+        branches: &mut [Branch<N>; 2],
+    ) -> Result<usize, IkError> {
+        let mut all = [Branch::default(); 2];
+        let count = self.orient(pose, hint, &mut all)?;
+        for (b, a) in branches.iter_mut().zip(&all) {
+            b.angles.copy_from_slice(&a.angles[..N]);
+            b.singular = a.singular;
+        }
+        Ok(count)
+    }
+
     /// The orientation branches of `pose`, for any number of free rotary
     /// axes and singular poses: the number of branches.
     #[cold]
@@ -737,7 +766,7 @@ impl Kinematics {
         &self,
         pose: &Pose,
         hint: Option<&[f64]>,
-        branches: &mut [Branch; 2],
+        branches: &mut [Branch<3>; 2],
     ) -> Result<usize, IkError> {
         let hint_of = |i: usize| hint.map_or(0.0, |h| h[i]);
         let target = self.rw0 * pose.axis;
@@ -843,87 +872,94 @@ impl Kinematics {
     }
 
     /// Whether every rotary angle of the branch has an equivalent inside its
-    /// travel (decided once per branch). An angle not yet known in degrees
+    /// travel (asked once per branch). An angle not yet known in degrees
     /// is first tried with the arc test, which leaves out its `atan2` when
     /// the answer is no.
     #[inline(always)]
-    fn fits<const N: usize>(&self, b: &mut Branch) -> bool {
-        if let Some(f) = b.fits {
-            return f;
-        }
-        let mut f = true;
+    fn fits<const N: usize>(&self, b: &mut Branch<N>) -> bool {
         for (slot, a) in self.slots[..N].iter().zip(&mut b.angles) {
             let Some(arc) = &slot.arc else {
                 continue;
             };
-            let inside = match (a.degrees, arc.contains(a.cos, a.sin)) {
-                (None, Some(inside)) => inside,
+            let inside = match arc.contains(a.cos, a.sin) {
+                Some(inside) if !a.has_degrees() => inside,
                 _ => slot.range(a.in_degrees(), None).has_equivalent(),
             };
             if !inside {
-                f = false;
-                break;
+                return false;
             }
         }
-        b.fits = Some(f);
-        f
+        true
     }
 
     /// The linear axes of one orientation branch, and its solutions.
     #[inline(always)]
     fn solve_branch<const N: usize>(
         &self,
-        b: &mut Branch,
+        b: &mut Branch<N>,
         branch: u8,
         point: &V3,
         hint: Option<&[f64]>,
         out: &mut Vec<Solution>,
     ) {
         let mut joints = self.fixed;
-        let mut rots = [Turned::IDENTITY; 3];
-        let mut ranges = [SlotRange::default(); 3];
-        for k in 0..N {
-            let (slot, a) = (&self.slots[k], &mut b.angles[k]);
-            ranges[k] = slot.range(a.in_degrees(), hint);
-            joints[slot.axis] = ranges[k].raw;
-            rots[k] = slot.turn.rotation(a.cos, a.sin);
+        // Arrays of the slots there are: no setup of unused ones.
+        let mut ranges = [SlotRange::default(); N];
+        for ((slot, a), r) in self.slots.iter().zip(&mut b.angles).zip(&mut ranges) {
+            *r = slot.range(a.in_degrees(), hint);
+            joints[slot.axis] = r.raw;
         }
-        if self.solve_linear(&mut joints, &rots, point) {
+        if self.solve_linear(&mut joints, &b.angles, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
-    /// With every rotary angle set in `q` (and their rotations in `rots`),
-    /// solves the free linear axes so that the tool point lands on `target`
-    /// (part frame), in place (no copies of the joints in and out); `false`
-    /// when they cannot.
-    fn solve_linear(&self, q: &mut Joints, rots: &Rots, target: &V3) -> bool {
+    /// With every rotary angle set in `q` (and their cosines and sines in
+    /// `angles`, by slot), solves the free linear axes so that the tool
+    /// point lands on `target` (part frame), in place (no copies of the
+    /// joints in and out); `false` when they cannot.
+    ///
+    /// (Inlined for the precomputed solve of most machines, the general one
+    /// out of line.)
+    #[inline(always)]
+    fn solve_linear(&self, q: &mut Joints, angles: &[SlotAngle], target: &V3) -> bool {
         // Bring the target inside the steps outside the linear axes.
         let mut y = *target;
         for step in &self.steps[..self.split] {
             match step {
                 // Locked linear axes only: the split is at the first free one.
                 Step::Linear { axis, dir, .. } => y -= dir * q[*axis],
-                Step::Rotary(t) => y = t.unmove_point(&rots[t.slot], &y),
+                Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
             }
         }
+        let LinearSolve::Constant { rows, axes, .. } = &self.linear_solve else {
+            return self.solve_linear_general(q, angles, &y);
+        };
+        // The tool point with the free linear axes at zero.
+        let mut point = self.tip;
+        for step in self.inner_fixed.iter().rev() {
+            match step {
+                Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                Step::Rotary(t) => point = t.move_point(&turned(angles, t), &point),
+            }
+        }
+        let rhs = y - point;
+        // Three axes, known here: no loops over `free_lin`.
+        let values = rows.map(|r| r.dot(&rhs));
+        for (&i, v) in axes.iter().zip(values) {
+            q[i] = v;
+        }
+        values.iter().all(|v| v.is_finite())
+    }
+
+    /// [`Kinematics::solve_linear`] inside the steps outside the linear
+    /// axes (`y`: the target there) when the columns depend on the angles
+    /// or there are fewer than three linear axes.
+    #[inline(never)]
+    fn solve_linear_general(&self, q: &mut Joints, angles: &[SlotAngle], y: &V3) -> bool {
+        let y = *y;
         let inner = &self.steps[self.split..];
         let m = self.free_lin.len();
-        if let LinearSolve::Constant(rows) = &self.linear_solve {
-            // The tool point with the free linear axes at zero.
-            let mut point = self.tip;
-            for step in self.inner_fixed.iter().rev() {
-                match step {
-                    Step::Linear { axis, dir, .. } => point += dir * q[*axis],
-                    Step::Rotary(t) => point = t.move_point(&rots[t.slot], &point),
-                }
-            }
-            let rhs = y - point;
-            for (k, &i) in self.free_lin.iter().enumerate() {
-                q[i] = rows[k].dot(&rhs);
-            }
-            return self.free_lin.iter().all(|&i| q[i].is_finite());
-        }
 
         // The tool point with the free linear axes at zero, and the column
         // of each free linear axis (how the point moves per unit of it).
@@ -938,7 +974,7 @@ impl Kinematics {
                 } => c[*k] = *dir,
                 Step::Linear { axis, dir, .. } => point += dir * q[*axis],
                 Step::Rotary(t) => {
-                    let r = &rots[t.slot];
+                    let r = &turned(angles, t);
                     point = t.move_point(r, &point);
                     for col in &mut c[..m] {
                         *col = r.apply(col);
@@ -993,12 +1029,12 @@ impl Kinematics {
     fn push_equivalents<const N: usize>(
         &self,
         mut joints: Joints,
-        ranges: &[SlotRange; 3],
+        ranges: &[SlotRange; N],
         branch: u8,
         singular: bool,
         out: &mut Vec<Solution>,
     ) {
-        if let Some(slot) = ranges[..N].iter().position(|r| !r.has_equivalent()) {
+        if let Some(slot) = ranges.iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
             out.push(Solution {
                 joints,
@@ -1013,20 +1049,8 @@ impl Kinematics {
         }
         // Linear axes: their values do not change between equivalents. A
         // branch outside the linear travel is given once.
-        // (`Axis::accepts` with the bounds worked out once; the solved
-        // values are finite, see `solve_linear`.)
-        let violation = self
-            .free_lin_bounds
-            .iter()
-            .find(|&&(i, [lo, hi])| !(joints[i] >= lo && joints[i] <= hi))
-            .map(|&(i, _)| Violation {
-                axis: i,
-                value: joints[i],
-            });
-        let mut turn = [0.0; 3];
-        for (t, r) in turn.iter_mut().zip(ranges) {
-            *t = r.first;
-        }
+        let violation = self.linear_violation(&joints);
+        let mut turn: [f64; N] = ranges.map(|r| r.first);
         loop {
             for k in 0..N {
                 joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
@@ -1057,6 +1081,42 @@ impl Kinematics {
     }
 }
 
+/// The rotation of the free rotary axis `t` for its angle in `angles`
+/// (each free rotary axis is one step of the chain: its rotation is made
+/// where it is used).
+#[inline(always)]
+fn turned(angles: &[SlotAngle], t: &Turn) -> Turned {
+    let a = &angles[t.slot];
+    t.rotation(a.cos, a.sin)
+}
+
+impl Kinematics {
+    /// The first free linear axis of `q` outside its travel, in
+    /// machine-file order (`Axis::accepts` with the bounds worked out once;
+    /// the solved values are finite, see `solve_linear`).
+    #[inline(always)]
+    fn linear_violation(&self, q: &Joints) -> Option<Violation> {
+        let outside = |&(i, [lo, hi]): &(usize, [f64; 2])| !(q[i] >= lo && q[i] <= hi);
+        let axis = match &self.linear_solve {
+            // Three axes, known here: the first outside, tested without
+            // a loop over a `Vec`.
+            LinearSolve::Constant { axes, bounds, .. } => {
+                let out: [bool; 3] = std::array::from_fn(|k| outside(&(axes[k], bounds[k])));
+                out.iter().position(|&o| o).map(|k| axes[k])
+            }
+            LinearSolve::General => self
+                .free_lin_bounds
+                .iter()
+                .find(|b| outside(b))
+                .map(|b| b.0),
+        };
+        axis.map(|i| Violation {
+            axis: i,
+            value: q[i],
+        })
+    }
+}
+
 /// The rows of Cramer's rule for the columns `c`: `x_k = rows[k]·rhs` solves
 /// `Σ x_k c_k = rhs`. `None` for a (nearly) singular matrix.
 fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
@@ -1070,13 +1130,27 @@ fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
     Some(n.map(|v| v / det))
 }
 
-/// One solved orientation branch: the angle of every free rotary slot,
-/// known as cosine and sine first, in degrees once needed.
-#[derive(Clone, Copy, Default)]
-struct Branch {
-    angles: [SlotAngle; 3],
-    fits: Option<bool>,
+/// One solved orientation branch: the angle of every free rotary slot
+/// (`N` of them), known as cosine and sine first, in degrees once needed.
+#[derive(Clone, Copy)]
+struct Branch<const N: usize> {
+    angles: [SlotAngle; N],
     singular: bool,
+}
+
+impl<const N: usize> Branch<N> {
+    fn new(angles: [SlotAngle; N]) -> Self {
+        Branch {
+            angles,
+            singular: false,
+        }
+    }
+}
+
+impl<const N: usize> Default for Branch<N> {
+    fn default() -> Self {
+        Branch::new([SlotAngle::default(); N])
+    }
 }
 
 /// The angle of one free rotary slot.
@@ -1088,17 +1162,22 @@ struct SlotAngle {
     /// `degrees` is known from the start.
     x: f64,
     y: f64,
-    degrees: Option<f64>,
+    /// NaN until known: a plain number, where an `Option` would add a tag
+    /// and its padding to every copy of a branch. (A NaN hint gives a NaN
+    /// `atan2`: taking it again changes nothing.)
+    degrees: f64,
 }
 
 impl Default for SlotAngle {
+    /// A placeholder, all zeros (cheap to write): every slot of a branch
+    /// that is solved is set by the orientation first.
     fn default() -> Self {
         SlotAngle {
-            cos: 1.0,
+            cos: 0.0,
             sin: 0.0,
-            x: 1.0,
+            x: 0.0,
             y: 0.0,
-            degrees: Some(0.0),
+            degrees: 0.0,
         }
     }
 }
@@ -1112,7 +1191,7 @@ impl SlotAngle {
             sin,
             x,
             y,
-            degrees: None,
+            degrees: f64::NAN,
         }
     }
 
@@ -1126,21 +1205,34 @@ impl SlotAngle {
             sin,
             x: cos,
             y: sin,
-            degrees: Some(rad.to_degrees()),
+            degrees: rad.to_degrees(),
         }
     }
 
     /// The angle in degrees (its `atan2` taken once).
     #[inline]
     fn in_degrees(&mut self) -> f64 {
-        *self
-            .degrees
-            .get_or_insert_with(|| atan2_deg(self.y, self.x))
+        if !self.has_degrees() {
+            self.degrees = xy_degrees(self.x, self.y);
+        }
+        self.degrees
+    }
+
+    #[inline]
+    fn has_degrees(&self) -> bool {
+        !self.degrees.is_nan()
     }
 
     fn rotation(&self, w: &V3) -> Matrix3<f64> {
         rotation_cs(w, self.cos, self.sin)
     }
+}
+
+/// The angle of `(x, y)` in degrees, out of line: inlined, its code
+/// crowds the registers of the solver around it.
+#[inline(never)]
+fn xy_degrees(x: f64, y: f64) -> f64 {
+    atan2_deg(y, x)
 }
 
 /// The travel `[lo, hi]` of a rotary axis (less than a full turn and a
@@ -1183,25 +1275,13 @@ impl Arc {
 }
 
 /// A free rotary axis, by its slot.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Slot {
     /// Machine-file index of the axis.
     axis: usize,
     limits: Option<[f64; 2]>,
     /// The arc test of a travel of less than a full turn and a degree.
     arc: Option<Arc>,
-    turn: Turn,
-}
-
-impl Default for Slot {
-    fn default() -> Self {
-        Slot {
-            axis: 0,
-            limits: None,
-            arc: None,
-            turn: Turn::new(0, 0, V3::z(), V3::zeros()),
-        }
-    }
 }
 
 impl Slot {
@@ -1280,6 +1360,17 @@ fn turn_range(lo: f64, hi: f64, principal: f64) -> (f64, f64) {
 /// Angle in degrees wrapped to (−180, 180].
 #[inline]
 pub fn wrap180(deg: f64) -> f64 {
+    // Inside (−180, 180) the formula below gives `deg` back to the bit
+    // (no turn, or one turn down and back up, both exact): skip it.
+    if deg.abs() < 180.0 {
+        return deg;
+    }
+    wrap180_by_turns(deg)
+}
+
+/// [`wrap180`] by the nearest whole turn.
+#[inline]
+fn wrap180_by_turns(deg: f64) -> f64 {
     let w = deg - 360.0 * turns_nearest(deg / 360.0);
     if w <= -180.0 {
         w + 360.0

@@ -325,6 +325,49 @@ proptest! {
         }
     }
 
+    /// The travel test of the precomputed linear solve (its three axes
+    /// written out) finds what the general one finds, for values inside,
+    /// outside and at the edges of the travel.
+    #[test]
+    fn linear_violation_of_the_precomputed_solve_is_the_general_one(mut rng in rngs()) {
+        // A machine with the precomputed solve.
+        let (m, kin) = loop {
+            let m = random_machine(&mut rng);
+            let kin = Kinematics::new(&m);
+            if matches!(kin.linear_solve, LinearSolve::Constant { .. }) {
+                break (m, kin);
+            }
+        };
+        let mut general = kin.clone();
+        general.linear_solve = LinearSolve::General;
+        for _ in 0..16 {
+            let mut q = [0.0; MAX_AXES];
+            for v in &mut q[..m.axes.len()] {
+                let edge = if rng.chance(0.5) { 2000.0 } else { -2000.0 };
+                *v = match (rng.next() * 3.0) as u32 {
+                    0 => rng.range(-2500.0, 2500.0),
+                    1 => edge + rng.range(-2e-9, 2e-9),
+                    _ => rng.range(-1000.0, 1000.0),
+                };
+            }
+            prop_assert_eq!(kin.linear_violation(&q), general.linear_violation(&q));
+        }
+    }
+
+    /// `wrap180` skips its turn inside (−180°, 180°): the same bits as by
+    /// the turn, there and an ulp or two either side of the edges.
+    #[test]
+    fn wrap180_shortcut_is_the_turn(deg in -200.0..200.0f64, edge in 0usize..3, ulps in -3i64..=3) {
+        let deg = match edge {
+            0 => deg,
+            1 => f64::from_bits((180.0f64.to_bits() as i64 + ulps) as u64),
+            _ => -f64::from_bits((180.0f64.to_bits() as i64 + ulps) as u64),
+        };
+        for d in [deg, deg * 1e-300, deg / 360.0] {
+            prop_assert_eq!(wrap180(d).to_bits(), wrap180_by_turns(d).to_bits(), "{}", d);
+        }
+    }
+
     /// The arc test never contradicts the turn count it stands in for.
     #[test]
     fn arc_test_agrees_with_turn_range(
