@@ -24,6 +24,11 @@ use crate::pressure::Wheel;
 use crate::solve::{Hold, solve_near};
 use crate::summary::SingularStretch;
 
+/// Settled points (see [`PathPlan::is_full`]) written at once: enough that
+/// a decision costs next to nothing, few enough that the points, their
+/// candidates and their CL text stay in the cache until written.
+const SETTLED_BATCH: usize = 256;
+
 /// One CL point waiting for the plan.
 #[derive(Debug, Clone)]
 pub(crate) struct PlanPoint {
@@ -226,9 +231,12 @@ impl PathPlan {
         Ok(())
     }
 
-    /// Whether the planner should decide now (see [`Trellis::is_full`]).
+    /// Whether the planner should decide now: the trellis is full, or
+    /// [`SETTLED_BATCH`] points or more wait in a settled trellis
+    /// ([`Trellis::is_settled`]: deciding them changes nothing, and the
+    /// waiting points stay in the cache).
     pub fn is_full(&self) -> bool {
-        self.trellis.is_full()
+        self.trellis.is_full() || (self.trellis.len() >= SETTLED_BATCH && self.trellis.is_settled())
     }
 
     /// Decides the waiting points and writes them, with the outputs among
@@ -244,7 +252,11 @@ impl PathPlan {
         all: bool,
     ) -> Result<(), PostError> {
         self.choices.clear();
-        self.trellis.decide(&mut self.choices);
+        if all || self.trellis.is_full() {
+            self.trellis.decide(&mut self.choices);
+        } else {
+            self.trellis.decide_settled(&mut self.choices);
+        }
         let end = if all {
             self.points.len()
         } else {
@@ -318,7 +330,9 @@ impl PathPlan {
                 }
             }
         }
-        if let Some((node, branch, _)) = &self.last {
+        // The last point written is the trellis's anchor already unless it
+        // was decided outside it (a singular point at the end).
+        if all && let Some((node, branch, _)) = &self.last {
             self.trellis.set_anchor(node.joints, *branch);
         }
         Ok(())

@@ -3,7 +3,11 @@
 //! cheapest sequence through them by [`Costs`]. Work and memory are linear in
 //! the number of points; the layers wait in memory until the caller decides
 //! (at the end of the input, or every `lag` points, see
-//! [`Trellis::is_full`]).
+//! [`Trellis::is_full`]), or until the last layer has a single candidate
+//! ([`Trellis::is_settled`]): every sequence of the later points goes through
+//! it, so the waiting points are decided already, and deciding them then
+//! ([`Trellis::decide_settled`]) keeps the layers small (in the cache) and
+//! changes no decision.
 
 use kinpost_machine::{Joints, Solution};
 
@@ -90,6 +94,14 @@ pub struct Trellis {
     /// The configuration before the first layer (the last decided point),
     /// if any.
     anchor: Option<(Joints, u8)>,
+    /// The cost of the cheapest sequence into the anchor since the last
+    /// [`Trellis::decide`] (0 after it): what a settled decision leaves
+    /// for the sums of the later points, so that they are those of one
+    /// decision at the end, bit for bit.
+    anchor_cost: f64,
+    /// Points pushed since the last [`Trellis::decide`] (settled decisions
+    /// do not count as one): `lag` counts these.
+    pushed: usize,
 }
 
 impl Trellis {
@@ -106,6 +118,8 @@ impl Trellis {
             next: Vec::new(),
             cheapest: 0,
             anchor: None,
+            anchor_cost: 0.0,
+            pushed: 0,
         }
     }
 
@@ -122,9 +136,16 @@ impl Trellis {
         self.layers.is_empty()
     }
 
-    /// Whether the caller should decide now.
+    /// Whether the caller should decide now: `lag` points were pushed since
+    /// the last [`Trellis::decide`].
     pub fn is_full(&self) -> bool {
-        self.layers.len() >= self.lag
+        self.pushed >= self.lag
+    }
+
+    /// Whether the waiting points are decided already: the last layer has a
+    /// single candidate, which every sequence of the later points extends.
+    pub fn is_settled(&self) -> bool {
+        self.tips.len() == 1 && !self.layers.is_empty()
     }
 
     /// The configuration before the waiting points.
@@ -186,6 +207,7 @@ impl Trellis {
         self.cheapest = cheapest;
         std::mem::swap(&mut self.tips, &mut self.next);
         self.layers.push(first as u32);
+        self.pushed += 1;
         true
     }
 
@@ -220,8 +242,10 @@ impl Trellis {
                     let (c, continuous) = self
                         .costs
                         .transition(&from, branch, &s.joints, s.branch, link);
+                    // The same sum as from a previous layer (the anchor's
+                    // cost is 0 after a decision that is not settled).
                     best = (
-                        c + if continuous { 0.0 } else { RECONFIGURE },
+                        self.anchor_cost + c + if continuous { 0.0 } else { RECONFIGURE },
                         u32::MAX,
                         continuous,
                     );
@@ -244,8 +268,29 @@ impl Trellis {
     }
 
     /// Decides every waiting point: the cheapest sequence, in path order,
-    /// appended to `out`. The last choice becomes the anchor of what follows.
+    /// appended to `out`. The last choice becomes the anchor of what follows,
+    /// whose costs start from zero.
     pub fn decide(&mut self, out: &mut Vec<Choice>) {
+        self.pushed = 0;
+        self.anchor_cost = 0.0;
+        self.decide_waiting(out);
+    }
+
+    /// [`Trellis::decide`] for a settled trellis ([`Trellis::is_settled`]):
+    /// the same choices, and the later points are costed as if nothing had
+    /// been decided (their decisions are those of one decision at the end,
+    /// bit for bit, and [`Trellis::is_full`] still counts them from the last
+    /// [`Trellis::decide`]). Not settled, it is [`Trellis::decide`].
+    pub fn decide_settled(&mut self, out: &mut Vec<Choice>) {
+        if !self.is_settled() {
+            return self.decide(out);
+        }
+        let cost = self.tips[0].cost;
+        self.decide_waiting(out);
+        self.anchor_cost = cost;
+    }
+
+    fn decide_waiting(&mut self, out: &mut Vec<Choice>) {
         let Some(&last) = self.layers.last() else {
             return;
         };
@@ -277,9 +322,10 @@ impl Trellis {
     }
 
     /// Sets the configuration the machine is in (e.g. after points decided
-    /// outside the trellis).
+    /// outside the trellis); the costs of what follows start from zero.
     pub fn set_anchor(&mut self, joints: Joints, branch: u8) {
         self.anchor = Some((joints, branch));
+        self.anchor_cost = 0.0;
     }
 }
 

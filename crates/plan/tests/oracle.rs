@@ -242,3 +242,44 @@ proptest! {
         prop_assert_eq!(bits(fast.anchor()), bits(slow.anchor.as_ref().map(|(j, _)| j)));
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    /// Deciding a settled trellis at once changes no decision: the choices,
+    /// the hints and the anchor are those of deciding only when it is full,
+    /// bit for bit (the later points are costed as if nothing had been
+    /// decided).
+    #[test]
+    fn settled_decisions_change_nothing(
+        which in 0u8..4,
+        lag in 1usize..50,
+        cone in prop_oneof![Just(0.0), 0.1..5.0f64],
+        singular in prop::option::of(0usize..6),
+        path in proptest::collection::vec(
+            (proptest::collection::vec(solution(), 0..4), link()),
+            1..60,
+        ),
+    ) {
+        let costs = Costs::new(&machine(which), cone, singular);
+        let mut early = Trellis::new(costs.clone(), lag);
+        let mut late = Trellis::new(costs, lag);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for (layer, link) in &path {
+            prop_assert_eq!(early.push(layer, *link), late.push(layer, *link));
+            prop_assert_eq!(bits(early.best_last()), bits(late.best_last()));
+            prop_assert_eq!(early.is_full(), late.is_full());
+            if early.is_full() {
+                early.decide(&mut a);
+                late.decide(&mut b);
+            } else if early.is_settled() {
+                early.decide_settled(&mut a);
+                prop_assert!(early.is_empty());
+            }
+        }
+        early.decide(&mut a);
+        late.decide(&mut b);
+        prop_assert!(same(&a, &b));
+        prop_assert_eq!(bits(early.anchor()), bits(late.anchor()));
+    }
+}
