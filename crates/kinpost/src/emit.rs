@@ -7,6 +7,7 @@
 
 use std::io::Write;
 
+use kinpost_machine::angle::SinCosMemo;
 use kinpost_machine::{
     Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
 };
@@ -107,6 +108,9 @@ pub(crate) struct Emitter<W: Write> {
     pressure: f64,
     last: Option<Last>,
     written: Joints,
+    /// The sines and cosines of the written rotary values, for the next
+    /// block's check.
+    sin_cos: SinCosMemo,
     solutions: Vec<Solution>,
     inserted: Vec<Node>,
     pub stats: CheckStats,
@@ -139,6 +143,7 @@ impl<W: Write> Emitter<W> {
             pressure: f64::NAN,
             last: None,
             written: [0.0; MAX_AXES],
+            sin_cos: SinCosMemo::default(),
             solutions: Vec::with_capacity(16),
             inserted: Vec::new(),
             stats: CheckStats::default(),
@@ -424,7 +429,7 @@ impl<W: Write> Emitter<W> {
         }
         self.writer
             .quantize_axes(&values[..n], &mut self.written[..n]);
-        let (mut reached, written_lever) = kin.fk_lever(&self.written[..n]);
+        let (mut reached, written_lever) = kin.fk_lever(&self.written[..n], &mut self.sin_cos);
         // The lever at the exact values, from that at the written ones.
         let (w, v) = self.rounding_travel;
         let mut lever = lever_over(written_lever, w, v);

@@ -41,6 +41,36 @@ pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
     }
 }
 
+/// [`sin_cos_deg`] of the last angle of each axis, remembered by its bits:
+/// the value written for a rotary axis repeats from block to block while the
+/// axis turns less than its last decimal, and its sine and cosine need not be
+/// worked out again. Gives the bits [`sin_cos_deg`] gives.
+#[derive(Debug, Clone)]
+pub struct SinCosMemo {
+    last: [(u64, (f64, f64)); crate::MAX_AXES],
+}
+
+impl Default for SinCosMemo {
+    /// Every axis at 0° (whose sine and cosine are exact).
+    fn default() -> Self {
+        SinCosMemo {
+            last: [(0f64.to_bits(), (0.0, 1.0)); crate::MAX_AXES],
+        }
+    }
+}
+
+impl SinCosMemo {
+    /// `sin_cos_deg(deg)` for axis `axis` (below [`crate::MAX_AXES`]).
+    #[inline(always)]
+    pub fn sin_cos_deg(&mut self, axis: usize, deg: f64) -> (f64, f64) {
+        let slot = &mut self.last[axis];
+        if slot.0 != deg.to_bits() {
+            *slot = (deg.to_bits(), sin_cos_deg(deg));
+        }
+        slot.1
+    }
+}
+
 /// sin x for |x| ≤ π/4 (fdlibm `__kernel_sin` with no tail).
 #[inline(always)]
 fn sin_kernel(x: f64) -> f64 {
@@ -174,6 +204,29 @@ mod tests {
         }
         let scale = a.abs().max(b.abs());
         (a - b).abs() / (scale * f64::EPSILON)
+    }
+
+    #[test]
+    fn the_memo_gives_the_bits_of_the_function() {
+        let bits = |(s, c): (f64, f64)| (s.to_bits(), c.to_bits());
+        let mut memo = SinCosMemo::default();
+        // Its initial entries (0°), then misses, hits and a -0.
+        for (axis, deg) in [
+            (0, 0.0),
+            (3, 0.0),
+            (3, 12.5),
+            (3, 12.5),
+            (3, -0.0),
+            (8, 1e-300),
+        ] {
+            assert_eq!(
+                bits(memo.sin_cos_deg(axis, deg)),
+                bits(sin_cos_deg(deg)),
+                "{deg}"
+            );
+        }
+        let nan = memo.sin_cos_deg(1, f64::NAN);
+        assert!(nan.0.is_nan() && nan.1.is_nan());
     }
 
     #[test]

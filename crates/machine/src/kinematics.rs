@@ -577,14 +577,19 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
-        self.chain::<false>(q).0
+        self.chain::<false>(q, |_, deg| sin_cos_deg(deg)).0
     }
 
     /// The forward kinematics, and with `LEVER` the largest distance from
     /// the tool point to the point of a free rotary axis line (see
     /// [`Kinematics::fk_lever`]).
+    /// `sin_cos(axis, degrees)` gives the sine and cosine of an axis value.
     #[inline(always)]
-    fn chain<const LEVER: bool>(&self, q: &[f64]) -> (Pose, f64) {
+    fn chain<const LEVER: bool>(
+        &self,
+        q: &[f64],
+        mut sin_cos: impl FnMut(usize, f64) -> (f64, f64),
+    ) -> (Pose, f64) {
         let mut point = self.tip;
         let mut axis = self.tip_axis;
         let mut reference = self.tip_reference;
@@ -601,7 +606,7 @@ impl Kinematics {
                         // point.
                         lever2 = lever2.max((point - t.point).norm_squared());
                     }
-                    let (s, c) = sin_cos_deg(q[t.axis]);
+                    let (s, c) = sin_cos(t.axis, q[t.axis]);
                     let m = t.rotation(c, s);
                     point = t.move_point(&m, &point);
                     axis = m.apply(&axis);

@@ -26,6 +26,7 @@
 //! the motion is within `max|p''| / 8` of the midpoint of the chord.
 
 use super::Kinematics;
+use crate::angle::SinCosMemo;
 use crate::model::Pose;
 
 /// Upper bound of the lever over a straight joint motion of rotary travel
@@ -50,11 +51,13 @@ pub fn midpoint_bound(lever: f64, w: f64, v: f64) -> f64 {
 }
 
 impl Kinematics {
-    /// Forward kinematics of `q` (as [`Kinematics::fk`]) and its lever: the
-    /// largest distance from the tool point to the reference point of a free
-    /// rotary axis (0 without one).
-    pub fn fk_lever(&self, q: &[f64]) -> (Pose, f64) {
-        self.chain::<true>(q)
+    /// Forward kinematics of `q` (as [`Kinematics::fk`], bit for bit) and
+    /// its lever: the largest distance from the tool point to the reference
+    /// point of a free rotary axis (0 without one). `memo` keeps the sines
+    /// and cosines of the rotary values for the next call (a sequence of
+    /// blocks whose rotary values often repeat).
+    pub fn fk_lever(&self, q: &[f64], memo: &mut SinCosMemo) -> (Pose, f64) {
+        self.chain::<true>(q, |axis, deg| memo.sin_cos_deg(axis, deg))
     }
 
     /// The travel of the straight joint motion from `a` to `b`: summed over
@@ -97,8 +100,14 @@ mod tests {
         let m = builtin::load("mts1600").unwrap().unwrap();
         let kin = Kinematics::new(&m);
         let q = [459.0, 12.0, 8.8, 361.4, -17.0, 0.0];
-        let (pose, lever) = kin.fk_lever(&q);
-        assert_eq!(pose, kin.fk(&q));
-        assert!(lever > 0.0 && lever.is_finite());
+        let mut memo = SinCosMemo::default();
+        for q in [q, q, [459.0, 12.0, 8.8, 361.4, -17.5, 0.0], q] {
+            let (pose, lever) = kin.fk_lever(&q, &mut memo);
+            let want = kin.fk(&q);
+            let bits = |v: &nalgebra::Vector3<f64>| v.map(f64::to_bits);
+            assert_eq!(bits(&pose.point), bits(&want.point));
+            assert_eq!(bits(&pose.axis), bits(&want.axis));
+            assert!(lever > 0.0 && lever.is_finite());
+        }
     }
 }
