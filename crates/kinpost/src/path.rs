@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use kinpost_diag::Diagnostic;
 use kinpost_machine::angle::{atan2_deg, atan2_rad};
-use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_machine::{Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
 use nalgebra::Vector3;
@@ -84,6 +84,11 @@ pub(crate) struct PathPlan {
     /// Distance from the tool axis of the last point in the trellis to the
     /// singular direction (`None`: no singularity, or no point yet).
     planned_pole: Option<Pole>,
+    /// The folds of the machine (see [`Folds`]), if it has any.
+    folds: Option<Folds>,
+    /// The distance of the last point in the trellis to the nearest fold
+    /// (radians) and the separation of its branches (see [`separation`]).
+    planned_fold: Option<(f64, f64)>,
     segment: u64,
     break_pending: bool,
     /// The last point written: its node, branch and segment.
@@ -119,6 +124,8 @@ impl PathPlan {
             free: true,
             previous_axes: None,
             planned_pole: None,
+            folds: kin.folds(),
+            planned_fold: None,
             segment: 0,
             break_pending: true,
             last: None,
@@ -200,12 +207,31 @@ impl PathPlan {
                 self.across = true;
             }
             self.planned_pole = pole;
+            // The tool axis may have passed a fold between the two points
+            // (its distances to it add up to no more than the turn): the
+            // branches meet there, and the angles may move by as much as
+            // the branches lie apart at the two points.
+            let fold = self.folds.map(|f| {
+                (
+                    f.distance(&pose.axis),
+                    separation(&self.solutions, &self.rotary),
+                )
+            });
+            let mut fold_deg = 0.0;
+            if let (Some((d0, s0)), Some((d1, s1))) = (self.planned_fold, fold)
+                && d0 + d1 <= self.turn.to_radians() + 1e-12
+                && (s0 + s1).is_finite()
+            {
+                fold_deg = s0 + s1;
+            }
+            self.planned_fold = fold;
             let link = if self.free {
                 Link::Free
             } else {
                 Link::Cut {
                     turn_deg: self.turn,
                     across_singular: self.across,
+                    fold_deg,
                 }
             };
             if !self.trellis.push(&self.solutions, link) {
@@ -552,6 +578,23 @@ impl Pole {
         (a.lower_rad() + b.lower_rad()).to_degrees() <= limit
             && a.exact_rad().to_degrees() + b.exact_rad().to_degrees() <= limit
     }
+}
+
+/// How far apart the branches of a point lie: over the pairs of candidates
+/// of different branches, the smallest largest difference of a rotary axis
+/// (degrees); infinite when the candidates are of one branch.
+fn separation(solutions: &[Solution], rotary: &[usize]) -> f64 {
+    let mut closest = f64::INFINITY;
+    for (k, a) in solutions.iter().enumerate() {
+        for b in solutions[k + 1..].iter().filter(|b| b.branch != a.branch) {
+            let apart = rotary
+                .iter()
+                .map(|&i| (a.joints[i] - b.joints[i]).abs())
+                .fold(0.0, f64::max);
+            closest = closest.min(apart);
+        }
+    }
+    closest
 }
 
 /// Angle between unit vectors, degrees (the turn of the tool axis between

@@ -36,6 +36,7 @@ pub fn layers(points: usize, per_point: usize) -> Vec<(Vec<Solution>, Link)> {
                 Link::Cut {
                     turn_deg: 0.05,
                     across_singular: false,
+                    fold_deg: 0.0,
                 }
             };
             (all[..per_point].to_vec(), link)

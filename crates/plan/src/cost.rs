@@ -55,9 +55,9 @@ impl CutRule {
     /// The limits of a [`Link::Cut`]: exactly those [`Costs::transition`]
     /// compares the steps with.
     #[inline]
-    pub fn limits(&self, turn_deg: f64, across_singular: bool) -> CutLimits {
-        let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
-        let switching = if across_singular {
+    pub fn limits(&self, turn_deg: f64, across_singular: bool, fold_deg: f64) -> CutLimits {
+        let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
+        let switching = if across_singular || fold_deg > 0.0 {
             bound
         } else {
             STEP_FLOOR_DEG
@@ -84,9 +84,17 @@ pub enum Link {
     /// reference direction, the larger of its turn and the axis's).
     /// `across_singular`: singular points in between, where the singular
     /// angle is interpolated, so it may turn by up to half a turn.
+    ///
+    /// `fold_deg`: the tool axis passes a fold between the points (see
+    /// [`kinpost_machine::Folds`]), where the two branches meet and the
+    /// angles move like the square root of the distance to it: a branch may
+    /// switch, and every rotary axis may move by that much more than the
+    /// turn allows (the separations of the branches at both points); 0
+    /// otherwise.
     Cut {
         turn_deg: f64,
         across_singular: bool,
+        fold_deg: f64,
     },
 }
 
@@ -270,21 +278,24 @@ impl Costs {
             Link::Cut {
                 turn_deg,
                 across_singular,
+                fold_deg,
             } => {
                 // Along one branch of the closed form a rotary angle turns at
                 // most 1/sin(cone) times as fast as the tool axis outside the
                 // singular cone; whole turns (360° equivalents) never pass.
-                // The branches meet only at the singular direction (and at
-                // the edge of the reachable directions of axes at other
-                // angles than 90°, where the steps are small): a switch
-                // elsewhere is a flip.
-                let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG);
+                // The branches meet only at the singular direction and at
+                // the folds (the edges of the reachable directions of axes
+                // at other angles, `fold_deg`): a switch elsewhere is a
+                // flip.
+                let bound =
+                    (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
                 let switch = ba != bb;
+                let fold = fold_deg > 0.0;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();
                     let limit = match self.singular_axis {
                         Some(i) if i == r.index && across_singular => 180.0 + 1e-9,
-                        _ if switch && !across_singular => STEP_FLOOR_DEG,
+                        _ if switch && !across_singular && !fold => STEP_FLOOR_DEG,
                         _ => bound,
                     };
                     if step > limit {
@@ -326,6 +337,7 @@ mod tests {
         let cut = Link::Cut {
             turn_deg: 0.5,
             across_singular: false,
+            fold_deg: 0.0,
         };
         let (c, ok) = costs.transition(&joints(30.0, 10.0), 0, &joints(30.5, 10.2), 0, cut);
         assert!(ok);
@@ -336,6 +348,7 @@ mod tests {
         let across = Link::Cut {
             turn_deg: 1.0,
             across_singular: true,
+            fold_deg: 0.0,
         };
         let (_, ok) = costs.transition(&joints(0.4, 10.0), 0, &joints(0.4, 190.0), 0, across);
         assert!(ok);

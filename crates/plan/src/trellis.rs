@@ -176,10 +176,11 @@ impl Trellis {
                 Link::Cut {
                     turn_deg,
                     across_singular,
+                    fold_deg,
                 },
                 Some(rule),
             ) => {
-                let limits = rule.limits(turn_deg, across_singular);
+                let limits = rule.limits(turn_deg, across_singular, fold_deg);
                 let layer = Layer {
                     costs: &self.costs,
                     tips: &self.tips,
@@ -415,6 +416,7 @@ mod tests {
         Link::Cut {
             turn_deg,
             across_singular: false,
+            fold_deg: 0.0,
         }
     }
 

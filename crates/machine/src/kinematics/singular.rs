@@ -46,7 +46,66 @@ impl Singularity {
     }
 }
 
+/// The tool-axis directions at which the two branches of a machine with two
+/// free rotary axes meet without an angle becoming free (a fold): the edges
+/// of the band of directions such a machine reaches when its axes are not
+/// at the angle the tool axis makes with the inner one.
+///
+/// The tool axis `p` turned about the inner axis `w2` sweeps a cone of
+/// half-angle `β = ∠(p, w2)` around it, and `w2` makes the angle
+/// `γ = ∠(w1, w2)` with the outer axis, about which the cone turns: the
+/// reachable axes make an angle between `|γ − β|` and `γ + β` with `w1`.
+/// An edge at 0 or 180° is the pole of [`Singularity`]; the others are
+/// folds, where subproblem 2 has a double root: near one, both angles move
+/// like the square root of the distance to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Folds {
+    /// Unit direction in the part frame (that of [`Singularity`]).
+    pub direction: Vector3<f64>,
+    /// Angles from `direction` of the folds, radians (unused ones NaN).
+    pub edges: [f64; 2],
+}
+
+impl Folds {
+    /// Angle between `axis` (unit) and the nearest fold, radians.
+    pub fn distance(&self, axis: &Vector3<f64>) -> f64 {
+        let t = atan2_rad(self.direction.cross(axis).norm(), self.direction.dot(axis));
+        self.edges
+            .iter()
+            .filter(|e| !e.is_nan())
+            .map(|e| (t - e).abs())
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
 impl Kinematics {
+    /// The folds of a machine with exactly two free rotary axes, if it has
+    /// any (see [`Folds`]): none when the axes are at the angle the tool
+    /// axis makes with the inner one (e.g. at right angles, with the tool
+    /// axis normal to the inner one), where both edges are poles.
+    pub fn folds(&self) -> Option<Folds> {
+        const POLE: f64 = 1e-9;
+        let s = self.singularity()?;
+        let (_, w1) = self.free_rot[0];
+        let angle = |a: &Vector3<f64>, b: &Vector3<f64>| atan2_rad(a.cross(b).norm(), a.dot(b));
+        let gamma = angle(&w1, &self.sp2_w2);
+        let beta = angle(&self.sp2_p, &self.sp2_w2);
+        let lower = (gamma - beta).abs();
+        let upper = gamma + beta;
+        let edges = [
+            if lower > POLE { lower } else { f64::NAN },
+            if upper < std::f64::consts::PI - POLE {
+                upper
+            } else {
+                f64::NAN
+            },
+        ];
+        (!edges.iter().all(|e| e.is_nan())).then_some(Folds {
+            direction: s.direction,
+            edges,
+        })
+    }
+
     /// The singular direction of a machine with exactly two free rotary axes
     /// (with three, the reference direction decides and none is reported).
     pub fn singularity(&self) -> Option<Singularity> {

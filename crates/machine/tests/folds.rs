@@ -1,0 +1,95 @@
+//! The folds of machines whose two rotary axes are not at the angle the tool
+//! axis makes with the inner one (`Kinematics::folds`), checked against the
+//! forward kinematics: every reachable tool axis lies in the band the folds
+//! bound, and at a fold the two branches of the inverse kinematics meet.
+
+use kinpost_machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use nalgebra::Vector3;
+
+fn machine(file: &str) -> Machine {
+    let path = format!("{}/tests/machines/{file}", env!("CARGO_MANIFEST_DIR"));
+    machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap()
+}
+
+fn angle(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+#[test]
+fn right_angles_have_poles_only() {
+    for name in builtin::names() {
+        let m = builtin::load(name).unwrap().unwrap();
+        assert_eq!(Kinematics::new(&m).folds(), None, "{name}");
+    }
+}
+
+#[test]
+fn a_nutating_head_folds_where_the_tool_lies_flat() {
+    // B at 45° to the C axis, the tool along C at home: the tool axis makes
+    // 0 to 90° with C (up to flat); 0° is the pole, 90° a fold.
+    let m = machine("nutating-45.toml");
+    let kin = Kinematics::new(&m);
+    let folds = kin.folds().expect("a fold");
+    let edges: Vec<f64> = folds
+        .edges
+        .iter()
+        .filter(|e| !e.is_nan())
+        .map(|e| e.to_degrees())
+        .collect();
+    assert_eq!(edges.len(), 1);
+    assert!((edges[0] - 90.0).abs() < 1e-9, "{edges:?}");
+    let (ib, ic) = (m.axis_index("B").unwrap(), m.axis_index("C").unwrap());
+    let mut q = vec![0.0; m.axes.len()];
+    // Every reachable axis points up or flat, never below (the band), and
+    // its distance to the fold is its elevation.
+    for k in 0..=72 {
+        q[ib] = -180.0 + 5.0 * f64::from(k);
+        q[ic] = 7.0 * f64::from(k);
+        let axis = kin.fk(&q).axis;
+        assert!(axis.z >= -1e-12, "B {}: {axis:?}", q[ib]);
+        let elevation = axis.z.asin().to_degrees();
+        assert!(
+            (folds.distance(&axis).to_degrees() - elevation).abs() < 1e-9,
+            "B {}: {} vs {elevation}",
+            q[ib],
+            folds.distance(&axis).to_degrees()
+        );
+    }
+    // B half a turn lays the tool flat, on the fold. Towards it the two
+    // branches of the inverse kinematics close in on each other, as the
+    // square root of the distance to the fold: a tenth of the distance, a
+    // third of the separation.
+    let mut last = (f64::INFINITY, f64::INFINITY);
+    for b in [170.0, 179.0, 179.9, 179.99] {
+        q[ib] = b;
+        q[ic] = 30.0;
+        let pose: Pose = kin.fk(&q);
+        let distance = folds.distance(&pose.axis).to_degrees();
+        let mut out = Vec::new();
+        kin.ik(&pose, None, &mut out).unwrap();
+        let valid: Vec<_> = out.iter().filter(|s| s.is_valid()).collect();
+        let mut apart = f64::INFINITY;
+        for s in &valid {
+            let back = kin.fk(&s.joints[..m.axes.len()]);
+            assert!(angle(&back.axis, &pose.axis) < 1e-9);
+            for t in valid.iter().filter(|t| t.branch != s.branch) {
+                // (Angles, not travel: B near ±180° is one angle.)
+                let turn = |a: f64, b: f64| ((a - b).rem_euclid(360.0) - 180.0).abs();
+                let d = (180.0 - turn(s.joints[ib], t.joints[ib]))
+                    .max(180.0 - turn(s.joints[ic], t.joints[ic]));
+                apart = apart.min(d);
+            }
+        }
+        assert!(apart.is_finite(), "B {b}: both branches");
+        assert!(
+            distance < last.0 && apart < last.1,
+            "B {b}: {distance}, {apart}"
+        );
+        if last.0.is_finite() {
+            let ratio = (apart / last.1) / (distance / last.0).sqrt();
+            assert!((0.8..1.25).contains(&ratio), "B {b}: {ratio}");
+        }
+        last = (distance, apart);
+    }
+    assert!(last.1 < 1.0, "{last:?}");
+}
