@@ -582,8 +582,8 @@ impl Kinematics {
 
     /// The forward kinematics, and with `LEVER` the largest distance from
     /// the tool point to the point of a free rotary axis line (see
-    /// [`Kinematics::fk_lever`]).
-    /// `sin_cos(axis, degrees)` gives the sine and cosine of an axis value.
+    /// [`Kinematics::fk_lever`]). `sin_cos(axis, degrees)` gives the sine
+    /// and cosine of an axis value.
     #[inline(always)]
     fn chain<const LEVER: bool>(
         &self,

@@ -93,3 +93,22 @@ fn a_nutating_head_folds_where_the_tool_lies_flat() {
     }
     assert!(last.1 < 1.0, "{last:?}");
 }
+
+#[test]
+fn a_tool_pointing_the_other_way_folds_alike() {
+    // The nutating head with the tool along −C at home: the band is the
+    // mirror image (down to flat), the fold is still where the tool lies
+    // flat. Here γ + β passes half a turn: the edge is 360° − γ − β.
+    for tool in [Vector3::z(), -Vector3::z()] {
+        let mut m = machine("nutating-45.toml");
+        m.tool.axis = tool;
+        let folds = Kinematics::new(&m).folds().expect("a fold");
+        for flat in [Vector3::x(), Vector3::y(), Vector3::new(-0.6, 0.8, 0.0)] {
+            assert!(
+                folds.distance(&flat) < 1e-12,
+                "{tool:?} {flat:?}: {folds:?}"
+            );
+        }
+        assert!((folds.distance(&tool).to_degrees() - 90.0).abs() < 1e-9);
+    }
+}

@@ -12,7 +12,7 @@
 use nalgebra::Vector3;
 
 use super::Kinematics;
-use crate::angle::atan2_rad;
+use crate::angle::{angle_between, atan2_rad};
 use crate::subproblems::{rotation, sp1_cs};
 
 /// The tool-axis direction at which one rotary angle becomes free.
@@ -54,10 +54,11 @@ impl Singularity {
 /// The tool axis `p` turned about the inner axis `w2` sweeps a cone of
 /// half-angle `β = ∠(p, w2)` around it, and `w2` makes the angle
 /// `γ = ∠(w1, w2)` with the outer axis, about which the cone turns: the
-/// reachable axes make an angle between `|γ − β|` and `γ + β` with `w1`.
-/// An edge at 0 or 180° is the pole of [`Singularity`]; the others are
-/// folds, where subproblem 2 has a double root: near one, both angles move
-/// like the square root of the distance to it.
+/// reachable axes make an angle between `|γ − β|` and `γ + β` with `w1`
+/// (`360° − γ − β` when that is less). An edge at 0 or 180° is the pole of
+/// [`Singularity`]; the others are folds, where subproblem 2 has a double
+/// root: near one, both angles move like the square root of the distance
+/// to it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Folds {
     /// Unit direction in the part frame (that of [`Singularity`]).
@@ -69,7 +70,7 @@ pub struct Folds {
 impl Folds {
     /// Angle between `axis` (unit) and the nearest fold, radians.
     pub fn distance(&self, axis: &Vector3<f64>) -> f64 {
-        let t = atan2_rad(self.direction.cross(axis).norm(), self.direction.dot(axis));
+        let t = angle_between(&self.direction, axis);
         self.edges
             .iter()
             .filter(|e| !e.is_nan())
@@ -80,25 +81,20 @@ impl Folds {
 
 impl Kinematics {
     /// The folds of a machine with exactly two free rotary axes, if it has
-    /// any (see [`Folds`]): none when the axes are at the angle the tool
-    /// axis makes with the inner one (e.g. at right angles, with the tool
-    /// axis normal to the inner one), where both edges are poles.
+    /// any (see [`Folds`]): none when both edges are poles (`γ = β = 90°`:
+    /// the axes at right angles, the tool axis normal to the inner one).
     pub fn folds(&self) -> Option<Folds> {
+        use std::f64::consts::{PI, TAU};
         const POLE: f64 = 1e-9;
         let s = self.singularity()?;
         let (_, w1) = self.free_rot[0];
-        let angle = |a: &Vector3<f64>, b: &Vector3<f64>| atan2_rad(a.cross(b).norm(), a.dot(b));
-        let gamma = angle(&w1, &self.sp2_w2);
-        let beta = angle(&self.sp2_p, &self.sp2_w2);
+        let gamma = angle_between(&w1, &self.sp2_w2);
+        let beta = angle_between(&self.sp2_p, &self.sp2_w2);
         let lower = (gamma - beta).abs();
-        let upper = gamma + beta;
+        let upper = (gamma + beta).min(TAU - gamma - beta);
         let edges = [
             if lower > POLE { lower } else { f64::NAN },
-            if upper < std::f64::consts::PI - POLE {
-                upper
-            } else {
-                f64::NAN
-            },
+            if upper < PI - POLE { upper } else { f64::NAN },
         ];
         (!edges.iter().all(|e| e.is_nan())).then_some(Folds {
             direction: s.direction,
