@@ -207,22 +207,31 @@ impl PathPlan {
                 self.across = true;
             }
             self.planned_pole = pole;
-            // The tool axis may have passed a fold between the two points
-            // (its distances to it add up to no more than the turn): the
+            // Near a fold the branches lie apart by a separation that
+            // grows like the square root of the distance to it. The tool
+            // axis may have passed the fold between the two points (its
+            // distances to it add up to no more than the turn): the
             // branches meet there, and the angles may move by as much as
-            // the branches lie apart at the two points.
+            // the branches lie apart at the two points. Otherwise each
+            // branch moves by its half of the change of the separation
+            // (the branches are its mean ± half of it, the mean as smooth
+            // as elsewhere) besides what the turn allows.
             let fold = self.folds.map(|f| {
                 (
                     f.distance(&pose.axis),
                     separation(&self.solutions, &self.rotary),
                 )
             });
-            let mut fold_deg = 0.0;
+            let (mut fold_deg, mut across_fold) = (0.0, false);
             if let (Some((d0, s0)), Some((d1, s1))) = (self.planned_fold, fold)
-                && d0 + d1 <= self.turn.to_radians() + 1e-12
                 && (s0 + s1).is_finite()
             {
-                fold_deg = s0 + s1;
+                across_fold = d0 + d1 <= self.turn.to_radians() + 1e-12;
+                fold_deg = if across_fold {
+                    s0 + s1
+                } else {
+                    0.5 * (s0 - s1).abs()
+                };
             }
             self.planned_fold = fold;
             let link = if self.free {
@@ -232,6 +241,7 @@ impl PathPlan {
                     turn_deg: self.turn,
                     across_singular: self.across,
                     fold_deg,
+                    across_fold,
                 }
             };
             if !self.trellis.push(&self.solutions, link) {

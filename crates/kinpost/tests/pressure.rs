@@ -243,122 +243,165 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
     #[test]
     fn random_machines_at_several_pressures(seed in 1u64..u64::MAX) {
-        let mut rng = Rng(seed);
-        let g = random_machine(&mut rng);
-        let toml = g.with_pressure();
-        let machine = machine_from_toml(&toml, "random.toml")
-            .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
-        let [lo, hi] = g.model.range();
-        // A random walk through joint space at random pressures (some
-        // outside the calibration), written as CL: the poses come from the
-        // machine at the reference; the post must reach them at any pressure.
-        let reference = Kinematics::new(&g.at(None));
-        let mut q: Vec<f64> = (0..5).map(|_| rng.range(-60.0, 60.0)).collect();
-        // Rotary axes well away from home: tilted poses.
-        for (v, a) in q.iter_mut().zip(&machine.axes) {
-            if a.is_rotary() {
-                *v = rng.range(20.0, 60.0).copysign(*v);
-            }
-        }
-        let default = (rng.next() < 0.5).then(|| half(&mut rng, lo - 100.0, hi + 100.0));
-        let mut pressure = default;
-        let mut cl = String::from("FEDRAT/MMPM,500\n");
-        // Per CL line: the pose and the pressure in force.
-        let mut want: Vec<Option<(Pose, Option<f64>)>> = vec![None, None];
-        let mut tilted = 0;
-        for k in 0..40 {
-            if k % 7 == 3 {
-                let p = half(&mut rng, lo - 300.0, hi + 300.0).max(0.0);
-                let word = match k % 3 {
-                    0 => format!("{},", g.word),
-                    1 => format!("{},", g.word.to_lowercase()),
-                    _ => String::new(),
-                };
-                cl.push_str(&format!("PRESSURE/{word}{p}\n"));
-                want.push(None);
-                pressure = Some(p);
-            }
-            for v in q.iter_mut() {
-                *v += rng.range(-3.0, 3.0);
-            }
-            let pose = reference.fk(&q);
-            tilted += usize::from(angle(&pose.axis, &reference.fk(&[0.0; 5]).axis) > 0.1);
-            cl.push_str(&format!(
-                "GOTO/{:.10},{:.10},{:.10},{:.12},{:.12},{:.12}\n",
-                pose.point.x, pose.point.y, pose.point.z, pose.axis.x, pose.axis.y, pose.axis.z
-            ));
-            want.push(Some((pose, pressure)));
-        }
-        prop_assert!(tilted > 0, "the poses must be tilted\n{toml}");
-        let options = PostOptions { pressure: default, ..Default::default() };
-        let (csv, summary) = post_text(&cl, &machine, "csv", &options)
-            .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}\n{cl}")))?;
-        prop_assert!(summary.planning.reconfigurations.is_empty(), "{:?}\n{toml}\n{cl}", summary.planning);
-        let mut rows = csv.lines();
-        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-        let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-        let mut seen = 0;
-        let mut cache: Vec<(Option<f64>, Kinematics)> = Vec::new();
-        for row in rows {
-            let f: Vec<&str> = row.split(',').collect();
-            let line: usize = f[col("line")].parse().unwrap();
-            let (pose, p) = want[line].expect("a GOTO line");
-            // The pressure column: the one in force, empty when none.
-            let written = match f[col(&g.word)] {
-                "" => None,
-                v => Some(v.parse::<f64>().unwrap()),
-            };
-            prop_assert_eq!(written, p, "line {}", line);
-            let values: Vec<f64> = machine.axes.iter().map(|a| f[col(&a.name)].parse().unwrap()).collect();
-            if !cache.iter().any(|(k, _)| *k == p) {
-                cache.push((p, Kinematics::new(&g.at(p))));
-            }
-            let kin = &cache.iter().find(|(k, _)| *k == p).unwrap().1;
-            let got = kin.fk(&values);
-            let dp = (got.point - pose.point).norm();
-            let da = angle(&got.axis, &pose.axis);
-            // The CL itself is rounded to 1e-10 mm / 1e-12.
-            prop_assert!(dp <= summary.tolerance_mm + 1e-8, "line {line}: {dp} mm\n{toml}");
-            let cone = singular_allowance(&summary, line);
-            prop_assert!(da <= summary.tolerance_rad + cone + 1e-9, "line {line}: {da} rad\n{toml}");
-            // The axes moved by exactly the (turned) wheel offset: through
-            // the machine at the reference they miss by its length.
-            let [d1, d2] = p.map_or([0.0, 0.0], |p| g.model.offset(g.reference, p));
-            let miss = (reference.fk(&values).point - pose.point).norm();
-            let offset = (g.plane[0] * d1 + g.plane[1] * d2).norm();
-            prop_assert!((miss - offset).abs() <= summary.tolerance_mm + 1e-8,
-                "line {line}: {miss} vs offset {offset}");
-            seen += 1;
-        }
-        prop_assert_eq!(seen, 40);
-        // Pressures outside the calibration are warned about.
-        let outside = cl.lines().filter_map(|l| l.strip_prefix("PRESSURE/"))
-            .map(|l| l.rsplit(',').next().unwrap().parse::<f64>().unwrap())
-            .chain(default)
-            .filter(|&p| p < lo || p > hi)
-            .count();
-        let warned = summary.warnings.iter().filter(|w| w.message.contains("calibration")).count();
-        prop_assert_eq!(warned, outside);
+        posts_at_several_pressures(seed)?;
+    }
+}
 
-        // The Sinumerik program read back: the pressure words set each
-        // block's pressure, and the blocks land on the CL at it.
-        let (nc, summary) = post_text(&cl, &machine, "sinumerik", &options)
-            .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
-        let axes = kinpost::axis_specs(&machine);
-        let blocks = read_program(&Dialect::builtin("sinumerik").unwrap(), &axes, "r.mpf", &nc)
-            .map_err(|e| TestCaseError::fail(e.to_string()))?;
-        let poses: Vec<&(Pose, Option<f64>)> = want.iter().flatten().collect();
-        prop_assert_eq!(blocks.len(), poses.len());
-        for (b, (pose, _)) in blocks.iter().zip(&poses) {
-            let values: Vec<f64> = b.axes[..5].iter().map(|v| v.unwrap()).collect();
-            // Sinumerik writes whole pressures: the wheel is where the
-            // written value puts it.
-            let kin = Kinematics::new(&g.at(b.axes[5]));
-            let got = kin.fk(&values);
-            let dp = (got.point - pose.point).norm();
-            prop_assert!(dp <= summary.tolerance_mm + 1e-8, "NC line {}: {} mm", b.line, dp);
+/// A branch that moves 1.47° for a 0.01° turn of the tool axis near a fold
+/// it does not pass (found by the property test with many more cases; it
+/// was taken for a flip and reconfigured).
+#[test]
+fn seed_5518296535352054306() {
+    posts_at_several_pressures(5518296535352054306).unwrap();
+}
+
+fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
+    let mut rng = Rng(seed);
+    let g = random_machine(&mut rng);
+    let toml = g.with_pressure();
+    let machine = machine_from_toml(&toml, "random.toml")
+        .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
+    let [lo, hi] = g.model.range();
+    // A random walk through joint space at random pressures (some
+    // outside the calibration), written as CL: the poses come from the
+    // machine at the reference; the post must reach them at any pressure.
+    let reference = Kinematics::new(&g.at(None));
+    let mut q: Vec<f64> = (0..5).map(|_| rng.range(-60.0, 60.0)).collect();
+    // Rotary axes well away from home: tilted poses.
+    for (v, a) in q.iter_mut().zip(&machine.axes) {
+        if a.is_rotary() {
+            *v = rng.range(20.0, 60.0).copysign(*v);
         }
     }
+    let default = (rng.next() < 0.5).then(|| half(&mut rng, lo - 100.0, hi + 100.0));
+    let mut pressure = default;
+    let mut cl = String::from("FEDRAT/MMPM,500\n");
+    // Per CL line: the pose and the pressure in force.
+    let mut want: Vec<Option<(Pose, Option<f64>)>> = vec![None, None];
+    let mut tilted = 0;
+    for k in 0..40 {
+        if k % 7 == 3 {
+            let p = half(&mut rng, lo - 300.0, hi + 300.0).max(0.0);
+            let word = match k % 3 {
+                0 => format!("{},", g.word),
+                1 => format!("{},", g.word.to_lowercase()),
+                _ => String::new(),
+            };
+            cl.push_str(&format!("PRESSURE/{word}{p}\n"));
+            want.push(None);
+            pressure = Some(p);
+        }
+        for v in q.iter_mut() {
+            *v += rng.range(-3.0, 3.0);
+        }
+        let pose = reference.fk(&q);
+        tilted += usize::from(angle(&pose.axis, &reference.fk(&[0.0; 5]).axis) > 0.1);
+        cl.push_str(&format!(
+            "GOTO/{:.10},{:.10},{:.10},{:.12},{:.12},{:.12}\n",
+            pose.point.x, pose.point.y, pose.point.z, pose.axis.x, pose.axis.y, pose.axis.z
+        ));
+        want.push(Some((pose, pressure)));
+    }
+    prop_assert!(tilted > 0, "the poses must be tilted\n{toml}");
+    let options = PostOptions {
+        pressure: default,
+        ..Default::default()
+    };
+    let (csv, summary) = post_text(&cl, &machine, "csv", &options)
+        .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}\n{cl}")))?;
+    prop_assert!(
+        summary.planning.reconfigurations.is_empty(),
+        "{:?}\n{toml}\n{cl}",
+        summary.planning
+    );
+    let mut rows = csv.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut seen = 0;
+    let mut cache: Vec<(Option<f64>, Kinematics)> = Vec::new();
+    for row in rows {
+        let f: Vec<&str> = row.split(',').collect();
+        let line: usize = f[col("line")].parse().unwrap();
+        let (pose, p) = want[line].expect("a GOTO line");
+        // The pressure column: the one in force, empty when none.
+        let written = match f[col(&g.word)] {
+            "" => None,
+            v => Some(v.parse::<f64>().unwrap()),
+        };
+        prop_assert_eq!(written, p, "line {}", line);
+        let values: Vec<f64> = machine
+            .axes
+            .iter()
+            .map(|a| f[col(&a.name)].parse().unwrap())
+            .collect();
+        if !cache.iter().any(|(k, _)| *k == p) {
+            cache.push((p, Kinematics::new(&g.at(p))));
+        }
+        let kin = &cache.iter().find(|(k, _)| *k == p).unwrap().1;
+        let got = kin.fk(&values);
+        let dp = (got.point - pose.point).norm();
+        let da = angle(&got.axis, &pose.axis);
+        // The CL itself is rounded to 1e-10 mm / 1e-12.
+        prop_assert!(
+            dp <= summary.tolerance_mm + 1e-8,
+            "line {line}: {dp} mm\n{toml}"
+        );
+        let cone = singular_allowance(&summary, line);
+        prop_assert!(
+            da <= summary.tolerance_rad + cone + 1e-9,
+            "line {line}: {da} rad\n{toml}"
+        );
+        // The axes moved by exactly the (turned) wheel offset: through
+        // the machine at the reference they miss by its length.
+        let [d1, d2] = p.map_or([0.0, 0.0], |p| g.model.offset(g.reference, p));
+        let miss = (reference.fk(&values).point - pose.point).norm();
+        let offset = (g.plane[0] * d1 + g.plane[1] * d2).norm();
+        prop_assert!(
+            (miss - offset).abs() <= summary.tolerance_mm + 1e-8,
+            "line {line}: {miss} vs offset {offset}"
+        );
+        seen += 1;
+    }
+    prop_assert_eq!(seen, 40);
+    // Pressures outside the calibration are warned about.
+    let outside = cl
+        .lines()
+        .filter_map(|l| l.strip_prefix("PRESSURE/"))
+        .map(|l| l.rsplit(',').next().unwrap().parse::<f64>().unwrap())
+        .chain(default)
+        .filter(|&p| p < lo || p > hi)
+        .count();
+    let warned = summary
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("calibration"))
+        .count();
+    prop_assert_eq!(warned, outside);
+
+    // The Sinumerik program read back: the pressure words set each
+    // block's pressure, and the blocks land on the CL at it.
+    let (nc, summary) = post_text(&cl, &machine, "sinumerik", &options)
+        .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
+    let axes = kinpost::axis_specs(&machine);
+    let blocks = read_program(&Dialect::builtin("sinumerik").unwrap(), &axes, "r.mpf", &nc)
+        .map_err(|e| TestCaseError::fail(e.to_string()))?;
+    let poses: Vec<&(Pose, Option<f64>)> = want.iter().flatten().collect();
+    prop_assert_eq!(blocks.len(), poses.len());
+    for (b, (pose, _)) in blocks.iter().zip(&poses) {
+        let values: Vec<f64> = b.axes[..5].iter().map(|v| v.unwrap()).collect();
+        // Sinumerik writes whole pressures: the wheel is where the
+        // written value puts it.
+        let kin = Kinematics::new(&g.at(b.axes[5]));
+        let got = kin.fk(&values);
+        let dp = (got.point - pose.point).norm();
+        prop_assert!(
+            dp <= summary.tolerance_mm + 1e-8,
+            "NC line {}: {} mm",
+            b.line,
+            dp
+        );
+    }
+    Ok(())
 }
 
 /// The mts1600 source without its `[pressure]` section.

@@ -37,6 +37,7 @@ pub fn layers(points: usize, per_point: usize) -> Vec<(Vec<Solution>, Link)> {
                     turn_deg: 0.05,
                     across_singular: false,
                     fold_deg: 0.0,
+                    across_fold: false,
                 }
             };
             (all[..per_point].to_vec(), link)

@@ -55,9 +55,15 @@ impl CutRule {
     /// The limits of a [`Link::Cut`]: exactly those [`Costs::transition`]
     /// compares the steps with.
     #[inline]
-    pub fn limits(&self, turn_deg: f64, across_singular: bool, fold_deg: f64) -> CutLimits {
+    pub fn limits(
+        &self,
+        turn_deg: f64,
+        across_singular: bool,
+        fold_deg: f64,
+        across_fold: bool,
+    ) -> CutLimits {
         let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
-        let switching = if across_singular || fold_deg > 0.0 {
+        let switching = if across_singular || across_fold {
             bound
         } else {
             STEP_FLOOR_DEG
@@ -85,16 +91,17 @@ pub enum Link {
     /// `across_singular`: singular points in between, where the singular
     /// angle is interpolated, so it may turn by up to half a turn.
     ///
-    /// `fold_deg`: the tool axis passes a fold between the points (see
-    /// [`kinpost_machine::Folds`]), where the two branches meet and the
-    /// angles move like the square root of the distance to it: a branch may
-    /// switch, and every rotary axis may move by that much more than the
-    /// turn allows (the separations of the branches at both points); 0
-    /// otherwise.
+    /// Near a fold (see [`kinpost_machine::Folds`]) the two branches meet
+    /// and the angles move like the square root of the distance to it, far
+    /// faster than the turn: `fold_deg` is how much more every rotary axis
+    /// may move than the turn allows (0 on machines without folds).
+    /// `across_fold`: the tool axis may pass a fold between the points, so
+    /// a branch may switch there.
     Cut {
         turn_deg: f64,
         across_singular: bool,
         fold_deg: f64,
+        across_fold: bool,
     },
 }
 
@@ -279,23 +286,23 @@ impl Costs {
                 turn_deg,
                 across_singular,
                 fold_deg,
+                across_fold,
             } => {
                 // Along one branch of the closed form a rotary angle turns at
                 // most 1/sin(cone) times as fast as the tool axis outside the
                 // singular cone; whole turns (360° equivalents) never pass.
                 // The branches meet only at the singular direction and at
                 // the folds (the edges of the reachable directions of axes
-                // at other angles, `fold_deg`): a switch elsewhere is a
+                // at other angles, `across_fold`): a switch elsewhere is a
                 // flip.
                 let bound =
                     (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
                 let switch = ba != bb;
-                let fold = fold_deg > 0.0;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();
                     let limit = match self.singular_axis {
                         Some(i) if i == r.index && across_singular => 180.0 + 1e-9,
-                        _ if switch && !across_singular && !fold => STEP_FLOOR_DEG,
+                        _ if switch && !across_singular && !across_fold => STEP_FLOOR_DEG,
                         _ => bound,
                     };
                     if step > limit {
@@ -338,6 +345,7 @@ mod tests {
             turn_deg: 0.5,
             across_singular: false,
             fold_deg: 0.0,
+            across_fold: false,
         };
         let (c, ok) = costs.transition(&joints(30.0, 10.0), 0, &joints(30.5, 10.2), 0, cut);
         assert!(ok);
@@ -349,6 +357,7 @@ mod tests {
             turn_deg: 1.0,
             across_singular: true,
             fold_deg: 0.0,
+            across_fold: false,
         };
         let (_, ok) = costs.transition(&joints(0.4, 10.0), 0, &joints(0.4, 190.0), 0, across);
         assert!(ok);
@@ -363,6 +372,35 @@ mod tests {
         let (c, ok) = costs.transition(&joints(0.0, 0.0), 0, &joints(90.0, 170.0), 1, Link::Free);
         assert!(ok);
         assert_eq!(c, 260.0);
+    }
+
+    #[test]
+    fn near_a_fold_a_branch_moves_faster_and_across_it_may_switch() {
+        let m = trunnion();
+        let costs = Costs::new(&m, 0.5, None);
+        // A 0.005° turn allows the 1° floor; near a fold the branches'
+        // separation adds `fold_deg`.
+        let link = |fold_deg, across_fold| Link::Cut {
+            turn_deg: 0.005,
+            across_singular: false,
+            fold_deg,
+            across_fold,
+        };
+        let near = |across_fold| link(1.5, across_fold);
+        let (a, b) = (joints(56.8, 32.7), joints(58.3, 32.5));
+        let cut = link(0.0, false);
+        assert!(!costs.transition(&a, 0, &b, 0, cut).1);
+        assert!(costs.transition(&a, 0, &b, 0, near(false)).1);
+        // Switching branch needs the fold between the points.
+        assert!(!costs.transition(&a, 0, &b, 1, near(false)).1);
+        assert!(costs.transition(&a, 0, &b, 1, near(true)).1);
+        // The fast path's limits say the same.
+        let rule = costs.cut_rule().unwrap();
+        for across_fold in [false, true] {
+            let l = rule.limits(0.005, false, 1.5, across_fold);
+            assert_eq!(l.same[0], 2.5);
+            assert_eq!(l.switch[0], if across_fold { 2.5 } else { STEP_FLOOR_DEG });
+        }
     }
 
     #[test]

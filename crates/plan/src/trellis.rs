@@ -177,10 +177,11 @@ impl Trellis {
                     turn_deg,
                     across_singular,
                     fold_deg,
+                    across_fold,
                 },
                 Some(rule),
             ) => {
-                let limits = rule.limits(turn_deg, across_singular, fold_deg);
+                let limits = rule.limits(turn_deg, across_singular, fold_deg, across_fold);
                 let layer = Layer {
                     costs: &self.costs,
                     tips: &self.tips,
@@ -417,6 +418,7 @@ mod tests {
             turn_deg,
             across_singular: false,
             fold_deg: 0.0,
+            across_fold: false,
         }
     }
 

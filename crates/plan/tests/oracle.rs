@@ -183,11 +183,13 @@ fn link() -> impl Strategy<Value = Link> {
             prop_oneof![Just(0.0), 0.0..0.05f64, 0.0..3.0f64, 0.0..200.0f64],
             prop::bool::weighted(0.2),
             prop_oneof![4 => Just(0.0), 1 => 0.0..20.0f64],
+            prop::bool::weighted(0.2),
         )
-            .prop_map(|(turn_deg, across_singular, fold_deg)| Link::Cut {
+            .prop_map(|(turn_deg, across_singular, fold_deg, across_fold)| Link::Cut {
                 turn_deg,
                 across_singular,
                 fold_deg,
+                across_fold,
             }),
     ]
 }
