@@ -302,7 +302,10 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
         ));
         want.push(Some((pose, pressure)));
     }
-    prop_assert!(tilted > 0, "the poses must be tilted\n{toml}");
+    // Rarely (about one machine in 3,000) the two rotations happen to bring
+    // the tool axis back near home all along the walk: not a tilted job,
+    // another machine instead.
+    prop_assume!(tilted > 0, "the poses must be tilted");
     let options = PostOptions {
         pressure: default,
         ..Default::default()
