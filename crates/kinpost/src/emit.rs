@@ -16,7 +16,7 @@ use nalgebra::Vector3;
 
 use crate::check::{CheckStats, Tolerance, angle_between, pose_error};
 use crate::post::{FeedMode, PostError, describe};
-use crate::solve::{Hold, interpolate, solve_near};
+use crate::solve::{Hold, Near, interpolate, solve_near};
 use crate::summary::{FeedClamp, Planning, Reconfiguration};
 
 /// Deepest halving of one CL segment by the linearization (2^16 blocks).
@@ -37,6 +37,8 @@ pub(crate) struct Node {
     pub joints: Joints,
     /// The singular angle held at this node, if any.
     pub hold: Option<Hold>,
+    /// The closed-form branch of `joints` (see [`kinpost_machine::Solution`]).
+    pub branch: u8,
 }
 
 /// One CL point as the planner hands it over.
@@ -285,17 +287,27 @@ impl<W: Write> Emitter<W> {
                 value: mid[s.axis],
             })
         });
+        // Both ends on one branch: the midpoint too. Near a fold the
+        // branches lie close, and the joint-space midpoint may be nearer the
+        // other one: a switch there would never converge. (Ends on two
+        // branches: the nearest.)
+        let branch = (a.branch == b.branch).then_some(a.branch);
+        let near = Near {
+            joints: &mid,
+            hold,
+            branch,
+        };
         let solved =
-            solve_near(kin, &pose, &mid, hold, &self.rotary, &mut self.solutions).or_else(|| {
+            solve_near(kin, &pose, &near, &self.rotary, &mut self.solutions).or_else(|| {
                 // The machine cannot point the interpolated tool axis (two
                 // rotary axes at an angle other than 90° reach a band of
-                // directions only): keep the axis of the rotary midpoint
-                // and put the contact point on the segment.
+                // directions only): keep the axis of the rotary midpoint and
+                // put the contact point on the segment.
                 let natural = Pose {
                     axis: kin.fk(&mid[..self.n]).axis,
                     ..pose
                 };
-                solve_near(kin, &natural, &mid, hold, &self.rotary, &mut self.solutions)
+                solve_near(kin, &natural, &near, &self.rotary, &mut self.solutions)
             });
         let Some((pose, sol)) = solved else {
             return Err("an intermediate pose of the linearization is outside the travel");
@@ -304,6 +316,7 @@ impl<W: Write> Emitter<W> {
             pose,
             joints: sol.joints,
             hold,
+            branch: sol.branch,
         };
         self.linearize(kin, a, &m, lever, depth + 1, out)?;
         out.push(m);
@@ -337,14 +350,14 @@ impl<W: Write> Emitter<W> {
         let over = lift(to);
         let mut nodes = [*from, *to];
         for (k, (pose, near)) in [(up, from), (over, to)].into_iter().enumerate() {
-            let Some((pose, sol)) = solve_near(
-                kin,
-                &pose,
-                &near.joints,
-                near.hold,
-                &self.rotary,
-                &mut self.solutions,
-            ) else {
+            let near = Near {
+                joints: &near.joints,
+                hold: near.hold,
+                branch: Some(near.branch),
+            };
+            let Some((pose, sol)) =
+                solve_near(kin, &pose, &near, &self.rotary, &mut self.solutions)
+            else {
                 return Err((t.at)(format!(
                     "the retract of {d} mm along the tool axis for a reconfiguration {} is outside the travel \
                      (set a smaller distance with --retract or [post] retract)",
@@ -359,6 +372,7 @@ impl<W: Write> Emitter<W> {
                 pose,
                 joints: sol.joints,
                 hold: near.hold,
+                branch: sol.branch,
             };
         }
         let (axis, a, b) = self.largest_jump(&from.joints, &to.joints);

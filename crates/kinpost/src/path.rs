@@ -21,8 +21,13 @@ use crate::check::angle_between;
 use crate::emit::{Emitter, Node, Target};
 use crate::post::{Pending, PostError, select, write_pending};
 use crate::pressure::Wheel;
-use crate::solve::{Hold, solve_near};
+use crate::solve::{Hold, Near, solve_near};
 use crate::summary::SingularStretch;
+
+/// How close to a fold the interpolated tool axis counts as reaching it,
+/// radians (the rounding of CL tool axes; the branches lie within
+/// ≈ √(1e-9) of each other there).
+const FOLD_SLACK_RAD: f64 = 1e-9;
 
 /// Settled points (see [`PathPlan::is_full`]) written at once: enough that
 /// a decision costs next to nothing, few enough that the points, their
@@ -52,8 +57,6 @@ pub(crate) struct PlanPoint {
 #[derive(Clone, Copy)]
 struct Decided {
     node: Node,
-    /// The closed-form branch of its configuration.
-    branch: u8,
     continuous: bool,
 }
 
@@ -86,9 +89,12 @@ pub(crate) struct PathPlan {
     planned_pole: Option<Pole>,
     /// The folds of the machine (see [`Folds`]), if it has any.
     folds: Option<Folds>,
-    /// The distance of the last point in the trellis to the nearest fold
-    /// (radians) and the separation of its branches (see [`separation`]).
-    planned_fold: Option<(f64, f64)>,
+    /// The separation of the branches of the last point in the trellis (see
+    /// [`separation`]), on a machine with folds.
+    planned_fold: Option<f64>,
+    /// Since the last point in the trellis: the tool axis, interpolated
+    /// from point to point, reached a fold.
+    fold_reached: bool,
     segment: u64,
     break_pending: bool,
     /// The last point written: its node, branch and segment.
@@ -126,6 +132,7 @@ impl PathPlan {
             planned_pole: None,
             folds: kin.folds(),
             planned_fold: None,
+            fold_reached: false,
             segment: 0,
             break_pending: true,
             last: None,
@@ -179,6 +186,9 @@ impl PathPlan {
                 turn = turn.max(angle_between_deg(a, b));
             }
             self.turn += turn;
+            if let Some(f) = &self.folds {
+                self.fold_reached |= f.reached(axis, &pose.axis, FOLD_SLACK_RAD);
+            }
         }
         self.previous_axes = Some((pose.axis, pose.reference));
         // The hint picks the turn of axes without limits: near the cheapest
@@ -208,25 +218,22 @@ impl PathPlan {
             }
             self.planned_pole = pole;
             // Near a fold the branches lie apart by a separation that
-            // grows like the square root of the distance to it. The tool
-            // axis may have passed the fold between the two points (its
-            // distances to it add up to no more than the turn): the
-            // branches meet there, and the angles may move by as much as
+            // grows like the square root of the distance to it. Where the
+            // tool axis, interpolated from point to point (as the
+            // linearization moves it), reaches the fold, the branches meet:
+            // a branch may switch, and the angles may move by as much as
             // the branches lie apart at the two points. Otherwise each
             // branch moves by its half of the change of the separation
             // (the branches are its mean ± half of it, the mean as smooth
             // as elsewhere) besides what the turn allows.
-            let fold = self.folds.map(|f| {
-                (
-                    f.distance(&pose.axis),
-                    separation(&self.solutions, &self.rotary),
-                )
-            });
+            let fold = self
+                .folds
+                .map(|_| separation(&self.solutions, &self.rotary));
             let (mut fold_deg, mut across_fold) = (0.0, false);
-            if let (Some((d0, s0)), Some((d1, s1))) = (self.planned_fold, fold)
+            if let (Some(s0), Some(s1)) = (self.planned_fold, fold)
                 && (s0 + s1).is_finite()
             {
-                across_fold = d0 + d1 <= self.turn.to_radians() + 1e-12;
+                across_fold = self.fold_reached;
                 fold_deg = if across_fold {
                     s0 + s1
                 } else {
@@ -249,6 +256,7 @@ impl PathPlan {
             }
             self.turn = 0.0;
             self.across = false;
+            self.fold_reached = false;
             self.free = false;
         }
         let start = self.source.len();
@@ -324,8 +332,8 @@ impl PathPlan {
                         pose: self.points[k].pose,
                         joints: choice.joints,
                         hold: None,
+                        branch: choice.branch,
                     },
-                    branch: choice.branch,
                     continuous: choice.continuous,
                 };
                 self.write_point(machine, kin, wheel, emitter, k, decided)?;
@@ -402,7 +410,7 @@ impl PathPlan {
             },
         )?;
         let segment = p.segment;
-        self.last = Some((d.node, d.branch, segment));
+        self.last = Some((d.node, d.node.branch, segment));
         Ok(())
     }
 
@@ -429,6 +437,7 @@ impl PathPlan {
                 pose: p.pose,
                 joints: c.joints,
                 hold: None,
+                branch: c.branch,
             });
         let anchor = self
             .last
@@ -478,28 +487,20 @@ impl PathPlan {
             });
             select(kin, wheel, p.pressure);
             let kin = &*kin;
-            let solved = solve_near(
-                kin,
-                &p.pose,
-                &guess,
+            // (The branches meet at the pole: any branch.)
+            let near = |hold| Near {
+                joints: &guess,
                 hold,
-                &self.rotary,
-                &mut self.solutions,
-            )
-            .map(|(pose, s)| (pose, s, hold))
-            .or_else(|| {
-                // The held angle is out of reach here: the exact solution
-                // nearest the previous point.
-                solve_near(
-                    kin,
-                    &p.pose,
-                    &guess,
-                    None,
-                    &self.rotary,
-                    &mut self.solutions,
-                )
-                .map(|(pose, s)| (pose, s, None))
-            });
+                branch: None,
+            };
+            let solved = solve_near(kin, &p.pose, &near(hold), &self.rotary, &mut self.solutions)
+                .map(|(pose, s)| (pose, s, hold))
+                .or_else(|| {
+                    // The held angle is out of reach here: the exact
+                    // solution nearest the previous point.
+                    solve_near(kin, &p.pose, &near(None), &self.rotary, &mut self.solutions)
+                        .map(|(pose, s)| (pose, s, None))
+                });
             let Some((pose, sol, hold)) = solved else {
                 return Err(self.error_at(
                     p,
@@ -521,8 +522,8 @@ impl PathPlan {
                     pose,
                     joints: sol.joints,
                     hold,
+                    branch: sol.branch,
                 },
-                branch: sol.branch,
                 continuous: true,
             });
         }

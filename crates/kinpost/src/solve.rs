@@ -40,21 +40,31 @@ fn slerp(a: &Vector3<f64>, b: &Vector3<f64>, t: f64) -> Vector3<f64> {
     }
 }
 
+/// Where to solve a pose near: a configuration, the singular angle held
+/// there if any, and the branch to keep if any.
+pub(crate) struct Near<'a> {
+    pub joints: &'a Joints,
+    pub hold: Option<Hold>,
+    /// Solutions of this branch come first (when there are any).
+    pub branch: Option<u8>,
+}
+
 /// The valid solution of `pose` whose rotary axes are nearest `near`
-/// (`rotary`: the free rotary axes), with the singular angle held if `hold`
-/// says so: the tool axis is then the nearest one the machine points with
-/// that angle, and the pose solved is returned with it.
+/// (`rotary`: the free rotary axes), of its branch if it has valid ones,
+/// with the singular angle held if `near` says so: the tool axis is then
+/// the nearest one the machine points with that angle, and the pose solved
+/// is returned with it.
 pub(crate) fn solve_near(
     kin: &Kinematics,
     pose: &Pose,
-    near: &Joints,
-    hold: Option<Hold>,
+    near: &Near,
     rotary: &[usize],
     scratch: &mut Vec<Solution>,
 ) -> Option<(Pose, Solution)> {
     let n = kin.axis_count();
-    let mut hint = *near;
+    let mut hint = *near.joints;
     let mut pose = *pose;
+    let hold = near.hold;
     if let Some(h) = hold {
         hint[h.axis] = h.value;
         if let Some(axis) = kin.held_axis(&pose.axis, h.value) {
@@ -65,10 +75,15 @@ pub(crate) fn solve_near(
     let travel =
         |s: &Solution| -> f64 { rotary.iter().map(|&i| (s.joints[i] - hint[i]).abs()).sum() };
     let held = |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value).abs() < 1e-6);
+    let other = |s: &Solution| near.branch.is_some_and(|b| b != s.branch);
     let best = scratch
         .iter()
         .filter(|s| s.is_valid() && held(s))
-        .min_by(|a, b| travel(a).total_cmp(&travel(b)))
+        .min_by(|a, b| {
+            other(a)
+                .cmp(&other(b))
+                .then(travel(a).total_cmp(&travel(b)))
+        })
         .copied()?;
     Some((pose, best))
 }

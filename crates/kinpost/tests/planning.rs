@@ -476,3 +476,30 @@ fn deciding_point_by_point_keeps_the_branch_it_is_on() {
         );
     }
 }
+
+/// Near the folds of a machine whose tool reaches a band of tool axes,
+/// the two branches lie close: the linearization keeps a segment's
+/// midpoints on its ends' branch (the joint-space midpoint may be nearer
+/// the other one), and the planner switches branch only where the
+/// interpolated tool axis reaches a fold. Here it leaves the band between
+/// two points and comes back (found by tests/pressure.rs; it failed with
+/// "does not converge").
+#[test]
+fn a_path_skirting_the_folds_is_linearized() {
+    let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{dir}/random-pressure.toml");
+    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let cl = std::fs::read_to_string(format!("{dir}/band-exit.cls")).unwrap();
+    let options = PostOptions::default();
+    let (csv, summary) = post_csv(&m, &cl, &options).unwrap();
+    assert!(summary.planning.reconfigurations.is_empty());
+    assert!(summary.planning.inserted_blocks > 100);
+    assert!(summary.planning.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
+    assert_eq!(
+        rows(&csv, m.axes.len())
+            .iter()
+            .filter(|r| r.0.is_some())
+            .count(),
+        40
+    );
+}

@@ -112,3 +112,69 @@ fn a_tool_pointing_the_other_way_folds_alike() {
         assert!((folds.distance(&tool).to_degrees() - 90.0).abs() < 1e-9);
     }
 }
+
+#[test]
+fn an_arc_reaches_the_fold_where_its_points_do() {
+    // Arcs between random tool axes against the angle from the fold
+    // direction sampled along them: where the samples pass an edge by more
+    // than the sampling can miss, the arc reaches it; where they stay that
+    // far from every edge, it does not.
+    // The tool tilted on the nutating head: edges away from 90°, where a
+    // short arc may reach one between two points on the same side.
+    let mut m = machine("nutating-45.toml");
+    m.tool.axis = Vector3::new(0.3, 0.5, 0.8).normalize();
+    let folds = Kinematics::new(&m).folds().unwrap();
+    assert!(
+        folds
+            .edges
+            .iter()
+            .all(|e| (e.to_degrees() - 90.0).abs() > 5.0),
+        "{folds:?}"
+    );
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let (mut reached, mut missed) = (0, 0);
+    for _ in 0..600 {
+        let a = Vector3::new(next(), next(), next()).normalize();
+        // Short arcs near the fold as well as long ones anywhere.
+        let b = (a + Vector3::new(next(), next(), next()) * next().abs().powi(3) * 2.0).normalize();
+        let theta = angle(&a, &b);
+        if !(1e-9..=3.1).contains(&theta) {
+            continue;
+        }
+        let u = (b - a * a.dot(&b)).normalize();
+        const SAMPLES: usize = 2000;
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for k in 0..=SAMPLES {
+            let phi = theta * k as f64 / SAMPLES as f64;
+            let t = angle(&folds.direction, &(a * phi.cos() + u * phi.sin()));
+            lo = lo.min(t);
+            hi = hi.max(t);
+        }
+        // Between samples the angle strays by at most (Δφ)²/8 from them.
+        let step = theta / SAMPLES as f64;
+        let miss = step * step + 1e-12;
+        let edges = folds.edges.iter().filter(|e| !e.is_nan());
+        let inside = edges.clone().any(|&e| e > lo + miss && e < hi - miss);
+        let outside = edges
+            .clone()
+            .all(|&e| e < lo - 2.0 * miss || e > hi + 2.0 * miss);
+        let got = folds.reached(&a, &b, 0.0);
+        if inside {
+            assert!(got, "{a:?} → {b:?}: [{lo}, {hi}]");
+            reached += 1;
+        }
+        if outside {
+            assert!(!got, "{a:?} → {b:?}: [{lo}, {hi}]");
+            missed += 1;
+        }
+        // Either way round.
+        assert_eq!(folds.reached(&b, &a, 0.0), got);
+    }
+    assert!(reached > 60 && missed > 60, "{reached} {missed}");
+}
