@@ -97,8 +97,8 @@ pub(crate) struct PathPlan {
     fold_reached: bool,
     segment: u64,
     break_pending: bool,
-    /// The last point written: its node, branch and segment.
-    last: Option<(Node, u8, u64)>,
+    /// The last point written: its node and segment.
+    last: Option<(Node, u64)>,
     choices: Vec<Choice>,
     /// The decided nodes of one run of singular points.
     run: Vec<Decided>,
@@ -376,8 +376,8 @@ impl PathPlan {
         }
         // The last point written is the trellis's anchor already unless it
         // was decided outside it (a singular point at the end).
-        if all && let Some((node, branch, _)) = &self.last {
-            self.trellis.set_anchor(node.joints, *branch);
+        if all && let Some((node, _)) = &self.last {
+            self.trellis.set_anchor(node.joints, node.branch);
         }
         Ok(())
     }
@@ -410,7 +410,7 @@ impl PathPlan {
             },
         )?;
         let segment = p.segment;
-        self.last = Some((d.node, d.node.branch, segment));
+        self.last = Some((d.node, segment));
         Ok(())
     }
 
@@ -427,7 +427,7 @@ impl PathPlan {
         let points = &self.points;
         let seg = points[run.start].segment;
         // The decided neighbours in the same segment.
-        let before: Option<Node> = self.last.filter(|(_, _, s)| *s == seg).map(|(n, _, _)| n);
+        let before: Option<Node> = self.last.filter(|(_, s)| *s == seg).map(|(n, _)| n);
         let after: Option<Node> = points
             .get(run.end)
             .filter(|p| p.segment == seg && !p.singular)
@@ -441,7 +441,7 @@ impl PathPlan {
             });
         let anchor = self
             .last
-            .map(|(n, _, _)| n.joints)
+            .map(|(n, _)| n.joints)
             .or_else(|| self.trellis.anchor().copied())
             .unwrap_or([0.0; MAX_AXES]);
         let axis = self.singularity.map(|s| s.axis);
