@@ -28,6 +28,10 @@ use crate::summary::SingularStretch;
 /// radians (the rounding of CL tool axes; the branches lie within
 /// ≈ √(1e-9) of each other there).
 const FOLD_SLACK_RAD: f64 = 1e-9;
+/// How far outside the singular cone an interpolated tool axis may pass
+/// the singular direction and still count as entering it, radians
+/// (round-off of the arc's least distance).
+const POLE_SLACK_RAD: f64 = 1e-9;
 
 /// Settled points (see [`PathPlan::is_full`]) written at once: enough that
 /// a decision costs next to nothing, few enough that the points, their
@@ -77,16 +81,17 @@ pub(crate) struct PathPlan {
     outputs: Vec<(usize, Pending)>,
     /// CL line texts of the waiting points, back to back.
     source: Vec<u8>,
-    /// Since the last point in the trellis: tool-axis turn (degrees),
-    /// singular points, a segment start.
+    /// Since the last point in the trellis: tool-axis turn (degrees), the
+    /// tool axis near the singular direction (at a singular point, or
+    /// interpolated from point to point), a segment start.
     turn: f64,
     across: bool,
     free: bool,
     /// Tool axis and reference of the last point.
     previous_axes: Option<(Vector3<f64>, Option<Vector3<f64>>)>,
-    /// Distance from the tool axis of the last point in the trellis to the
-    /// singular direction (`None`: no singularity, or no point yet).
-    planned_pole: Option<Pole>,
+    /// Distance from the tool axis of the last point to the singular
+    /// direction (`None`: no singularity, or no point yet).
+    previous_pole: Option<Pole>,
     /// The folds of the machine (see [`Folds`]), if it has any.
     folds: Option<Folds>,
     /// The separation of the branches of the last point in the trellis (see
@@ -129,7 +134,7 @@ impl PathPlan {
             across: false,
             free: true,
             previous_axes: None,
-            planned_pole: None,
+            previous_pole: None,
             folds: kin.folds(),
             planned_fold: None,
             fold_reached: false,
@@ -180,25 +185,40 @@ impl PathPlan {
             self.segment += 1;
             self.free = true;
         }
+        let pole = self.singularity.map(|s| Pole(s.sin_cos(&pose.axis)));
         if let Some((axis, reference)) = &self.previous_axes {
-            let mut turn = angle_between_deg(axis, &pose.axis);
+            let axis_turn = angle_between_deg(axis, &pose.axis);
+            let mut turn = axis_turn;
             if let (Some(a), Some(b)) = (reference, &pose.reference) {
                 turn = turn.max(angle_between_deg(a, b));
             }
             self.turn += turn;
+            // The tool axis, interpolated from point to point (as the
+            // linearization moves it), passes through the singular cone:
+            // the branches meet there, as at singular points. The arc comes
+            // within the cone only if the distances of its ends add up to
+            // at most its length and the cone's diameter (triangle
+            // inequality): far from the pole that settles it.
+            if let (Some(s), Some(a), Some(b)) = (&self.singularity, self.previous_pole, pole) {
+                let cone = self.cone_rad + POLE_SLACK_RAD;
+                if Pole::sum_within(a, b, axis_turn + 2.0 * cone.to_degrees() + 1e-9)
+                    && s.arc_distance(axis, &pose.axis) <= cone
+                {
+                    self.across = true;
+                }
+            }
             if let Some(f) = &self.folds {
                 self.fold_reached |= f.reached(axis, &pose.axis, FOLD_SLACK_RAD);
             }
         }
         self.previous_axes = Some((pose.axis, pose.reference));
+        self.previous_pole = pole;
         // The hint picks the turn of axes without limits: near the cheapest
         // configuration of the previous point.
         let hint: Joints = self.trellis.best_last().copied().unwrap_or([0.0; MAX_AXES]);
         let n = kin.axis_count();
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
             .map_err(|e| PointError::Ik(e.to_string()))?;
-        // Angle between the tool axis and the singular direction.
-        let pole = self.singularity.map(|s| Pole(s.sin_cos(&pose.axis)));
         let in_cone = pole.is_some_and(|p| p.within(self.cone_rad));
         let singular = in_cone || self.solutions.iter().all(|s| s.singular);
         if singular {
@@ -207,16 +227,6 @@ impl PathPlan {
             }
             self.across = true;
         } else {
-            // The tool axis swept past the pole between the two points (its
-            // distances to the pole add up to the turn): the branches meet
-            // there, as across singular points.
-            let limit = self.turn + 2.0 * self.cone_rad.to_degrees() + 1e-9;
-            if let (Some(a), Some(b)) = (self.planned_pole, pole)
-                && Pole::sum_within(a, b, limit)
-            {
-                self.across = true;
-            }
-            self.planned_pole = pole;
             // Near a fold the branches lie apart by a separation that
             // grows like the square root of the distance to it. Where the
             // tool axis, interpolated from point to point (as the

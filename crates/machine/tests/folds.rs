@@ -131,34 +131,9 @@ fn an_arc_reaches_the_fold_where_its_points_do() {
             .all(|e| (e.to_degrees() - 90.0).abs() > 5.0),
         "{folds:?}"
     );
-    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
     let (mut reached, mut missed) = (0, 0);
-    for _ in 0..600 {
-        let a = Vector3::new(next(), next(), next()).normalize();
-        // Short arcs near the fold as well as long ones anywhere.
-        let b = (a + Vector3::new(next(), next(), next()) * next().abs().powi(3) * 2.0).normalize();
-        let theta = angle(&a, &b);
-        if !(1e-9..=3.1).contains(&theta) {
-            continue;
-        }
-        let u = (b - a * a.dot(&b)).normalize();
-        const SAMPLES: usize = 2000;
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for k in 0..=SAMPLES {
-            let phi = theta * k as f64 / SAMPLES as f64;
-            let t = angle(&folds.direction, &(a * phi.cos() + u * phi.sin()));
-            lo = lo.min(t);
-            hi = hi.max(t);
-        }
-        // Between samples the angle strays by at most (Δφ)²/8 from them.
-        let step = theta / SAMPLES as f64;
-        let miss = step * step + 1e-12;
+    for (a, b) in random_arcs() {
+        let (lo, hi, miss) = sampled_angles(&folds.direction, &a, &b);
         let edges = folds.edges.iter().filter(|e| !e.is_nan());
         let inside = edges.clone().any(|&e| e > lo + miss && e < hi - miss);
         let outside = edges
@@ -177,4 +152,73 @@ fn an_arc_reaches_the_fold_where_its_points_do() {
         assert_eq!(folds.reached(&b, &a, 0.0), got);
     }
     assert!(reached > 60 && missed > 60, "{reached} {missed}");
+}
+
+#[test]
+fn an_arc_comes_as_near_the_pole_as_its_points_do() {
+    // The least distance to the singular direction (or its opposite) along
+    // arcs between random tool axes, against samples along them.
+    let m = builtin::load("head-head-bc").unwrap().unwrap();
+    let s = Kinematics::new(&m).singularity().unwrap();
+    let (mut inner, mut at_ends) = (0, 0);
+    for (a, b) in random_arcs() {
+        let (lo, hi, miss) = sampled_angles(&s.direction, &a, &b);
+        let want = lo.min(std::f64::consts::PI - hi);
+        let got = s.arc_distance(&a, &b);
+        assert!(
+            got <= want + 1e-12 && got >= want - miss,
+            "{a:?} → {b:?}: {got} vs sampled {want}"
+        );
+        assert!((s.arc_distance(&b, &a) - got).abs() < 1e-12);
+        let ends = s.distance(&a).min(s.distance(&b));
+        if got < ends - 1e-3 {
+            inner += 1;
+        } else {
+            at_ends += 1;
+        }
+    }
+    assert!(inner > 30 && at_ends > 60, "{inner} {at_ends}");
+}
+
+/// Pairs of random unit tool axes: short arcs as well as long ones
+/// (below 3.1 rad: the shorter arc is well defined).
+fn random_arcs() -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut arcs = Vec::new();
+    for _ in 0..600 {
+        let a = Vector3::new(next(), next(), next()).normalize();
+        let b = (a + Vector3::new(next(), next(), next()) * next().abs().powi(3) * 2.0).normalize();
+        if (1e-9..=3.1).contains(&angle(&a, &b)) {
+            arcs.push((a, b));
+        }
+    }
+    arcs
+}
+
+/// The least and largest angle from `d` over 2,001 points of the arc from
+/// `a` to `b`, and how far the arc itself can stray beyond them between
+/// samples.
+fn sampled_angles(d: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64, f64) {
+    let theta = angle(a, b);
+    let u = (b - a * a.dot(b)).normalize();
+    const SAMPLES: usize = 2000;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..=SAMPLES {
+        let phi = theta * k as f64 / SAMPLES as f64;
+        let t = angle(d, &(a * phi.cos() + u * phi.sin()));
+        lo = lo.min(t);
+        hi = hi.max(t);
+    }
+    // Between samples the angle strays from them by at most (Δφ)²/8 times
+    // its curvature, 1/sin of the angle from ±d (which is at least the
+    // nearest sample's less a step: the angle changes no faster than φ).
+    let step = theta / SAMPLES as f64;
+    let near = lo.min(std::f64::consts::PI - hi) - step;
+    (lo, hi, step * step / (8.0 * near.max(step).sin()) + 1e-12)
 }

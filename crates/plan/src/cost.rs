@@ -17,9 +17,14 @@ const PREFERENCE: f64 = 0.01;
 /// Cost per whole turn away from the principal value, for `wrap = "unwind"`
 /// axes at the start of a segment: large enough to always unwind.
 const UNWIND: f64 = 1e4;
-/// A rotary step this small is always continuous, whatever the tool axis did
-/// (round-off, CL points that repeat the tool axis).
+/// A rotary step this small is always continuous on one branch, whatever
+/// the tool axis did (round-off, CL points that repeat the tool axis).
 const STEP_FLOOR_DEG: f64 = 1.0;
+/// The largest rotary step of a switch of branch where the branches do not
+/// meet (neither a singular stretch nor a fold between the points): none.
+/// Near a fold the branches may lie within a degree of each other, and a
+/// switch there is a jump the linearization cannot follow.
+const SWITCH_APART_DEG: f64 = 0.0;
 /// No rotary axis turns by half a turn or more between two points of a cut.
 const STEP_CEILING_DEG: f64 = 179.0;
 
@@ -66,7 +71,7 @@ impl CutRule {
         let switching = if across_singular || across_fold {
             bound
         } else {
-            STEP_FLOOR_DEG
+            SWITCH_APART_DEG
         };
         let mut same = [bound; MAX_ROTARY];
         let mut switch = [switching; MAX_ROTARY];
@@ -302,7 +307,7 @@ impl Costs {
                     let step = (b[r.index] - a[r.index]).abs();
                     let limit = match self.singular_axis {
                         Some(i) if i == r.index && across_singular => 180.0 + 1e-9,
-                        _ if switch && !across_singular && !across_fold => STEP_FLOOR_DEG,
+                        _ if switch && !across_singular && !across_fold => SWITCH_APART_DEG,
                         _ => bound,
                     };
                     if step > limit {
@@ -365,6 +370,12 @@ mod tests {
         // the turn of the tool axis.
         let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(38.0, 12.0), 1, cut);
         assert!(!ok);
+        // Also within the step floor (near a fold the branches may lie that
+        // close without meeting between the points).
+        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(40.2, 10.9), 1, cut);
+        assert!(!ok);
+        let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(40.2, 10.9), 0, cut);
+        assert!(ok);
         // Whole turns never pass.
         let (_, ok) = costs.transition(&joints(40.0, 10.0), 0, &joints(40.0, 370.0), 0, across);
         assert!(!ok);
@@ -391,15 +402,19 @@ mod tests {
         let cut = link(0.0, false);
         assert!(!costs.transition(&a, 0, &b, 0, cut).1);
         assert!(costs.transition(&a, 0, &b, 0, near(false)).1);
-        // Switching branch needs the fold between the points.
+        // Switching branch needs the fold between the points, even for a
+        // step within the floor.
         assert!(!costs.transition(&a, 0, &b, 1, near(false)).1);
+        let c = joints(57.0, 32.6);
+        assert!(!costs.transition(&a, 0, &c, 1, near(false)).1);
+        assert!(costs.transition(&a, 0, &c, 1, near(true)).1);
         assert!(costs.transition(&a, 0, &b, 1, near(true)).1);
         // The fast path's limits say the same.
         let rule = costs.cut_rule().unwrap();
         for across_fold in [false, true] {
             let l = rule.limits(0.005, false, 1.5, across_fold);
             assert_eq!(l.same[0], 2.5);
-            assert_eq!(l.switch[0], if across_fold { 2.5 } else { STEP_FLOOR_DEG });
+            assert_eq!(l.switch[0], if across_fold { 2.5 } else { 0.0 });
         }
     }
 

@@ -44,6 +44,14 @@ impl Singularity {
             self.direction.dot(axis).abs(),
         )
     }
+
+    /// The least [`Singularity::distance`] along the shorter great-circle
+    /// arc from tool axis `a` to `b` (unit; the path a linearization
+    /// interpolates), radians.
+    pub fn arc_distance(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+        let (lo, hi) = arc_angles(&self.direction, a, b);
+        lo.min(std::f64::consts::PI - hi)
+    }
 }
 
 /// The tool-axis directions at which the two branches of a machine with two
@@ -80,43 +88,50 @@ impl Folds {
 
     /// Whether the shorter great-circle arc from tool axis `a` to `b` (unit;
     /// the path a linearization interpolates) reaches a fold, within
-    /// `slack` radians: the angle from `direction` along the arc takes
-    /// every value between its least and its largest, which lie at the ends
-    /// or where the arc is nearest and farthest from `direction`.
+    /// `slack` radians.
     pub fn reached(&self, a: &Vector3<f64>, b: &Vector3<f64>, slack: f64) -> bool {
-        let d = &self.direction;
-        let (mut lo, mut hi) = {
-            let (ta, tb) = (angle_between(d, a), angle_between(d, b));
-            (ta.min(tb), ta.max(tb))
-        };
-        // The arc: x(φ) = cos φ·a + sin φ·u for φ in [0, θ], u the unit
-        // vector normal to a towards b; d·x(φ) = p·cos φ + q·sin φ is
-        // largest at φ* = atan2(q, p) and least half a turn on.
-        let theta = angle_between(a, b);
-        let u = b - a * a.dot(b);
-        let norm = u.norm();
-        if theta > 0.0 && norm > 0.0 {
-            let u = u / norm;
-            let (p, q) = (d.dot(a), d.dot(&u));
-            let nearest = atan2_rad(q, p);
-            let farthest = if nearest > 0.0 {
-                nearest - std::f64::consts::PI
-            } else {
-                nearest + std::f64::consts::PI
-            };
-            for phi in [nearest, farthest] {
-                if phi > 0.0 && phi < theta {
-                    let x = a * phi.cos() + u * phi.sin();
-                    let t = angle_between(d, &x);
-                    lo = lo.min(t);
-                    hi = hi.max(t);
-                }
-            }
-        }
+        let (lo, hi) = arc_angles(&self.direction, a, b);
         self.edges
             .iter()
             .any(|&e| e >= lo - slack && e <= hi + slack)
     }
+}
+
+/// The least and the largest angle from `d` (unit) along the shorter
+/// great-circle arc from `a` to `b` (unit; the tool axis a linearization
+/// interpolates between two points), radians. The angle takes every value
+/// between them along the arc; they lie at the ends or where the arc is
+/// nearest and farthest from `d`.
+fn arc_angles(d: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = {
+        let (ta, tb) = (angle_between(d, a), angle_between(d, b));
+        (ta.min(tb), ta.max(tb))
+    };
+    // The arc: x(φ) = cos φ·a + sin φ·u for φ in [0, θ], u the unit vector
+    // normal to a towards b; d·x(φ) = p·cos φ + q·sin φ is largest at
+    // φ* = atan2(q, p) and least half a turn on.
+    let theta = angle_between(a, b);
+    let u = b - a * a.dot(b);
+    let norm = u.norm();
+    if theta > 0.0 && norm > 0.0 {
+        let u = u / norm;
+        let (p, q) = (d.dot(a), d.dot(&u));
+        let nearest = atan2_rad(q, p);
+        let farthest = if nearest > 0.0 {
+            nearest - std::f64::consts::PI
+        } else {
+            nearest + std::f64::consts::PI
+        };
+        for phi in [nearest, farthest] {
+            if phi > 0.0 && phi < theta {
+                let x = a * phi.cos() + u * phi.sin();
+                let t = angle_between(d, &x);
+                lo = lo.min(t);
+                hi = hi.max(t);
+            }
+        }
+    }
+    (lo, hi)
 }
 
 impl Kinematics {
