@@ -98,6 +98,8 @@ pub(crate) struct Emitter<W: Write> {
     n: usize,
     /// Free rotary axes.
     rotary: Vec<usize>,
+    /// Free linear axes.
+    linear: Vec<usize>,
     /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
     /// measures it: one unit of the last decimal of every free axis.
     rounding_travel: (f64, f64),
@@ -136,6 +138,9 @@ impl<W: Write> Emitter<W> {
             settings,
             n: axes.len(),
             rotary: machine.free_rotary_axes().collect(),
+            linear: (0..axes.len())
+                .filter(|&i| axes[i].is_free() && !axes[i].is_rotary())
+                .collect(),
             vmax: (0..axes.len())
                 .filter(|&i| axes[i].is_free())
                 .filter_map(|i| axes[i].max_velocity.map(|v| (i, v)))
@@ -272,10 +277,21 @@ impl<W: Write> Emitter<W> {
         let span = (a.pose.point - b.pose.point).norm();
         if depth >= MAX_DEPTH || (span < 1e-7 && turn < 1e-9) {
             // The axes move while the pose hardly does: not a continuous
-            // motion of the tool.
-            return Err(
-                "the rotary axes cannot follow the path continuously (the joint motion does not converge to the straight CL segment)",
-            );
+            // motion of the tool. Where the volume the linear axes span
+            // (1 for axes at right angles) is nearly zero or changes sign,
+            // their directions (turned by rotary axes between them in the
+            // chain) become coplanar there, and their travel grows like
+            // the inverse of the distance to that place.
+            let volume = |q: &Joints| linear_volume(kin, q, self.n, &self.linear);
+            let coplanar = match (volume(&a.joints), volume(&b.joints)) {
+                (Some(va), Some(vb)) => va * vb <= 0.0 || va.abs().min(vb.abs()) < 0.02,
+                _ => false,
+            };
+            return Err(if coplanar {
+                "the linear axes cannot follow the straight CL segment (rotary axes between them in the chain turn their directions into a plane along it, where their travel grows without bound; --lintol 0 writes the segment as one joint move)"
+            } else {
+                "the rotary axes cannot follow the path continuously (the joint motion does not converge to the straight CL segment)"
+            });
         }
         let pose = interpolate(&a.pose, &b.pose, 0.5);
         // Inside the singular cone the singular angle moves linearly in
@@ -617,6 +633,23 @@ pub(crate) fn distance_to_segment(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector
         0.0
     };
     (p - (a + ab * t)).norm()
+}
+
+/// The signed volume the directions of three linear axes span at `q` (part
+/// frame, by the forward kinematics: the tool point's motion per unit of
+/// each axis); `None` unless there are three. It changes sign where rotary
+/// axes between them in the chain turn them into a plane.
+fn linear_volume(kin: &Kinematics, q: &Joints, n: usize, linear: &[usize]) -> Option<f64> {
+    let &[i, j, k] = linear else {
+        return None;
+    };
+    let base = kin.fk(&q[..n]).point;
+    let direction = |axis: usize| {
+        let mut moved = *q;
+        moved[axis] += 1.0;
+        kin.fk(&moved[..n]).point - base
+    };
+    Some(direction(i).dot(&direction(j).cross(&direction(k))))
 }
 
 #[cfg(test)]
