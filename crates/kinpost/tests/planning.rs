@@ -555,22 +555,24 @@ fn deciding_point_by_point_keeps_the_branch_it_is_on() {
 /// "does not converge").
 #[test]
 fn a_path_skirting_the_folds_is_linearized() {
-    let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
-    let path = format!("{dir}/random-pressure.toml");
-    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
-    let cl = std::fs::read_to_string(format!("{dir}/band-exit.cls")).unwrap();
-    let options = PostOptions::default();
-    let (csv, summary) = post_csv(&m, &cl, &options).unwrap();
-    assert!(summary.planning.reconfigurations.is_empty());
+    let summary = posts_fold_fixture("random-pressure.toml", "band-exit.cls", 40);
     assert!(summary.planning.inserted_blocks > 100);
+}
+
+/// Posts a CL file of `tests/folds` on a machine there with the defaults:
+/// no reconfiguration, linearized within the tolerance, a block for each of
+/// the `points` CL points.
+fn posts_fold_fixture(machine: &str, cl: &str, points: usize) -> Summary {
+    let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{dir}/{machine}");
+    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let cl = std::fs::read_to_string(format!("{dir}/{cl}")).unwrap();
+    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    assert!(summary.planning.reconfigurations.is_empty());
     assert!(summary.planning.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
-    assert_eq!(
-        rows(&csv, m.axes.len())
-            .iter()
-            .filter(|r| r.0.is_some())
-            .count(),
-        40
-    );
+    let all = rows(&csv, m.axes.len());
+    assert_eq!(all.iter().filter(|r| r.0.is_some()).count(), points);
+    summary
 }
 
 /// Between CL lines 13 and 14 the tool axis passes within 0.0003° of a fold
@@ -580,13 +582,5 @@ fn a_path_skirting_the_folds_is_linearized() {
 /// be linearized ("does not converge").
 #[test]
 fn a_path_passing_a_fold_it_does_not_reach_keeps_its_branch() {
-    let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
-    let path = format!("{dir}/near-fold.toml");
-    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
-    let cl = std::fs::read_to_string(format!("{dir}/near-fold.cls")).unwrap();
-    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
-    assert!(summary.planning.reconfigurations.is_empty());
-    assert!(summary.planning.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
-    let all = rows(&csv, m.axes.len());
-    assert_eq!(all.iter().filter(|r| r.0.is_some()).count(), 25);
+    posts_fold_fixture("near-fold.toml", "near-fold.cls", 25);
 }
