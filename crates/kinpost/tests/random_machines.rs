@@ -72,11 +72,11 @@ fn seed_10053701000599962857() {
 }
 
 /// Whether rotary axes turn the linear axes' directions (as the part sees
-/// them) by different rotations: a rotary axis lies between two linear ones
-/// in the chain. Then the three directions can become coplanar along a
-/// path, and the linear axes cannot follow the straight CL segment there
-/// (their travel grows without bound). With the linear axes next to each
-/// other in the chain, the volume they span never changes.
+/// them) by different rotations (e.g. a rotary axis lies between two linear
+/// ones in the chain). Then the three directions can become coplanar along
+/// a path, and the linear axes cannot follow the straight CL segment there
+/// (their travel grows without bound). Turned alike, they keep the volume
+/// they span.
 fn turned_apart(m: &Machine) -> bool {
     // Chain order from the base outwards, per side. The part frame sits at
     // the end of the workpiece side: a workpiece-side axis is turned by the
