@@ -203,11 +203,24 @@ impl<W: Write> Emitter<W> {
                     // the CL asks for at feed: it is written as it is.
                     Err(_) if !t.cut => inserted.clear(),
                     Err(e) => {
-                        return Err((t.at)(format!(
-                            "{e} between CL line {} and this point, {}",
-                            from_line,
-                            describe(&t.node.pose)
-                        )));
+                        let to = &t.node.pose;
+                        // Leaving the band explains a midpoint the machine
+                        // cannot reach and halving that does not converge.
+                        let band = match e {
+                            SplitError::LinearPlane => None,
+                            _ => outside_the_band(kin, &from.pose, to),
+                        };
+                        return Err((t.at)(match band {
+                            Some(band) => format!(
+                                "the tool axis interpolated between CL line {from_line} and this point, {}, {band}",
+                                describe(to)
+                            ),
+                            None => format!(
+                                "{} between CL line {from_line} and this point, {}",
+                                e.message(),
+                                describe(to)
+                            ),
+                        }));
                     }
                 }
                 for node in &inserted {
@@ -241,7 +254,7 @@ impl<W: Write> Emitter<W> {
         lever: f64,
         depth: u32,
         out: &mut Vec<Node>,
-    ) -> Result<(), &'static str> {
+    ) -> Result<(), SplitError> {
         if let Some(bound) = chord_settles(kin, a, b, lever, self.settings.lintol) {
             let p = &mut self.planning;
             p.max_linearization_error_mm = p.max_linearization_error_mm.max(bound);
@@ -260,7 +273,7 @@ impl<W: Write> Emitter<W> {
         lever: f64,
         depth: u32,
         out: &mut Vec<Node>,
-    ) -> Result<(), &'static str> {
+    ) -> Result<(), SplitError> {
         let n = self.n;
         let mut mid = a.joints;
         for (m, v) in mid.iter_mut().zip(&b.joints).take(n) {
@@ -288,9 +301,9 @@ impl<W: Write> Emitter<W> {
                 _ => false,
             };
             return Err(if coplanar {
-                "the linear axes cannot follow the straight CL segment (rotary axes between them in the chain turn their directions into a plane along it, where their travel grows without bound; --lintol 0 writes the segment as one joint move)"
+                SplitError::LinearPlane
             } else {
-                "the rotary axes cannot follow the path continuously (the joint motion does not converge to the straight CL segment)"
+                SplitError::NoConvergence
             });
         }
         let pose = interpolate(&a.pose, &b.pose, 0.5);
@@ -326,7 +339,7 @@ impl<W: Write> Emitter<W> {
                 solve_near(kin, &natural, &near, &self.rotary, &mut self.solutions)
             });
         let Some((pose, sol)) = solved else {
-            return Err("an intermediate pose of the linearization is outside the travel");
+            return Err(SplitError::OutsideTravel);
         };
         let m = Node {
             pose,
@@ -650,6 +663,55 @@ fn linear_volume(kin: &Kinematics, q: &Joints, n: usize, linear: &[usize]) -> Op
         kin.fk(&moved[..n]).point - base
     };
     Some(direction(i).dot(&direction(j).cross(&direction(k))))
+}
+
+/// Why a CL segment cannot be linearized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SplitError {
+    /// The directions of the three linear axes become coplanar along it.
+    LinearPlane,
+    /// The halving reached its depth while the pose hardly moved.
+    NoConvergence,
+    /// No solution inside the travel at a midpoint.
+    OutsideTravel,
+}
+
+impl SplitError {
+    fn message(self) -> &'static str {
+        match self {
+            SplitError::LinearPlane => {
+                "the linear axes cannot follow the straight CL segment (rotary axes between them in the chain turn their directions into a plane along it, where their travel grows without bound; --lintol 0 writes the segment as one joint move)"
+            }
+            SplitError::NoConvergence => {
+                "the rotary axes cannot follow the path continuously (the joint motion does not converge to the straight CL segment)"
+            }
+            SplitError::OutsideTravel => {
+                "an intermediate pose of the linearization is outside the travel"
+            }
+        }
+    }
+}
+
+/// Why no motion follows the CL segment from `a` to `b` when the tool axis
+/// interpolated along it (the great circle the linearization follows)
+/// leaves the band of directions the machine can point (see
+/// [`kinpost_machine::Folds`]), as the end of a sentence on that axis;
+/// `None` when it stays inside.
+fn outside_the_band(kin: &Kinematics, a: &Pose, b: &Pose) -> Option<String> {
+    let e = kin.folds()?.arc_outside(&a.axis, &b.axis)?;
+    // Below this the linearization's own rounding, not the machine, decides.
+    (e.depth > 1e-9).then(|| {
+        // (+ 0.0: no "-0.0000000".)
+        let c = e.cone_axis.map(|v| v + 0.0);
+        format!(
+            "passes {:.4}° into the cone of directions within {:.4}° of ({:.7}, {:.7}, {:.7}) that the machine cannot point: add CL points outside that cone, or --lintol 0 writes the segment as one joint move",
+            e.depth.to_degrees(),
+            e.half_angle.to_degrees(),
+            c.x,
+            c.y,
+            c.z
+        )
+    })
 }
 
 #[cfg(test)]

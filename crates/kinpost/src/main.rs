@@ -276,6 +276,28 @@ fn run(cli: Cli) -> Result<()> {
                 free.len(),
                 free.join(" ")
             );
+            if let Some(folds) = Kinematics::new(&m).folds() {
+                // Two rotary axes at another angle than the tool makes with
+                // the inner one: say which tool axes exist at all, from the
+                // end of the singular direction the band lies nearer.
+                let [lo, hi] = folds.edges.map(|e| e.to_degrees());
+                let (lo, hi) = (
+                    if lo.is_nan() { 0.0 } else { lo },
+                    if hi.is_nan() { 180.0 } else { hi },
+                );
+                let flip = lo + hi > 180.0;
+                let (lo, hi, d) = if flip {
+                    (180.0 - hi, 180.0 - lo, -folds.direction)
+                } else {
+                    (lo, hi, folds.direction)
+                };
+                // (+ 0.0: no "-0.0000000".)
+                let d = d.map(|v| v + 0.0);
+                println!(
+                    "  the tool axis reaches only the directions {lo:.4}° to {hi:.4}° from ({:.7}, {:.7}, {:.7}); at an edge that is not 0° or 180° the two solutions meet (a fold)",
+                    d.x, d.y, d.z
+                );
+            }
             Ok(())
         }
         Command::Dialects => {

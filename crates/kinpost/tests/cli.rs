@@ -312,6 +312,20 @@ fn machine_check() {
     assert_exit(&o, 0);
     assert!(stdout(&o).contains("is valid"), "{}", stdout(&o));
     assert!(stdout(&o).contains("5 free: X A Y Z B"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("reaches only"), "{}", stdout(&o));
+
+    // A nutating head whose tool is 0.2° off its B axis's inclination
+    // (45.2° from B): the tool axis makes 0.2° to 90.2° with the C axis.
+    let folds = root().join("crates/kinpost/tests/folds/nutating-off.toml");
+    let o = run(&["machine", "check", folds.to_str().unwrap()]);
+    assert_exit(&o, 0);
+    assert!(
+        stdout(&o).contains(
+            "the tool axis reaches only the directions 0.2000° to 90.2000° from (0.0000000, 0.0000000, 1.0000000)"
+        ),
+        "{}",
+        stdout(&o)
+    );
 
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");

@@ -559,6 +559,38 @@ fn a_path_skirting_the_folds_is_linearized() {
     assert!(summary.planning.inserted_blocks > 100);
 }
 
+/// The tool axis of nutating-off.toml cannot point within 0.2° of the C
+/// axis (a fold, not a pole, bounds the band there). cone-crossing.cls
+/// tilts it 1° at azimuth 0°, then at 170°: the great circle between
+/// passes the C axis at atan(tan 1°·cos 85°) and enters that cone. The
+/// error names the cone and the depth instead of a linearization that
+/// does not converge.
+#[test]
+fn a_segment_through_a_cone_the_machine_cannot_point_is_named() {
+    let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{dir}/nutating-off.toml");
+    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let cl = std::fs::read_to_string(format!("{dir}/cone-crossing.cls")).unwrap();
+    let e = post_csv(&m, &cl, &PostOptions::default())
+        .unwrap_err()
+        .to_string();
+    let nearest = (1f64.to_radians().tan() * 85f64.to_radians().cos())
+        .atan()
+        .to_degrees();
+    let want = format!(
+        "the tool axis interpolated between CL line 7 and this point, point (3.0000, 0.0000, 0.0000) axis (-0.0171873, 0.0030306, 0.9998477), passes {:.4}° into the cone of directions within 0.2000° of (0.0000000, 0.0000000, 1.0000000) that the machine cannot point",
+        0.2 - nearest
+    );
+    assert!(e.contains(&want), "{e}\nwanted: {want}");
+    // Written as joint moves, the segment posts.
+    let options = PostOptions {
+        lintol_mm: Some(0.0),
+        ..Default::default()
+    };
+    let (csv, _) = post_csv(&m, &cl, &options).unwrap();
+    assert_eq!(rows(&csv, m.axes.len()).len(), 6);
+}
+
 /// Posts a CL file of `tests/folds` on a machine there with the defaults:
 /// no reconfiguration, linearized within the tolerance, a block for each of
 /// the `points` CL points.

@@ -45,7 +45,7 @@ use crate::angle::{atan2_deg, sin_cos_deg};
 mod chord;
 mod singular;
 pub use chord::{lever_over, midpoint_bound};
-pub use singular::{Folds, Singularity};
+pub use singular::{Excursion, Folds, Singularity};
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
 use crate::subproblems::{FREE_EPS, Sp2, coordinate_axis, rotation, rotation_cs, sp1_xy, unit_xy};

@@ -24,7 +24,7 @@ pub mod subproblems;
 
 pub use file::machine_from_toml;
 pub use kinematics::{
-    Folds, IkError, Joints, Kinematics, Singularity, Solution, Violation, lever_over,
+    Excursion, Folds, IkError, Joints, Kinematics, Singularity, Solution, Violation, lever_over,
     midpoint_bound, wrap180,
 };
 pub use model::{

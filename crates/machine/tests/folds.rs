@@ -180,6 +180,78 @@ fn an_arc_comes_as_near_the_pole_as_its_points_do() {
     assert!(inner > 30 && at_ends > 60, "{inner} {at_ends}");
 }
 
+#[test]
+fn an_arc_leaves_the_band_as_far_as_its_points_do() {
+    // How far arcs between random tool axes go outside the band of
+    // reachable directions, against samples along them and the forward
+    // kinematics: the tool tilted on the nutating head so that the band has
+    // a fold at each edge (a cone it cannot point around the pole, and one
+    // around its opposite).
+    let mut m = machine("nutating-45.toml");
+    m.tool.axis = Vector3::new(0.3, 0.5, 0.8).normalize();
+    let kin = Kinematics::new(&m);
+    let folds = kin.folds().unwrap();
+    let [lower, upper] = folds.edges;
+    assert!(lower > 0.1 && upper < 3.1, "{folds:?}");
+    // Every tool axis the machine points lies in the band.
+    let (ib, ic) = (m.axis_index("B").unwrap(), m.axis_index("C").unwrap());
+    let mut q = vec![0.0; m.axes.len()];
+    for k in 0..=360 {
+        q[ib] = f64::from(k);
+        q[ic] = 13.0 * f64::from(k);
+        let t = angle(&folds.direction, &kin.fk(&q).axis);
+        assert!(t >= lower - 1e-12 && t <= upper + 1e-12, "B {k}: {t}");
+    }
+    let (mut below, mut above, mut inside) = (0, 0, 0);
+    // Random arcs, and the same drawn towards either cone (the one beyond
+    // the upper fold is narrow).
+    let d = folds.direction;
+    let toward = |c: Vector3<f64>, w: f64| {
+        random_arcs()
+            .into_iter()
+            .map(move |(a, b)| ((a + c * w).normalize(), (b + c * w).normalize()))
+    };
+    let arcs = random_arcs()
+        .into_iter()
+        .chain(toward(d, 1.0))
+        .chain(toward(-d, 6.0));
+    for (a, b) in arcs {
+        let (lo, hi, miss) = sampled_angles(&d, &a, &b);
+        let got = folds.arc_outside(&a, &b);
+        let back = folds.arc_outside(&b, &a);
+        assert_eq!(got.is_some(), back.is_some(), "either way round");
+        if let (Some(x), Some(y)) = (got, back) {
+            assert!((x.depth - y.depth).abs() < 1e-12 && x.cone_axis == y.cone_axis);
+        }
+        let want = (lower - lo).max(hi - upper);
+        match got {
+            None => {
+                assert!(want <= miss, "{a:?} → {b:?}: sampled {want} outside");
+                inside += 1;
+            }
+            Some(e) => {
+                assert!(
+                    e.depth >= want - 1e-12 && e.depth <= want + miss,
+                    "{a:?} → {b:?}: {} vs sampled {want}",
+                    e.depth
+                );
+                let (axis, half) = if lower - lo >= hi - upper {
+                    below += 1;
+                    (d, lower)
+                } else {
+                    above += 1;
+                    (-d, std::f64::consts::PI - upper)
+                };
+                assert_eq!((e.cone_axis, e.half_angle), (axis, half));
+            }
+        }
+    }
+    assert!(
+        below > 30 && above > 30 && inside > 30,
+        "{below} {above} {inside}"
+    );
+}
+
 /// Pairs of random unit tool axes: short arcs as well as long ones
 /// (below 3.1 rad: the shorter arc is well defined).
 fn random_arcs() -> Vec<(Vector3<f64>, Vector3<f64>)> {

@@ -71,7 +71,8 @@ impl Singularity {
 pub struct Folds {
     /// Unit direction in the part frame (that of [`Singularity`]).
     pub direction: Vector3<f64>,
-    /// Angles from `direction` of the folds, radians (unused ones NaN).
+    /// Angles from `direction` of the lower and the upper fold, radians
+    /// (NaN where that edge of the band is a pole).
     pub edges: [f64; 2],
 }
 
@@ -95,6 +96,44 @@ impl Folds {
             .iter()
             .any(|&e| e >= lo - slack && e <= hi + slack)
     }
+
+    /// Where the shorter great-circle arc from tool axis `a` to `b` (unit;
+    /// the path a linearization interpolates) goes deepest outside the band
+    /// of directions the machine can point: into the cone inside the lower
+    /// fold (around `direction`) or beyond the upper one (around its
+    /// opposite). `None` when it stays inside the band.
+    pub fn arc_outside(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> Option<Excursion> {
+        use std::f64::consts::PI;
+        let (lo, hi) = arc_angles(&self.direction, a, b);
+        let [lower, upper] = self.edges;
+        // An edge that is a pole (NaN) bounds nothing.
+        let below = Excursion {
+            cone_axis: self.direction,
+            half_angle: lower,
+            depth: lower - lo,
+        };
+        let above = Excursion {
+            cone_axis: -self.direction,
+            half_angle: PI - upper,
+            depth: hi - upper,
+        };
+        [below, above]
+            .into_iter()
+            .filter(|e| e.depth > 0.0)
+            .max_by(|x, y| x.depth.total_cmp(&y.depth))
+    }
+}
+
+/// How far an arc of tool axes enters a cone of directions the machine
+/// cannot point ([`Folds::arc_outside`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Excursion {
+    /// The cone's axis (unit, part frame).
+    pub cone_axis: Vector3<f64>,
+    /// The cone's half-angle, radians (the angle of a fold from its axis).
+    pub half_angle: f64,
+    /// How far inside the cone the arc comes, radians.
+    pub depth: f64,
 }
 
 /// The least and the largest angle from `d` (unit) along the shorter
