@@ -276,6 +276,12 @@ fn run(cli: Cli) -> Result<()> {
                 free.len(),
                 free.join(" ")
             );
+            for a in m.axes.iter().filter(|a| a.is_endless()) {
+                let limits = a.limits.map_or(String::new(), |[lo, hi]| {
+                    format!("; its limits [{lo}, {hi}] are not applied")
+                });
+                println!("  {} turns without end (wrap = \"modulo\"){limits}", a.name);
+            }
             if let Some(folds) = Kinematics::new(&m).folds() {
                 // Two rotary axes at another angle than the tool makes with
                 // the inner one: say which tool axes exist at all, from the

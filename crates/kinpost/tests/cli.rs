@@ -313,6 +313,13 @@ fn machine_check() {
     assert!(stdout(&o).contains("is valid"), "{}", stdout(&o));
     assert!(stdout(&o).contains("5 free: X A Y Z B"), "{}", stdout(&o));
     assert!(!stdout(&o).contains("reaches only"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains(
+            "A turns without end (wrap = \"modulo\"); its limits [-360, 360] are not applied"
+        ),
+        "{}",
+        stdout(&o)
+    );
 
     // A nutating head whose tool is 0.2° off its B axis's inclination
     // (45.2° from B): the tool axis makes 0.2° to 90.2° with the C axis.

@@ -199,6 +199,53 @@ fn short_c() -> Machine {
     m
 }
 
+/// A C axis whose file gives it ±370° (a head's cables, say) and no `wrap`
+/// keeps them: a tool axis turning three times about the part's Z is
+/// written inside them, with reconfigurations. Only `wrap = "modulo"`
+/// turns it without end.
+#[test]
+fn limits_of_more_than_a_turn_are_kept_unless_the_axis_is_modulo() {
+    let source = builtin::source("trunnion-ac").unwrap().replace(
+        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+        "point = [0, 0, 0]\nlimits = [-370, 370]",
+    );
+    let mut cl = String::from("FEDRAT/MMPM,800\n");
+    for k in 0..=216 {
+        let phi = (5.0 * k as f64).to_radians();
+        let tilt = 25f64.to_radians();
+        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
+        cl.push_str(&goto(
+            &Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0),
+            &axis,
+        ));
+    }
+    let largest_c = |source: &str| {
+        let m = machine_from_toml(source, "c370.toml").unwrap();
+        let ic = m.axis_index("C").unwrap();
+        assert_eq!(m.axes[ic].limits, Some([-370.0, 370.0]));
+        let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+        let c = rows(&csv, m.axes.len())
+            .iter()
+            .map(|r| r.2[ic].abs())
+            .fold(0.0, f64::max);
+        (c, summary.planning.reconfigurations.len())
+    };
+    let (c, reconfigurations) = largest_c(&source);
+    assert!(
+        c <= 370.0 + 1e-9 && reconfigurations > 0,
+        "C {c}°, {reconfigurations}"
+    );
+    let modulo = source.replace(
+        "limits = [-370, 370]",
+        "limits = [-370, 370]\nwrap = \"modulo\"",
+    );
+    let (c, reconfigurations) = largest_c(&modulo);
+    assert!(
+        c > 720.0 && reconfigurations == 0,
+        "C {c}°, {reconfigurations}"
+    );
+}
+
 /// Tool axis tilted 25° turning about the part's Z by 270°: more than C's
 /// range on either A branch.
 fn long_turn() -> String {

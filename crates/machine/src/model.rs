@@ -92,10 +92,11 @@ impl Axis {
     }
 
     /// The `wrap` of an axis whose machine file does not say: modulo for a
-    /// rotary axis without limits or with at least a full turn each way
-    /// (±360°), continuous otherwise.
+    /// rotary axis without limits, continuous otherwise. Limits a file gives
+    /// are kept unless it asks for modulo: a head whose cables allow ±370°
+    /// must not be turned without end.
     pub fn default_wrap(kind: AxisKind, limits: Option<[f64; 2]>) -> Wrap {
-        if kind == AxisKind::Rotary && limits.is_none_or(|[lo, hi]| hi - lo >= 720.0) {
+        if kind == AxisKind::Rotary && limits.is_none() {
             Wrap::Modulo
         } else {
             Wrap::None
