@@ -24,7 +24,6 @@ const UNIT_TOLERANCE: f64 = 1e-6;
 const MAX_ROTARY_TRAVEL: f64 = 3600.0;
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawMachine {
     name: Option<Spanned<String>>,
     #[serde(default)]
@@ -39,7 +38,6 @@ struct RawMachine {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
 struct RawPost {
     dialect: Option<String>,
     header: Option<String>,
@@ -89,7 +87,6 @@ enum RawSide {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawAxis {
     name: Spanned<String>,
     kind: RawKind,
@@ -109,7 +106,6 @@ struct RawAxis {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawWorkpiece {
     origin: Spanned<Nums<3>>,
     x: Spanned<Nums<3>>,
@@ -117,7 +113,6 @@ struct RawWorkpiece {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawTool {
     point: Spanned<Nums<3>>,
     axis: Spanned<Nums<3>>,
@@ -126,7 +121,6 @@ struct RawTool {
 
 /// `[pressure]`: the grinding-pressure axis (DESIGN.md §2.2).
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawPressure {
     name: Spanned<String>,
     reference: Spanned<f64>,
@@ -311,18 +305,154 @@ fn toml_error(e: &toml::de::Error, file: &str, source: &str, syntax: bool) -> Di
     Diagnostic::at_byte_span(Severity::Error, file, source, span, message)
 }
 
+/// Every key the machine file does not know and every unknown value of a
+/// key that takes a word (`kind`, `side`, `wrap`, …), in file order, worded
+/// as serde words them. The names come from the `Raw*` types, which do not
+/// deny unknown keys themselves: this is where they are refused.
+fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
+    use toml::de::{DeTable, DeValue};
+    let Ok(doc) = DeTable::parse(source) else {
+        return Vec::new();
+    };
+    let mut found: Vec<(std::ops::Range<usize>, String)> = Vec::new();
+    // The keys of `table` against `fields`, and the words of `words`'
+    // keys against their values.
+    let mut check = |table: &DeTable, fields: &[&str], words: &[(&str, &[&str])]| {
+        for (key, value) in table {
+            let k = key.get_ref().as_ref();
+            if !fields.contains(&k) {
+                found.push((
+                    key.span(),
+                    format!("unknown key `{k}`, {}", expected(fields)),
+                ));
+                continue;
+            }
+            if let (Some((_, allowed)), DeValue::String(w)) =
+                (words.iter().find(|(name, _)| *name == k), value.get_ref())
+                && !allowed.contains(&w.as_ref())
+            {
+                found.push((
+                    value.span(),
+                    format!("unknown value `{w}`, {}", expected(allowed)),
+                ));
+            }
+        }
+    };
+    let doc = doc.get_ref();
+    check(doc, names::<RawMachine>(), &[]);
+    let section = |name: &str| doc.get(name).map(|v| v.get_ref());
+    if let Some(DeValue::Table(t)) = section("post") {
+        check(t, names::<RawPost>(), &[("output", names::<RawOutput>())]);
+    }
+    if let Some(DeValue::Array(axes)) = section("axis") {
+        let words = [
+            ("kind", names::<RawKind>()),
+            ("side", names::<RawSide>()),
+            ("wrap", names::<RawWrap>()),
+            ("prefer", names::<RawPrefer>()),
+        ];
+        for axis in axes {
+            if let DeValue::Table(t) = axis.get_ref() {
+                check(t, names::<RawAxis>(), &words);
+            }
+        }
+    }
+    for (name, fields) in [
+        ("workpiece", names::<RawWorkpiece>()),
+        ("tool", names::<RawTool>()),
+        ("pressure", names::<RawPressure>()),
+    ] {
+        if let Some(DeValue::Table(t)) = section(name) {
+            check(t, fields, &[]);
+        }
+    }
+    found.sort_by_key(|(span, _)| span.start);
+    found
+        .into_iter()
+        .map(|(span, message)| {
+            Diagnostic::at_byte_span(Severity::Error, file, source, span, message)
+        })
+        .collect()
+}
+
+/// serde's wording of the names a key or value may take.
+fn expected(names: &[&str]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match quoted.as_slice() {
+        [] => "there are none".to_string(),
+        [one] => format!("expected {one}"),
+        [a, b] => format!("expected {a} or {b}"),
+        all => format!("expected one of {}", all.join(", ")),
+    }
+}
+
+/// The field names serde's derive gives a struct, or the variant names of an
+/// enum (as written in the file): asked of `T` through a deserializer that
+/// only listens, so that the lists cannot drift from the types.
+fn names<T: serde::de::DeserializeOwned>() -> &'static [&'static str] {
+    use serde::de::{Error, Visitor, value};
+    struct Listen<'a>(&'a mut &'static [&'static str]);
+    impl<'de> serde::Deserializer<'de> for Listen<'_> {
+        type Error = value::Error;
+        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, value::Error> {
+            Err(value::Error::custom("listening only"))
+        }
+        fn deserialize_struct<V: Visitor<'de>>(
+            self,
+            _: &'static str,
+            fields: &'static [&'static str],
+            _: V,
+        ) -> Result<V::Value, value::Error> {
+            *self.0 = fields;
+            Err(value::Error::custom("listening only"))
+        }
+        fn deserialize_enum<V: Visitor<'de>>(
+            self,
+            _: &'static str,
+            variants: &'static [&'static str],
+            _: V,
+        ) -> Result<V::Value, value::Error> {
+            *self.0 = variants;
+            Err(value::Error::custom("listening only"))
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
+            bytes byte_buf option unit unit_struct newtype_struct seq tuple
+            tuple_struct map identifier ignored_any
+        }
+    }
+    let mut names: &'static [&'static str] = &[];
+    let _ = T::deserialize(Listen(&mut names));
+    names
+}
+
 /// Reads a machine file. `file` is the name used in diagnostics.
 pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostics> {
     // Syntax first, then the keys and types of the machine file.
     if let Err(e) = source.parse::<toml::Table>() {
         return Err(toml_error(&e, file, source, true).into());
     }
-    let raw: RawMachine = toml::from_str(source)
-        .map_err(|e| Diagnostics::from(toml_error(&e, file, source, false)))?;
+    // serde would stop at the first unknown key or value: they are all
+    // found here (the `Raw*` types let unknown keys pass), and reported with
+    // the mistakes the checks below find.
+    let unknown = unknown_names(source, file);
+    let raw: RawMachine = match toml::from_str(source) {
+        Ok(raw) => raw,
+        // An unknown value is among `unknown`; any other mistake of type
+        // goes after them.
+        Err(e) => {
+            let mut all = unknown;
+            let first = toml_error(&e, file, source, false);
+            if !all.contains(&first) {
+                all.push(first);
+            }
+            return Err(Diagnostics(all));
+        }
+    };
     let mut c = Checker {
         file,
         source,
-        errors: Vec::new(),
+        errors: unknown,
     };
 
     let name = match &raw.name {
