@@ -95,6 +95,42 @@ fn through_the_pole_a_changes_sign_and_c_stays() {
     assert!(summary.max_position_error_mm <= summary.tolerance_mm);
 }
 
+/// With A limited to −10° a pass through (or 0.2° beside) the pole cannot
+/// go on with A negative: C turns half a turn where the tool axis passes
+/// the pole and A stays positive, without a retract. (C turns without end:
+/// the inverse kinematics offers both turns of a configuration half a turn
+/// from the hint; with the nearest alone, the branch the path needs flipped
+/// by a whole turn from point to point with the rounding, and the planner
+/// retracted when A reached its limit.)
+#[test]
+fn through_the_pole_with_a_short_a_c_turns_instead_of_a_retract() {
+    let source = builtin::source("trunnion-ac")
+        .unwrap()
+        .replace("limits = [-30, 120]", "limits = [-10, 120]");
+    let m = machine_from_toml(&source, "short-a.toml").unwrap();
+    let (ia, ic) = (m.axis_index("A").unwrap(), m.axis_index("C").unwrap());
+    assert_eq!(m.axes[ia].limits, Some([-10.0, 120.0]));
+    for offset in [0.0, 0.2] {
+        let (cl, _) = pole_pass(offset);
+        let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+        assert!(
+            summary.planning.reconfigurations.is_empty(),
+            "offset {offset}: {:?}",
+            summary.planning.reconfigurations
+        );
+        let all = rows(&csv, m.axes.len());
+        assert!(all.iter().all(|r| r.2[ia] >= 0.0), "offset {offset}: A < 0");
+        let c_travel: f64 = all
+            .windows(2)
+            .map(|w| (w[1].2[ic] - w[0].2[ic]).abs())
+            .sum();
+        assert!(
+            (170.0..=180.0 + 1e-3).contains(&c_travel),
+            "offset {offset}: C travels {c_travel}°"
+        );
+    }
+}
+
 #[test]
 fn near_the_pole_c_turns_no_more_than_the_pass_needs() {
     let m = builtin::load("trunnion-ac").unwrap().unwrap();

@@ -632,7 +632,9 @@ impl Kinematics {
     /// [`Kinematics::ik_all_branches`]).
     ///
     /// `hint` (e.g. the previous block) gives the value of an angle that is
-    /// free at a singular pose, and the turn of rotary axes without limits.
+    /// free at a singular pose, and the turns of rotary axes without limits:
+    /// those within 210° of the hint (one, or two for an angle about half a
+    /// turn from it).
     pub fn ik(
         &self,
         pose: &Pose,
@@ -1292,14 +1294,23 @@ struct Slot {
 impl Slot {
     /// The angle `raw` (degrees, as solved), its principal value and the
     /// whole turns that keep it inside the travel; for an axis without
-    /// limits, the one turn nearest to the hint (continuous output).
+    /// limits, the turns within [`ENDLESS_REACH_DEG`] of the hint.
     #[inline(always)]
     fn range(&self, raw: f64, hint: Option<&[f64]>) -> SlotRange {
         let principal = wrap180(raw);
         let (first, last) = match self.limits {
             None => {
-                let t = turns_nearest((hint.map_or(0.0, |h| h[self.axis]) - principal) / 360.0);
-                (t, t)
+                // The nearest turn lies within half a turn of the hint;
+                // the one beyond it too when that is within the reach.
+                let h = hint.map_or(0.0, |h| h[self.axis]);
+                let t = turns_nearest((h - principal) / 360.0);
+                let d = principal + 360.0 * t - h;
+                let below = d - 360.0 >= -ENDLESS_REACH_DEG;
+                let above = d + 360.0 <= ENDLESS_REACH_DEG;
+                (
+                    t - f64::from(u8::from(below)),
+                    t + f64::from(u8::from(above)),
+                )
             }
             Some([lo, hi]) => turn_range(lo, hi, principal),
         };
@@ -1311,6 +1322,14 @@ impl Slot {
         }
     }
 }
+
+/// How far from the hint the equivalents of an axis without limits go:
+/// half a turn, and a margin. Of two configurations half a turn apart on
+/// the hint (the other branch of an A/C trunnion), both turns are
+/// candidates, so that a sequence on either branch stays continuous while
+/// the best one is the hint (nearest the hint alone, its turn would follow
+/// the rounding).
+const ENDLESS_REACH_DEG: f64 = 180.0 + 30.0;
 
 /// A slot angle in degrees as solved (`raw`), wrapped to (−180°, 180°], and
 /// the whole turns `first..=last` that keep it inside the travel.

@@ -163,6 +163,38 @@ fn singular_pose_keeps_the_hinted_angle_and_is_exact() {
     assert!((kin.fk(&s.joints[..5]).point - pose.point).norm() < 1e-9);
 }
 
+#[test]
+fn an_axis_without_limits_takes_the_turns_within_210_degrees_of_the_hint() {
+    // The built-in A/C trunnion: C turns without end. At A 20°, C 100° the
+    // other branch is A −20°, C 280° (half a turn away).
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let (ia, ic) = (m.axis_index("A").unwrap(), m.axis_index("C").unwrap());
+    let kin = Kinematics::new(&m);
+    let mut q = vec![0.0; m.axes.len()];
+    q[ia] = 20.0;
+    q[ic] = 100.0;
+    let pose = kin.fk(&q);
+    let turns = |hint_c: f64| {
+        let mut hint = q.clone();
+        hint[ic] = hint_c;
+        let mut sols = Vec::new();
+        kin.ik(&pose, Some(&hint), &mut sols).unwrap();
+        let mut got: Vec<(i64, i64)> = sols
+            .iter()
+            .map(|s| (s.joints[ia].round() as i64, s.joints[ic].round() as i64))
+            .collect();
+        got.sort();
+        got
+    };
+    // On the hint: that turn of its branch; the other branch, half a turn
+    // away, in both turns.
+    assert_eq!(turns(100.0), [(-20, -80), (-20, 280), (20, 100)]);
+    // 200° from the hint: both turns within 210°.
+    assert_eq!(turns(300.0), [(-20, 280), (20, 100), (20, 460)]);
+    // Beyond 210° a turn is left out: 100 is 215° from −115.
+    assert_eq!(turns(-115.0), [(-20, -80), (20, -260)]);
+}
+
 /// Seed 000, Figure 28: the CL points and the NC values the authors' post
 /// printed, to the printed decimals.
 #[test]
