@@ -149,6 +149,20 @@ impl Diagnostic {
     }
 }
 
+/// The most characters of a source line a diagnostic shows.
+const SHOWN_CHARS: usize = 160;
+
+/// `c`, or U+FFFD for a control character other than a line break: bytes
+/// of a binary file must not reach the terminal as escape sequences. (One
+/// character for one: the caret stays under its column.)
+fn printable(c: char) -> char {
+    if c.is_control() && c != '\n' {
+        '\u{FFFD}'
+    } else {
+        c
+    }
+}
+
 fn floor_char_boundary(s: &str, mut i: usize) -> usize {
     while i > 0 && !s.is_char_boundary(i) {
         i -= 1;
@@ -160,7 +174,8 @@ fn floor_char_boundary(s: &str, mut i: usize) -> usize {
 /// location, the source line and a caret under the offending text.
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "{}: {}", self.severity, self.message)?;
+        let message: String = self.message.chars().map(printable).collect();
+        writeln!(f, "{}: {message}", self.severity)?;
         if self.line == 0 {
             return write!(f, "  --> {}", self.file);
         }
@@ -169,18 +184,34 @@ impl fmt::Display for Diagnostic {
         writeln!(f, "{pad}--> {}", self.location())?;
         writeln!(f, "{pad} |")?;
         // Tabs would shift the caret; show them as single spaces.
-        let shown: String = self
+        let chars: Vec<char> = self
             .source_line
             .chars()
-            .map(|c| if c == '\t' { ' ' } else { c })
+            .map(|c| if c == '\t' { ' ' } else { printable(c) })
             .collect();
-        write!(f, "{number} | {shown}")?;
-        if self.column > 0 {
+        // A long line (a binary file, a CL line without breaks) is shown
+        // around the column only.
+        let (mut start, mut end) = (0, chars.len());
+        if end > SHOWN_CHARS {
+            start = self
+                .column
+                .saturating_sub(SHOWN_CHARS / 3)
+                .min(end - SHOWN_CHARS);
+            end = start + SHOWN_CHARS;
+        }
+        let shown: String = chars[start..end].iter().collect();
+        let (before, after) = (
+            if start > 0 { "…" } else { "" },
+            if end < chars.len() { "…" } else { "" },
+        );
+        write!(f, "{number} | {before}{shown}{after}")?;
+        if self.column > start {
+            let width = self.width.min(end + 1 - self.column.min(end));
             write!(
                 f,
                 "\n{pad} | {}{}",
-                " ".repeat(self.column - 1),
-                "^".repeat(self.width)
+                " ".repeat(self.column - 1 - start + before.chars().count()),
+                "^".repeat(width.max(1))
             )?;
         }
         Ok(())
@@ -216,6 +247,28 @@ impl From<Diagnostic> for Diagnostics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn control_characters_are_not_echoed() {
+        let d = Diagnostic::error("bin.cls", 3, 2, 1, "G\u{1b}[2J\tX", "bad `\u{1b}[2J`");
+        assert_eq!(
+            d.to_string(),
+            "error: bad `\u{FFFD}[2J`\n --> bin.cls:3:2\n  |\n3 | G\u{FFFD}[2J X\n  |  ^"
+        );
+    }
+
+    #[test]
+    fn a_long_line_is_shown_around_its_column() {
+        let line = format!("{}X{}", "a".repeat(300), "b".repeat(300));
+        let d = Diagnostic::error("long.cls", 1, 301, 1, line, "here");
+        let shown = d.to_string();
+        let lines: Vec<&str> = shown.lines().collect();
+        let want = format!("1 | …{}X{}…", "a".repeat(52), "b".repeat(107));
+        assert_eq!(lines[3], want);
+        // The caret stands under the X.
+        let caret = lines[4].find('^').unwrap();
+        assert_eq!(lines[3].chars().nth(caret), Some('X'));
+    }
 
     #[test]
     fn renders_location_source_and_caret() {

@@ -100,6 +100,8 @@ struct WheelArgs {
 }
 
 #[derive(clap::Args)]
+// `--lintol -1` is a value for the check below, not an unknown option.
+#[command(allow_negative_numbers = true)]
 struct PostArgs {
     /// CL file, or - for standard input.
     input: String,

@@ -248,6 +248,7 @@ pub fn post<R: BufRead, W: Write>(
     }
     let mut named = options.program_name.is_some();
     let mut tool_loaded = false;
+    let mut remarked = Remarked::default();
 
     while let Some(statement) = reader.next_statement()? {
         let line = statement.line;
@@ -264,6 +265,11 @@ pub fn post<R: BufRead, W: Write>(
                     axis: Vector3::from(axis),
                     reference: reference.map(Vector3::from),
                 };
+                if let Some(r) = &pose.reference
+                    && let Some(message) = reference_remark(machine, &pose.axis, r, &mut remarked)
+                {
+                    warnings.push(reader.statement_diagnostic(Severity::Warning, message));
+                }
                 job.motion(&pose, motion, line, &reader)?;
             }
             ClEvent::Feedrate { value, unit } => {
@@ -356,6 +362,17 @@ pub fn post<R: BufRead, W: Write>(
     let tolerance = emitter.settings.tolerance;
     writer.finish()?;
 
+    if job.cl_points == 0 {
+        warnings.push(Diagnostic::warning(
+            &options.cl_file,
+            0,
+            0,
+            0,
+            "",
+            "the CL file has no motion (no GOTO): the program is its header and footer only"
+                .to_string(),
+        ));
+    }
     warnings.extend(reader.take_warnings());
     warnings.sort_by_key(|w| (w.line, w.column));
     let mut planning = emitter.planning;
@@ -726,6 +743,48 @@ pub(crate) fn select(kin: &mut Kinematics, wheel: &mut Option<Wheel>, pressure: 
 }
 
 /// The pose as a user reads it in a message.
+/// Which remarks on reference directions were made (each once a file).
+#[derive(Default)]
+struct Remarked {
+    ignored: bool,
+    skew: bool,
+}
+
+/// A remark on the reference direction `r` of a CL point with tool axis
+/// `axis`, the first time it applies: the machine has no rotary axis the
+/// reference turns (it is ignored), or the reference is not perpendicular
+/// to the tool axis (its part along the axis is ignored).
+fn reference_remark(
+    machine: &Machine,
+    axis: &Vector3<f64>,
+    r: &Vector3<f64>,
+    remarked: &mut Remarked,
+) -> Option<String> {
+    let free_rotary = machine
+        .axes
+        .iter()
+        .filter(|a| a.is_rotary() && (a.is_free() || a.free_with_reference))
+        .count();
+    if free_rotary < 3 {
+        return (!std::mem::replace(&mut remarked.ignored, true)).then(|| {
+            format!(
+                "reference directions (GOTO values 7 to 9) are ignored: machine `{}` has no third rotary axis to turn them (further ones are not reported)",
+                machine.name
+            )
+        });
+    }
+    // Off perpendicular by more than a tenth of a degree.
+    let off = (axis.dot(r) / (axis.norm() * r.norm()))
+        .clamp(-1.0, 1.0)
+        .asin();
+    (off.abs() > 0.1f64.to_radians() && !std::mem::replace(&mut remarked.skew, true)).then(|| {
+        format!(
+            "the reference direction is {:.3}° off perpendicular to the tool axis: only its part perpendicular to it is used (further ones are not reported)",
+            off.abs().to_degrees()
+        )
+    })
+}
+
 pub(crate) fn describe(pose: &Pose) -> String {
     let (p, a) = (pose.point, pose.axis);
     format!(

@@ -158,7 +158,17 @@ impl Summary {
             );
         }
         if !p.singular_stretches.is_empty() {
-            planning += &format!("; {} singular stretch(es)", p.singular_stretches.len());
+            // The held angle leaves the tool axis off the CL there (the
+            // closed loop above counts the other blocks).
+            let held = p
+                .singular_stretches
+                .iter()
+                .map(|s| s.max_axis_deviation_deg)
+                .fold(0.0, f64::max);
+            planning += &format!(
+                "; {} singular stretch(es), tool axis held within {held:.4}°",
+                p.singular_stretches.len()
+            );
         }
         if !p.reconfigurations.is_empty() {
             planning += &format!("; {} reconfiguration(s)", p.reconfigurations.len());

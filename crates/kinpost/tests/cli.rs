@@ -277,16 +277,22 @@ fn bad_tolerance_is_bad_input() {
     ]);
     assert_exit(&o, 1);
     assert!(stderr(&o).contains("--tolerance"), "{}", stderr(&o));
-    // A negative number reads as an option: a usage error.
-    let o = run(&[
-        "post",
-        "examples/flat-part.cls",
-        "-m",
-        "mts1600",
-        "--tolerance",
-        "-1",
-    ]);
-    assert_exit(&o, 2);
+    // A negative number is a value (not an unknown option), refused alike.
+    for (option, message) in [
+        ("--tolerance", "--tolerance must be a positive number of mm"),
+        ("--lintol", "--lintol must be a distance of 0 or more (mm)"),
+    ] {
+        let o = run(&[
+            "post",
+            "examples/flat-part.cls",
+            "-m",
+            "mts1600",
+            option,
+            "-1",
+        ]);
+        assert_exit(&o, 1);
+        assert!(stderr(&o).contains(message), "{}", stderr(&o));
+    }
 }
 
 #[test]

@@ -109,3 +109,90 @@ fn mixing_five_and_six_axis_points_is_an_error_naming_the_line() {
         "{err}"
     );
 }
+
+/// The warnings of posting `cl` on built-in machine `machine`: line and
+/// message.
+fn warnings(machine: &str, cl: &str) -> Vec<(usize, String)> {
+    let machine = builtin::load(machine).unwrap().unwrap();
+    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let summary = post(
+        cl.as_bytes(),
+        &machine,
+        &dialect,
+        std::io::sink(),
+        &PostOptions::default(),
+    )
+    .unwrap();
+    summary
+        .warnings
+        .iter()
+        .map(|w| (w.line, w.message.clone()))
+        .collect()
+}
+
+/// Nine-value GOTOs at poses of `machine`'s forward kinematics at `qs`,
+/// each reference turned `skew_deg` towards the tool axis.
+fn goto9(machine: &str, qs: &[Vec<f64>], skew_deg: f64) -> String {
+    let m = builtin::load(machine).unwrap().unwrap();
+    let kin = Kinematics::new(&m.with_reference_axes_free());
+    let mut cl = String::from("FEDRAT/MMPM,300\n");
+    for q in qs {
+        let p = kin.fk(q);
+        let a = p.axis;
+        // A unit vector normal to the tool axis (the machine's own reference
+        // where it has one).
+        let normal = p
+            .reference
+            .unwrap_or_else(|| a.cross(&nalgebra::Vector3::x()).normalize());
+        let s = skew_deg.to_radians();
+        let r = normal * s.cos() + a * s.sin();
+        cl.push_str(&format!(
+            "GOTO/{:.6},{:.6},{:.6},{:.9},{:.9},{:.9},{:.9},{:.9},{:.9}\n",
+            p.point.x, p.point.y, p.point.z, a.x, a.y, a.z, r.x, r.y, r.z
+        ));
+    }
+    cl
+}
+
+#[test]
+fn references_off_perpendicular_or_unused_are_remarked_once() {
+    // mts1600 (X A Y Z B C), C freed by the references.
+    let qs = [
+        vec![459.0, 5.0, 10.0, 355.0, -15.0, -60.0],
+        vec![460.0, 6.0, 9.0, 356.0, -14.0, -50.0],
+    ];
+    assert!(warnings("mts1600", &goto9("mts1600", &qs, 0.0)).is_empty());
+    assert_eq!(
+        warnings("mts1600", &goto9("mts1600", &qs, 30.0)),
+        [(
+            2,
+            "the reference direction is 30.000° off perpendicular to the tool axis: only its part perpendicular to it is used (further ones are not reported)"
+                .to_string()
+        )]
+    );
+    // trunnion-ac (X Y Z A C): two rotary axes, nothing turns a reference.
+    let qs = [
+        vec![10.0, 20.0, -30.0, 20.0, 40.0],
+        vec![11.0, 20.0, -30.0, 21.0, 41.0],
+    ];
+    assert_eq!(
+        warnings("trunnion-ac", &goto9("trunnion-ac", &qs, 0.0)),
+        [(
+            2,
+            "reference directions (GOTO values 7 to 9) are ignored: machine `trunnion-ac` has no third rotary axis to turn them (further ones are not reported)"
+                .to_string()
+        )]
+    );
+}
+
+#[test]
+fn a_cl_file_without_motion_is_remarked() {
+    assert_eq!(
+        warnings("mts1600", "$$ nothing to do\nFINI\n"),
+        [(
+            0,
+            "the CL file has no motion (no GOTO): the program is its header and footer only"
+                .to_string()
+        )]
+    );
+}
