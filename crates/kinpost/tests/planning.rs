@@ -104,10 +104,7 @@ fn through_the_pole_a_changes_sign_and_c_stays() {
 /// retracted when A reached its limit.)
 #[test]
 fn through_the_pole_with_a_short_a_c_turns_instead_of_a_retract() {
-    let source = builtin::source("trunnion-ac")
-        .unwrap()
-        .replace("limits = [-30, 120]", "limits = [-10, 120]");
-    let m = machine_from_toml(&source, "short-a.toml").unwrap();
+    let m = trunnion_with_a("[-10, 120]");
     let (ia, ic) = (m.axis_index("A").unwrap(), m.axis_index("C").unwrap());
     assert_eq!(m.axes[ia].limits, Some([-10.0, 120.0]));
     for offset in [0.0, 0.2] {
@@ -219,6 +216,14 @@ fn a_swing_just_outside_the_singular_cone_keeps_its_branch() {
         (travel - net).abs() < 1e-9 && net < 180.0,
         "C travels {travel}°, net {net}°"
     );
+}
+
+/// The built-in A/C trunnion with A's `limits` (TOML) instead of −30..120°.
+fn trunnion_with_a(limits: &str) -> Machine {
+    let source = builtin::source("trunnion-ac")
+        .unwrap()
+        .replace("limits = [-30, 120]", &format!("limits = {limits}"));
+    machine_from_toml(&source, "trunnion-a.toml").unwrap()
 }
 
 /// The built-in A/C trunnion with C turning by ±100° only.
@@ -603,10 +608,7 @@ fn deciding_point_by_point_keeps_the_branch_it_is_on() {
     // A limited to negative values puts the path on one branch of the
     // closed form; steps of 3° of the tool axis are no flip, whether the
     // planner decides at the end or at every point.
-    let source = builtin::source("trunnion-ac")
-        .unwrap()
-        .replace("limits = [-30, 120]", "limits = [-60, 0]");
-    let m = machine_from_toml(&source, "negative-a.toml").unwrap();
+    let m = trunnion_with_a("[-60, 0]");
     let mut cl = String::from("FEDRAT/MMPM,500\nRAPID\n");
     for k in 0..8 {
         let t = (20.0 + 3.0 * k as f64).to_radians();

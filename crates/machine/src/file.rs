@@ -392,10 +392,17 @@ fn expected(names: &[&str]) -> String {
 fn names<T: serde::de::DeserializeOwned>() -> &'static [&'static str] {
     use serde::de::{Error, Visitor, value};
     struct Listen<'a>(&'a mut &'static [&'static str]);
+    impl Listen<'_> {
+        /// Keeps the names the type asked for, and stops it there.
+        fn heard<T>(self, names: &'static [&'static str]) -> Result<T, value::Error> {
+            *self.0 = names;
+            Err(value::Error::custom("listening only"))
+        }
+    }
     impl<'de> serde::Deserializer<'de> for Listen<'_> {
         type Error = value::Error;
         fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, value::Error> {
-            Err(value::Error::custom("listening only"))
+            self.heard(&[])
         }
         fn deserialize_struct<V: Visitor<'de>>(
             self,
@@ -403,8 +410,7 @@ fn names<T: serde::de::DeserializeOwned>() -> &'static [&'static str] {
             fields: &'static [&'static str],
             _: V,
         ) -> Result<V::Value, value::Error> {
-            *self.0 = fields;
-            Err(value::Error::custom("listening only"))
+            self.heard(fields)
         }
         fn deserialize_enum<V: Visitor<'de>>(
             self,
@@ -412,8 +418,7 @@ fn names<T: serde::de::DeserializeOwned>() -> &'static [&'static str] {
             variants: &'static [&'static str],
             _: V,
         ) -> Result<V::Value, value::Error> {
-            *self.0 = variants;
-            Err(value::Error::custom("listening only"))
+            self.heard(variants)
         }
         serde::forward_to_deserialize_any! {
             bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
