@@ -742,7 +742,6 @@ pub(crate) fn select(kin: &mut Kinematics, wheel: &mut Option<Wheel>, pressure: 
     }
 }
 
-/// The pose as a user reads it in a message.
 /// Which remarks on reference directions were made (each once a file).
 #[derive(Default)]
 struct Remarked {
@@ -785,6 +784,7 @@ fn reference_remark(
     })
 }
 
+/// The pose as a user reads it in a message.
 pub(crate) fn describe(pose: &Pose) -> String {
     let (p, a) = (pose.point, pose.axis);
     format!(
