@@ -49,24 +49,26 @@
 //! |---|---|
 //! | `TOOL PATH/name,word,…` | [`ClEvent::ToolPath`] |
 //! | `TLDATA/kind,v,…`, `CUTTER/v,…` | [`ClEvent::ToolData`] |
-//! | `MSYS/x,y,z[,xi,xj,xk[,yi,yj,yk]]` | [`ClEvent::MachineSystem`] |
+//! | `MSYS/x,y,z[,xi,xj,xk[,yi,yj,yk]]` | [`ClEvent::MachineSystem`]; a later `MSYS` that changes it is an error |
 //! | `$$ text`, `PPRINT/text` | [`ClEvent::Comment`] |
 //! | `RAPID`, `RAPID/` | no event: the next `GOTO` is a rapid move |
 //! | `GOTO/x,y,z[,i,j,k[,u,v,w]]` | [`ClEvent::Goto`] |
-//! | `FEDRAT/[unit,]f`, `FEDRAT/f[,unit]` | [`ClEvent::Feedrate`] |
-//! | `LOAD/TOOL,n`, `SELECT/TOOL,n` | [`ClEvent::LoadTool`], [`ClEvent::SelectTool`] |
+//! | `GODLTA/dx,dy,dz`, `GODLTA/d` (along the tool axis) | [`ClEvent::Goto`] to the last point moved by that much |
+//! | `TLAXIS/i,j,k` | no event: the tool axis of the three-value `GOTO`s that follow |
+//! | `FEDRAT/[unit,]f`, `FEDRAT/f[,unit]` | [`ClEvent::Feedrate`]; it cancels a `RAPID` no move used (with a warning) |
+//! | `LOAD/TOOL,n`, `LOADTL/n`, `SELECT/TOOL,n` | [`ClEvent::LoadTool`], [`ClEvent::SelectTool`] |
 //! | `SPINDL/rpm,RPM,CLW`, `SPINDL/OFF` | [`ClEvent::Spindle`], [`ClEvent::SpindleOff`] |
 //! | `COOLNT/mode` | [`ClEvent::Coolant`] |
 //! | `INSERT/text` | [`ClEvent::Insert`] |
 //! | `END-OF-PATH` | [`ClEvent::EndOfPath`] |
-//! | `PARTNO/text`, `PARTNO text` | [`ClEvent::PartNo`] |
+//! | `PARTNO/text`, `PARTNO text` | [`ClEvent::PartNo`] (one pair of enclosing quotes removed) |
 //! | `UNITS/MM`, `UNIT/MM`, `UNITS/INCHES` | [`ClEvent::Units`] |
 //! | `MULTAX[/ON\|/OFF]` | [`ClEvent::Multax`] |
 //! | `PRESSURE/[word,]value` (kinpost extension) | [`ClEvent::Pressure`] |
 //! | `FINI` | [`ClEvent::Fini`] |
 //! | `PAINT/…`, `TRNTYP/…`, `CSI_…`, identity `CSYS/…`, `CUTCOM/OFF` | nothing (display-only or harmless) |
 //! | `CUTCOM/LEFT\|RIGHT…` | nothing, with a warning (cutter compensation ignored) |
-//! | `CIRCLE/…`, `NURBS…`, `CYCLE/…`, non-identity `CSYS/…` | error: not supported yet |
+//! | `CIRCLE/…`, `NURBS…`, `CYCLE/…`, non-identity `CSYS/…`, `TLAXIS` other than `i,j,k` | error: not supported yet |
 //! | anything else | nothing, with a warning (unknown statement ignored) |
 //!
 //! # Syntax

@@ -89,6 +89,11 @@ pub struct ClReader<R> {
     warnings: Vec<Diagnostic>,
     axis: Option<Vec3>,
     reference: Option<Vec3>,
+    /// The point of the last `GOTO` (CL units), for `GODLTA`.
+    last_point: Option<Vec3>,
+    /// The first `MSYS` (origin and axes as given) and its line: a later
+    /// one must not change it.
+    msys: Option<([f64; 9], usize, usize)>,
     rapid: bool,
     units: Units,
     spindle: Option<(f64, SpindleDir)>,
@@ -111,6 +116,8 @@ impl<R: BufRead> ClReader<R> {
             warnings: Vec::new(),
             axis: None,
             reference: None,
+            last_point: None,
+            msys: None,
             rapid: false,
             units: Units::Mm,
             spindle: None,
@@ -559,7 +566,22 @@ impl<R: BufRead> ClReader<R> {
                 self.rapid = true;
                 Ok(None)
             }
-            b"FEDRAT" => self.fedrat(args).map(Some),
+            b"FEDRAT" => {
+                let feed = self.fedrat(args)?;
+                // APT: a feed rate cancels a RAPID that no move has used.
+                if std::mem::take(&mut self.rapid) {
+                    self.warn(
+                        (word.0, args.1),
+                        "FEDRAT after RAPID: the next move is at this feed, not rapid",
+                    );
+                }
+                Ok(Some(feed))
+            }
+            b"TLAXIS" => self.tlaxis(word, args),
+            b"GODLTA" => self.godlta(word, args).map(Some),
+            b"LOADTL" => Ok(Some(ClEvent::LoadTool {
+                number: self.loadtl(word, args)?,
+            })),
             b"TLDATA" => self.tool_data(args, false).map(Some),
             b"CUTTER" => self.tool_data(args, true).map(Some),
             b"MSYS" => self.msys(args),
@@ -579,7 +601,7 @@ impl<R: BufRead> ClReader<R> {
             ))),
             b"END-OF-PATH" => Ok(Some(ClEvent::EndOfPath)),
             b"PARTNO" => Ok(Some(ClEvent::PartNo(
-                self.text()[args.0..].trim().to_string(),
+                unquote(self.text()[args.0..].trim()).to_string(),
             ))),
             b"UNITS" | b"UNIT" => self.units_statement(word, args).map(Some),
             b"MULTAX" => self.multax(args).map(Some),
@@ -760,6 +782,7 @@ impl<R: BufRead> ClReader<R> {
         // Only now, when nothing can fail: a failed statement has no effect.
         // (The reference direction is kept as it is unless given.)
         self.axis = Some(axis);
+        self.last_point = Some(point);
         let motion = if std::mem::take(&mut self.rapid) {
             Motion::Rapid
         } else {
@@ -883,6 +906,23 @@ impl<R: BufRead> ClReader<R> {
         if count < 3 {
             return Err(self.error(args, "MSYS needs at least the origin x,y,z"));
         }
+        // Every GOTO is posted in the machine file's part frame: a second
+        // coordinate system would put the points after it elsewhere.
+        let line = self.statement_line().0;
+        match self.msys {
+            None => self.msys = Some((v, count, line)),
+            Some((first, first_count, first_line)) => {
+                let n = count.min(first_count);
+                if (0..n).any(|k| (v[k] - first[k]).abs() > 1e-6) {
+                    return Err(self.error(
+                        args,
+                        format!(
+                            "MSYS changes the machine coordinate system of line {first_line}: kinpost posts every point in the part frame of the machine file; post the operations of each coordinate system as a program of their own"
+                        ),
+                    ));
+                }
+            }
+        }
         let origin = [v[0], v[1], v[2]];
         let x = (count >= 6).then_some([v[3], v[4], v[5]]);
         let y = (count >= 9).then_some([v[6], v[7], v[8]]);
@@ -902,6 +942,109 @@ impl<R: BufRead> ClReader<R> {
         Ok(Some(ClEvent::MachineSystem { origin, x, y }))
     }
 
+    /// `TLAXIS/i,j,k`: the tool axis of the three-value `GOTO`s that follow.
+    fn tlaxis(&mut self, word: Span, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
+        self.split(args);
+        if self.fields.len() != 3 || self.fields.iter().any(|&f| self.is_word(f)) {
+            return Err(self.error(
+                (word.0, args.1),
+                "only `TLAXIS/i,j,k` is supported (a fixed tool axis); have the CAM system output the tool axis in each GOTO",
+            ));
+        }
+        let mut v = [0.0; 3];
+        for (value, &f) in v.iter_mut().zip(&self.fields) {
+            *value = self.number(f)?;
+        }
+        match normalize(v) {
+            Some(axis) => {
+                self.axis = Some(axis);
+                Ok(None)
+            }
+            None => Err(self.error(args, "the tool axis (i,j,k) is zero or not finite")),
+        }
+    }
+
+    /// `GODLTA/dx,dy,dz` (a move by that much) or `GODLTA/d` (along the
+    /// tool axis): a `GOTO` relative to the last point, tool axis kept.
+    fn godlta(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
+        self.split(args);
+        let (Some(last), Some(axis)) = (self.last_point, self.axis) else {
+            return Err(self.error(
+                (word.0, args.1),
+                "GODLTA before any GOTO: a relative move needs a point to start from",
+            ));
+        };
+        let mut d = [0.0; 3];
+        match self.fields.len() {
+            1 => {
+                let t = self.number(self.fields[0])?;
+                d = axis.map(|a| a * t);
+            }
+            3 => {
+                for (value, &f) in d.iter_mut().zip(&self.fields) {
+                    *value = self.number(f)?;
+                }
+            }
+            n => {
+                return Err(self.error(
+                    args,
+                    format!(
+                        "GODLTA has {n} values, expected 1 (along the tool axis) or 3 (dx,dy,dz)"
+                    ),
+                ));
+            }
+        }
+        let v = [
+            last[0] + d[0],
+            last[1] + d[1],
+            last[2] + d[2],
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ];
+        let (point, axis, motion) = self.goto_move(args, v, 3)?;
+        Ok(ClEvent::Goto {
+            point,
+            axis,
+            reference: self.reference,
+            motion,
+        })
+    }
+
+    /// `LOADTL/n[,…]` (CATIA, Fusion, Mastercam APT): `LOAD/TOOL,n`.
+    fn loadtl(&mut self, word: Span, args: Span) -> Result<u32, Diagnostic> {
+        self.split(args);
+        let Some(&f) = self.fields.first() else {
+            return Err(self.error(word, "expected `LOADTL/n`"));
+        };
+        let n = self.whole_tool_number(f)?;
+        if self.fields.len() > 1 {
+            let rest = (self.fields[1].0, args.1);
+            let text = self.text()[rest.0..rest.1].trim().to_string();
+            self.warn(rest, format!("`{text}` after the tool number ignored"));
+        }
+        Ok(n)
+    }
+
+    /// Field `f` as a tool number.
+    fn whole_tool_number(&self, f: Span) -> Result<u32, Diagnostic> {
+        let n = self.number(f)?;
+        if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
+            return Err(self.error(
+                f,
+                format!(
+                    "the tool number must be a whole number from 0 to {}, got `{}`",
+                    u32::MAX,
+                    self.field(f)
+                ),
+            ));
+        }
+        Ok(n as u32)
+    }
+
     fn tool_number(&mut self, name: &str, word: Span, args: Span) -> Result<u32, Diagnostic> {
         self.split(args);
         let usage = format!("expected `{name}/TOOL,n`");
@@ -917,23 +1060,13 @@ impl<R: BufRead> ClReader<R> {
                 format!("{usage}: the tool number is missing"),
             ));
         };
-        let n = self.number(f)?;
-        if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
-            return Err(self.error(
-                f,
-                format!(
-                    "the tool number must be a whole number from 0 to {}, got `{}`",
-                    u32::MAX,
-                    self.field(f)
-                ),
-            ));
-        }
+        let n = self.whole_tool_number(f)?;
         if self.fields.len() > 2 {
             let rest = (self.fields[2].0, args.1);
             let text = self.text()[rest.0..rest.1].trim().to_string();
             self.warn(rest, format!("`{text}` after the tool number ignored"));
         }
-        Ok(n as u32)
+        Ok(n)
     }
 
     fn spindle(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
@@ -1326,6 +1459,17 @@ fn floor_char_boundary(s: &str, i: usize) -> usize {
 }
 
 /// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
+/// `text` without one pair of enclosing quotes (`'1001'`, `"A B"`), as
+/// APT writers quote names.
+fn unquote(text: &str) -> &str {
+    for q in ['\'', '"'] {
+        if let Some(inner) = text.strip_prefix(q).and_then(|t| t.strip_suffix(q)) {
+            return inner;
+        }
+    }
+    text
+}
+
 fn normalize(v: Vec3) -> Option<Vec3> {
     let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if n2 == 1.0 {

@@ -642,3 +642,105 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn tlaxis_sets_the_axis_of_three_value_gotos() {
+    let e = events("TLAXIS/0,3,4\nGOTO/1,2,3\nGOTO/4,5,6,0,0,1\nGOTO/7,8,9\n");
+    assert_eq!(
+        e,
+        vec![
+            goto([1., 2., 3.], [0., 0.6, 0.8], Motion::Feed),
+            goto([4., 5., 6.], [0., 0., 1.], Motion::Feed),
+            goto([7., 8., 9.], [0., 0., 1.], Motion::Feed),
+        ]
+    );
+    let e = error("TLAXIS/NORMPS\n");
+    assert_eq!(
+        (e.line, e.message.as_str()),
+        (
+            1,
+            "only `TLAXIS/i,j,k` is supported (a fixed tool axis); have the CAM system output the tool axis in each GOTO"
+        )
+    );
+    assert_eq!(
+        error("TLAXIS/0,0,0\n").message,
+        "the tool axis (i,j,k) is zero or not finite"
+    );
+}
+
+#[test]
+fn godlta_moves_from_the_last_point() {
+    let e = events("GOTO/1,2,3,0,0,1\nGODLTA/0,0,-5\nRAPID\nGODLTA/10\nGODLTA/1,1,1\n");
+    assert_eq!(
+        e,
+        vec![
+            goto([1., 2., 3.], [0., 0., 1.], Motion::Feed),
+            goto([1., 2., -2.], [0., 0., 1.], Motion::Feed),
+            goto([1., 2., 8.], [0., 0., 1.], Motion::Rapid),
+            goto([2., 3., 9.], [0., 0., 1.], Motion::Feed),
+        ]
+    );
+    assert_eq!(
+        error("GODLTA/0,0,5\n").message,
+        "GODLTA before any GOTO: a relative move needs a point to start from"
+    );
+    assert_eq!(
+        error("GOTO/1,2,3\nGODLTA/1,2\n").message,
+        "GODLTA has 2 values, expected 1 (along the tool axis) or 3 (dx,dy,dz)"
+    );
+}
+
+#[test]
+fn loadtl_loads_a_tool_and_partno_loses_its_quotes() {
+    assert_eq!(
+        events("LOADTL/2\nPARTNO/'1001'\nPARTNO \"A B\"\nPARTNO/it's\n"),
+        vec![
+            ClEvent::LoadTool { number: 2 },
+            ClEvent::PartNo("1001".into()),
+            ClEvent::PartNo("A B".into()),
+            ClEvent::PartNo("it's".into()),
+        ]
+    );
+    let (s, w) = read("LOADTL/3,ADJUST,3\n");
+    assert_eq!(s[0].event, ClEvent::LoadTool { number: 3 });
+    assert_eq!(w[0].message, "`ADJUST,3` after the tool number ignored");
+    assert_eq!(
+        error("LOADTL/2.5\n").message,
+        "the tool number must be a whole number from 0 to 4294967295, got `2.5`"
+    );
+}
+
+#[test]
+fn a_second_msys_must_not_change_the_first() {
+    // Repeated as it was (and cut short): fine.
+    events("MSYS/1,2,3,1,0,0,0,1,0\nMSYS/1,2,3,1,0,0,0,1,0\nMSYS/1,2,3\n");
+    let e = error("MSYS/1,2,3,1,0,0,0,1,0\nGOTO/0,0,0\nMSYS/1,2,4,1,0,0,0,1,0\n");
+    assert_eq!(
+        (e.line, e.message.as_str()),
+        (
+            3,
+            "MSYS changes the machine coordinate system of line 1: kinpost posts every point in the part frame of the machine file; post the operations of each coordinate system as a program of their own"
+        )
+    );
+}
+
+#[test]
+fn a_feed_rate_cancels_an_unused_rapid() {
+    let (s, w) = read("GOTO/0,0,9,0,0,1\nRAPID\nFEDRAT/100\nGOTO/0,0,1\nFEDRAT/200\n");
+    let motions: Vec<_> = s
+        .iter()
+        .filter_map(|s| match s.event {
+            ClEvent::Goto { motion, .. } => Some(motion),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(motions, [Motion::Feed, Motion::Feed]);
+    assert_eq!(w.len(), 1);
+    assert_eq!(
+        (w[0].line, w[0].message.as_str()),
+        (
+            3,
+            "FEDRAT after RAPID: the next move is at this feed, not rapid"
+        )
+    );
+}

@@ -27,6 +27,9 @@ const KNOWN: &[&str] = &[
     "CIRCLE",
     "CYCLE",
     "NURBS",
+    "TLAXIS",
+    "GODLTA",
+    "LOADTL",
 ];
 
 /// The known word closest to `word` (case-insensitive), if it is close enough

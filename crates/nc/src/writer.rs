@@ -483,7 +483,12 @@ impl<W: Write> NcWriter<W> {
     pub fn coolant(&mut self, mode: Option<&str>) -> Result<(), NcError> {
         match mode {
             None => self.command(TemplateKind::CoolantOff, Vec::new()),
-            Some(m) => self.command(TemplateKind::CoolantOn, vec![("mode", Value::from(m))]),
+            // Templates see the mode in lower case (`mist`, `flood`), as
+            // DIALECTS.md documents, whatever case the CL wrote.
+            Some(m) => self.command(
+                TemplateKind::CoolantOn,
+                vec![("mode", Value::from(m.to_ascii_lowercase()))],
+            ),
         }
     }
 

@@ -255,13 +255,15 @@ fn commands_tool_spindle_coolant() {
     w.spindle(Spindle::Ccw(3000.4)).unwrap();
     w.coolant(Some("flood")).unwrap();
     w.coolant(Some("mist")).unwrap();
+    // As the CL reader gives it (COOLNT/MIST): templates see lower case.
+    w.coolant(Some("MIST")).unwrap();
     w.coolant(None).unwrap();
     w.spindle(Spindle::Off).unwrap();
     w.comment("posted by (kinpost)\nline two").unwrap();
     w.insert("G642 U1030").unwrap();
     assert_eq!(
         text(w),
-        "T3\nM6\nS3013 M03\nS3000 M04\nM08\nM07\nM09\nM05\n; posted by (kinpost) line two\nG642 U1030\n"
+        "T3\nM6\nS3013 M03\nS3000 M04\nM08\nM07\nM07\nM09\nM05\n; posted by (kinpost) line two\nG642 U1030\n"
     );
 }
 
