@@ -23,7 +23,24 @@ pub(crate) fn environment() -> Environment<'static> {
     env.set_undefined_behavior(UndefinedBehavior::Strict);
     env.set_debug(true);
     env.add_filter("num", num);
+    env.add_filter("name", name);
     env
+}
+
+/// `{{ program_name | name }}`: a name every controller takes as one word:
+/// ASCII letters, digits, `_` and `-` kept, anything else `_` (a Heidenhain
+/// `BEGIN PGM` name ends at a blank and a `;` starts a comment).
+fn name(value: &str) -> String {
+    value
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// `{{ value | num }}`, `{{ value | num(1) }}`: a number with at most that many
@@ -171,6 +188,18 @@ pub(crate) fn error_span_in_toml(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn name_filter() {
+        let env = environment();
+        let got = env
+            .render_str(
+                "{{ n | name }}",
+                minijinja::context! { n => "TEST (V2) ; A=B Gehäuse-1" },
+            )
+            .unwrap();
+        assert_eq!(got, "TEST__V2____A_B_Geh_use-1");
+    }
 
     #[test]
     fn num_filter() {

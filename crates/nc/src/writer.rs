@@ -248,6 +248,9 @@ pub struct NcWriter<W: Write> {
     vars: BTreeMap<String, Value>,
     blocks: u64,
     csv_header_done: bool,
+    /// Tool-centre-point control is on: a tool change turns it off first
+    /// and on again for the new tool (its length).
+    tcp_on: bool,
 }
 
 /// The pressure word: its format and state (modal), and whether the
@@ -363,6 +366,7 @@ impl<W: Write> NcWriter<W> {
             vars,
             blocks: 0,
             csv_header_done: false,
+            tcp_on: false,
         }
     }
 
@@ -451,12 +455,22 @@ impl<W: Write> NcWriter<W> {
     }
 
     /// Tool change (template `tool_change` with `tool_number` and `tool_name`;
-    /// `tool` and `tool_number` are updated for later templates too).
+    /// `tool` and `tool_number` are updated for later templates too). With
+    /// tool-centre-point control on, it is turned off before and on again
+    /// after, for the new tool.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
+        let tcp = self.tcp_on;
+        if tcp {
+            self.tcp(false)?;
+        }
         self.vars.insert("tool_number".into(), Value::from(number));
         self.vars.insert("tool".into(), Value::from(name));
         self.vars.insert("tool_name".into(), Value::from(name));
-        self.command(TemplateKind::ToolChange, Vec::new())
+        self.command(TemplateKind::ToolChange, Vec::new())?;
+        if tcp {
+            self.tcp(true)?;
+        }
+        Ok(())
     }
 
     /// Spindle on (`spindle_on` with `speed`, `clockwise`, `direction` =
@@ -494,6 +508,7 @@ impl<W: Write> NcWriter<W> {
 
     /// Tool-centre-point control on or off (templates `tcp_on`, `tcp_off`).
     pub fn tcp(&mut self, on: bool) -> Result<(), NcError> {
+        self.tcp_on = on;
         let kind = if on {
             TemplateKind::TcpOn
         } else {

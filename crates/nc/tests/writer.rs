@@ -822,3 +822,19 @@ fn documented_pressure_tables() {
         );
     }
 }
+
+#[test]
+fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    w.tool_change(1, "T1").unwrap();
+    w.tcp(true).unwrap();
+    w.tool_change(2, "T2").unwrap();
+    w.tcp(false).unwrap();
+    w.tool_change(3, "T3").unwrap();
+    assert_eq!(
+        text(w),
+        "T1 M06\nG43.4 H1\nG49\nT2 M06\nG43.4 H2\nG49\nT3 M06\n"
+    );
+}
