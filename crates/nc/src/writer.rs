@@ -457,7 +457,7 @@ impl<W: Write> NcWriter<W> {
     /// Tool change (template `tool_change` with `tool_number` and `tool_name`;
     /// `tool` and `tool_number` are updated for later templates too). With
     /// tool-centre-point control on, it is turned off before and on again
-    /// after, for the new tool.
+    /// after, for the new tool. The next block writes every axis word.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
         let tcp = self.tcp_on;
         if tcp {
@@ -467,6 +467,11 @@ impl<W: Write> NcWriter<W> {
         self.vars.insert("tool".into(), Value::from(name));
         self.vars.insert("tool_name".into(), Value::from(name));
         self.command(TemplateKind::ToolChange, Vec::new())?;
+        // The change moves the axes to where the machine changes tools: the
+        // next block states every axis again.
+        for w in &mut self.words {
+            w.known = false;
+        }
         if tcp {
             self.tcp(true)?;
         }

@@ -838,3 +838,31 @@ fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
         "T1 M06\nG43.4 H1\nG49\nT2 M06\nG43.4 H2\nG49\nT3 M06\n"
     );
 }
+
+#[test]
+fn after_a_tool_change_every_axis_is_written_again() {
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
+    let block = |w: &mut NcWriter<Vec<u8>>, z: f64| {
+        let mut q = p;
+        q[3] = z;
+        w.block(&Block {
+            cl_line: None,
+            motion: Motion::Rapid,
+            axes: &q,
+            feed: None,
+        })
+        .unwrap();
+    };
+    block(&mut w, 380.0);
+    block(&mut w, 400.0);
+    w.tool_change(2, "T2").unwrap();
+    block(&mut w, 400.0);
+    let out = text(w);
+    assert_eq!(
+        out,
+        "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nX459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
+    );
+}
