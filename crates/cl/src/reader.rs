@@ -912,7 +912,7 @@ impl<R: BufRead> ClReader<R> {
         match self.msys {
             None => self.msys = Some((v, count, line)),
             Some((first, first_count, first_line)) => {
-                let n = count.min(first_count);
+                let n = count.min(first_count).min(v.len());
                 if (0..n).any(|k| (v[k] - first[k]).abs() > 1e-6) {
                     return Err(self.error(
                         args,

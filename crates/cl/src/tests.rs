@@ -714,6 +714,9 @@ fn loadtl_loads_a_tool_and_partno_loses_its_quotes() {
 fn a_second_msys_must_not_change_the_first() {
     // Repeated as it was (and cut short): fine.
     events("MSYS/1,2,3,1,0,0,0,1,0\nMSYS/1,2,3,1,0,0,0,1,0\nMSYS/1,2,3\n");
+    // More than nine values, twice (found by the fuzzer: out of bounds).
+    let (_, w) = read("MSYS/1,2,3,1,0,0,0,1,0,7\nMSYS/1,2,3,1,0,0,0,1,0,8\n");
+    assert_eq!(w.len(), 2);
     let e = error("MSYS/1,2,3,1,0,0,0,1,0\nGOTO/0,0,0\nMSYS/1,2,4,1,0,0,0,1,0\n");
     assert_eq!(
         (e.line, e.message.as_str()),
