@@ -1017,20 +1017,16 @@ impl<R: BufRead> ClReader<R> {
     /// `LOADTL/n[,…]` (CATIA, Fusion, Mastercam APT): `LOAD/TOOL,n`.
     fn loadtl(&mut self, word: Span, args: Span) -> Result<u32, Diagnostic> {
         self.split(args);
-        let Some(&f) = self.fields.first() else {
+        if self.fields.is_empty() {
             return Err(self.error(word, "expected `LOADTL/n`"));
-        };
-        let n = self.whole_tool_number(f)?;
-        if self.fields.len() > 1 {
-            let rest = (self.fields[1].0, args.1);
-            let text = self.text()[rest.0..rest.1].trim().to_string();
-            self.warn(rest, format!("`{text}` after the tool number ignored"));
         }
-        Ok(n)
+        self.tool_number_field(0, args)
     }
 
-    /// Field `f` as a tool number.
-    fn whole_tool_number(&self, f: Span) -> Result<u32, Diagnostic> {
+    /// Field `k` (split already) as a tool number; the fields after it are
+    /// ignored with a warning.
+    fn tool_number_field(&mut self, k: usize, args: Span) -> Result<u32, Diagnostic> {
+        let f = self.fields[k];
         let n = self.number(f)?;
         if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
             return Err(self.error(
@@ -1041,6 +1037,11 @@ impl<R: BufRead> ClReader<R> {
                     self.field(f)
                 ),
             ));
+        }
+        if let Some(next) = self.fields.get(k + 1) {
+            let rest = (next.0, args.1);
+            let text = self.text()[rest.0..rest.1].trim().to_string();
+            self.warn(rest, format!("`{text}` after the tool number ignored"));
         }
         Ok(n as u32)
     }
@@ -1054,19 +1055,13 @@ impl<R: BufRead> ClReader<R> {
         if !self.is(first, "TOOL") {
             return Err(self.error(first, usage));
         }
-        let Some(&f) = self.fields.get(1) else {
+        if self.fields.len() < 2 {
             return Err(self.error(
                 (first.1, first.1),
                 format!("{usage}: the tool number is missing"),
             ));
-        };
-        let n = self.whole_tool_number(f)?;
-        if self.fields.len() > 2 {
-            let rest = (self.fields[2].0, args.1);
-            let text = self.text()[rest.0..rest.1].trim().to_string();
-            self.warn(rest, format!("`{text}` after the tool number ignored"));
         }
-        Ok(n)
+        self.tool_number_field(1, args)
     }
 
     fn spindle(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
