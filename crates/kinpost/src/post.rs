@@ -182,6 +182,10 @@ struct Job<'a, W: Write> {
     /// Scale from CL units to mm.
     scale: f64,
     feed: Option<f64>,
+    /// The spindle speed last programmed, rpm.
+    rpm: Option<f64>,
+    /// A feed given per revolution (mm): `feed` follows the spindle speed.
+    feed_per_rev: Option<f64>,
     cl_points: u64,
     /// Pressures already warned about as not compensated (bits).
     uncompensated: Vec<u64>,
@@ -227,6 +231,8 @@ pub fn post<R: BufRead, W: Write>(
         },
         scale: 1.0,
         feed: None,
+        rpm: None,
+        feed_per_rev: None,
         cl_points: 0,
         uncompensated: Vec::new(),
         pressure: None,
@@ -273,16 +279,27 @@ pub fn post<R: BufRead, W: Write>(
                 job.motion(&pose, motion, line, &reader)?;
             }
             ClEvent::Feedrate { value, unit } => {
-                job.feed = Some(match unit {
+                let mm = match unit {
                     FeedUnit::Mmpm | FeedUnit::Mmpr => value,
                     FeedUnit::Ipm | FeedUnit::Ipr => value * 25.4,
+                };
+                job.feed_per_rev = None;
+                job.feed = Some(if matches!(unit, FeedUnit::Mmpr | FeedUnit::Ipr) {
+                    // The feed word is per minute: per revolution times the
+                    // spindle speed, now and after every speed change.
+                    let Some(rpm) = job.rpm else {
+                        return Err(reader
+                            .statement_diagnostic(
+                                Severity::Error,
+                                "a feed per revolution needs the spindle speed: give SPINDL/rpm before it",
+                            )
+                            .into());
+                    };
+                    job.feed_per_rev = Some(mm);
+                    mm * rpm
+                } else {
+                    mm
                 });
-                if matches!(unit, FeedUnit::Mmpr | FeedUnit::Ipr) {
-                    warnings.push(reader.statement_diagnostic(
-                        Severity::Warning,
-                        "feed per revolution is written as given; the dialect's feed word is per minute",
-                    ));
-                }
             }
             ClEvent::Units(units) => {
                 job.scale = match units {
@@ -321,10 +338,16 @@ pub fn post<R: BufRead, W: Write>(
                 tool_loaded = true;
             }
             ClEvent::SelectTool { .. } => {}
-            ClEvent::Spindle { rpm, dir } => job.emit(Pending::Spindle(match dir {
-                SpindleDir::Clockwise => Spindle::Cw(rpm),
-                SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
-            }))?,
+            ClEvent::Spindle { rpm, dir } => {
+                job.rpm = Some(rpm);
+                if let Some(per_rev) = job.feed_per_rev {
+                    job.feed = Some(per_rev * rpm);
+                }
+                job.emit(Pending::Spindle(match dir {
+                    SpindleDir::Clockwise => Spindle::Cw(rpm),
+                    SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
+                }))?
+            }
             ClEvent::SpindleOff => job.emit(Pending::Spindle(Spindle::Off))?,
             ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
             ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,

@@ -701,3 +701,41 @@ fn posts_fold_fixture(machine: &str, cl: &str, points: usize) -> Summary {
 fn a_path_passing_a_fold_it_does_not_reach_keeps_its_branch() {
     posts_fold_fixture("near-fold.toml", "near-fold.cls", 25);
 }
+
+/// A feed per revolution is written per minute at the spindle speed, and
+/// follows it when the speed changes; without a speed it is an error.
+#[test]
+fn a_feed_per_revolution_follows_the_spindle_speed() {
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let options = PostOptions {
+        lintol_mm: Some(0.0),
+        ..Default::default()
+    };
+    let cl = "FEDRAT/MMPM,500\nGOTO/0,0,50,0,0,1\nSPINDL/RPM,2000,CLW\nFEDRAT/MMPR,0.1\n\
+              GOTO/0,0,10\nSPINDL/RPM,3000,CLW\nGOTO/0,0,5\nFEDRAT/IPR,0.01\nGOTO/0,0,4\n\
+              FEDRAT/300\nGOTO/0,0,1\n";
+    let (csv, summary) = post_csv(&m, cl, &options).unwrap();
+    assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    let feeds: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap())
+        .collect();
+    assert_eq!(
+        feeds,
+        [
+            "500.000000",
+            "200.000000",
+            "300.000000",
+            "762.000000",
+            "300.000000"
+        ]
+    );
+    let e = post_csv(&m, "FEDRAT/MMPR,0.1\nGOTO/0,0,50,0,0,1\n", &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("a feed per revolution needs the spindle speed: give SPINDL/rpm before it"),
+        "{e}"
+    );
+}
