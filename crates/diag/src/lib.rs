@@ -15,6 +15,8 @@
 
 use std::fmt;
 
+pub mod toml_names;
+
 /// How bad a diagnostic is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Severity {

@@ -306,45 +306,22 @@ fn toml_error(e: &toml::de::Error, file: &str, source: &str, syntax: bool) -> Di
 }
 
 /// Every key the machine file does not know and every unknown value of a
-/// key that takes a word (`kind`, `side`, `wrap`, …), in file order, worded
-/// as serde words them. The names come from the `Raw*` types, which do not
-/// deny unknown keys themselves: this is where they are refused.
+/// key that takes a word (`kind`, `side`, `wrap`, …), in file order. The
+/// `Raw*` types do not deny unknown keys themselves: this is where they are
+/// refused.
 fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
+    use kinpost_diag::toml_names::{Unknown, names, table};
     use toml::de::{DeTable, DeValue};
     let Ok(doc) = DeTable::parse(source) else {
         return Vec::new();
     };
-    let mut found: Vec<(std::ops::Range<usize>, String)> = Vec::new();
-    // The keys of `table` against `fields`, and the words of `words`'
-    // keys against their values.
-    let mut check = |table: &DeTable, fields: &[&str], words: &[(&str, &[&str])]| {
-        for (key, value) in table {
-            let k = key.get_ref().as_ref();
-            if !fields.contains(&k) {
-                found.push((
-                    key.span(),
-                    format!("unknown key `{k}`, {}", expected(fields)),
-                ));
-                continue;
-            }
-            if let (Some((_, allowed)), DeValue::String(w)) =
-                (words.iter().find(|(name, _)| *name == k), value.get_ref())
-                && !allowed.contains(&w.as_ref())
-            {
-                found.push((
-                    value.span(),
-                    format!("unknown value `{w}`, {}", expected(allowed)),
-                ));
-            }
-        }
-    };
     let doc = doc.get_ref();
-    check(doc, names::<RawMachine>(), &[]);
-    let section = |name: &str| doc.get(name).map(|v| v.get_ref());
-    if let Some(DeValue::Table(t)) = section("post") {
-        check(t, names::<RawPost>(), &[("output", names::<RawOutput>())]);
+    let mut unknown = Unknown::default();
+    unknown.check(doc, names::<RawMachine>(), &[]);
+    if let Some(t) = table(doc, "post") {
+        unknown.check(t, names::<RawPost>(), &[("output", names::<RawOutput>())]);
     }
-    if let Some(DeValue::Array(axes)) = section("axis") {
+    if let Some(DeValue::Array(axes)) = doc.get("axis").map(|v| v.get_ref()) {
         let words = [
             ("kind", names::<RawKind>()),
             ("side", names::<RawSide>()),
@@ -353,7 +330,7 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
         ];
         for axis in axes {
             if let DeValue::Table(t) = axis.get_ref() {
-                check(t, names::<RawAxis>(), &words);
+                unknown.check(t, names::<RawAxis>(), &words);
             }
         }
     }
@@ -362,73 +339,11 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
         ("tool", names::<RawTool>()),
         ("pressure", names::<RawPressure>()),
     ] {
-        if let Some(DeValue::Table(t)) = section(name) {
-            check(t, fields, &[]);
+        if let Some(t) = table(doc, name) {
+            unknown.check(t, fields, &[]);
         }
     }
-    found.sort_by_key(|(span, _)| span.start);
-    found
-        .into_iter()
-        .map(|(span, message)| {
-            Diagnostic::at_byte_span(Severity::Error, file, source, span, message)
-        })
-        .collect()
-}
-
-/// serde's wording of the names a key or value may take.
-fn expected(names: &[&str]) -> String {
-    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
-    match quoted.as_slice() {
-        [] => "there are none".to_string(),
-        [one] => format!("expected {one}"),
-        [a, b] => format!("expected {a} or {b}"),
-        all => format!("expected one of {}", all.join(", ")),
-    }
-}
-
-/// The field names serde's derive gives a struct, or the variant names of an
-/// enum (as written in the file): asked of `T` through a deserializer that
-/// only listens, so that the lists cannot drift from the types.
-fn names<T: serde::de::DeserializeOwned>() -> &'static [&'static str] {
-    use serde::de::{Error, Visitor, value};
-    struct Listen<'a>(&'a mut &'static [&'static str]);
-    impl Listen<'_> {
-        /// Keeps the names the type asked for, and stops it there.
-        fn heard<T>(self, names: &'static [&'static str]) -> Result<T, value::Error> {
-            *self.0 = names;
-            Err(value::Error::custom("listening only"))
-        }
-    }
-    impl<'de> serde::Deserializer<'de> for Listen<'_> {
-        type Error = value::Error;
-        fn deserialize_any<V: Visitor<'de>>(self, _: V) -> Result<V::Value, value::Error> {
-            self.heard(&[])
-        }
-        fn deserialize_struct<V: Visitor<'de>>(
-            self,
-            _: &'static str,
-            fields: &'static [&'static str],
-            _: V,
-        ) -> Result<V::Value, value::Error> {
-            self.heard(fields)
-        }
-        fn deserialize_enum<V: Visitor<'de>>(
-            self,
-            _: &'static str,
-            variants: &'static [&'static str],
-            _: V,
-        ) -> Result<V::Value, value::Error> {
-            self.heard(variants)
-        }
-        serde::forward_to_deserialize_any! {
-            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
-            bytes byte_buf option unit unit_struct newtype_struct seq tuple
-            tuple_struct map identifier ignored_any
-        }
-    }
-    let mut names: &'static [&'static str] = &[];
-    let _ = T::deserialize(Listen(&mut names));
-    names
+    unknown.into_diagnostics(file, source)
 }
 
 /// Reads a machine file. `file` is the name used in diagnostics.

@@ -275,16 +275,32 @@ impl Dialect {
     /// Parses and validates a dialect file. Every problem is reported as a
     /// diagnostic naming `file_name`, line and column.
     pub fn from_toml(source: &str, file_name: &str) -> Result<Dialect, Diagnostics> {
-        let raw: RawDialect = toml::from_str(source).map_err(|e| {
-            Diagnostics::from(Diagnostic::at_byte_span(
-                Severity::Error,
-                file_name,
-                source,
-                e.span().unwrap_or(0..0),
-                e.message().trim_end().to_string(),
-            ))
-        })?;
-        let mut errors = Vec::new();
+        // serde would stop at the first unknown key or value: they are all
+        // found here (the `Raw*` types let unknown keys pass), and reported
+        // with the mistakes the checks below find.
+        let unknown = unknown_names(source, file_name);
+        let raw: RawDialect = match toml::from_str(source) {
+            Ok(raw) => raw,
+            Err(e) => {
+                let first = Diagnostic::at_byte_span(
+                    Severity::Error,
+                    file_name,
+                    source,
+                    e.span().unwrap_or(0..0),
+                    e.message().trim_end().to_string(),
+                );
+                let mut all = unknown;
+                // An unknown value is among them already.
+                if !all
+                    .iter()
+                    .any(|d| (d.line, d.column) == (first.line, first.column))
+                {
+                    all.push(first);
+                }
+                return Err(Diagnostics(all));
+            }
+        };
+        let mut errors = unknown;
         let mut err = |span: std::ops::Range<usize>, msg: String| {
             errors.push(Diagnostic::at_byte_span(
                 Severity::Error,
@@ -769,8 +785,53 @@ impl From<&RawWord> for PartialWord {
 
 // ---------------------------------------------------------------- raw TOML
 
+/// Every key the dialect file does not know and every unknown value of a
+/// key that takes a word (`kind`, `trailing_zeros`, `initial`), in file
+/// order. The `Raw*` types do not deny unknown keys themselves: this is
+/// where they are refused.
+fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
+    use kinpost_diag::toml_names::{Unknown, names, table};
+    let Ok(doc) = toml::de::DeTable::parse(source) else {
+        return Vec::new();
+    };
+    let doc = doc.get_ref();
+    let mut unknown = Unknown::default();
+    unknown.check(
+        doc,
+        names::<RawDialect>(),
+        &[("kind", names::<DialectKind>())],
+    );
+    let zeros = [("trailing_zeros", names::<TrailingZeros>())];
+    let mut words: Vec<&toml::de::DeTable> = ["linear", "rotary", "endless", "pressure"]
+        .iter()
+        .filter_map(|name| table(doc, name))
+        .collect();
+    if let Some(axes) = table(doc, "axis") {
+        words.extend(axes.keys().filter_map(|k| table(axes, k.get_ref())));
+    }
+    for t in words {
+        unknown.check(t, names::<RawWord>(), &zeros);
+    }
+    for (name, fields, keywords) in [
+        ("feed", names::<RawFeed>(), &zeros[..]),
+        ("block", names::<RawBlock>(), &[]),
+        (
+            "motion",
+            names::<RawMotion>(),
+            &[("initial", names::<RawInitial>())],
+        ),
+        ("numbering", names::<RawNumbering>(), &[]),
+        ("comment", names::<RawComment>(), &[]),
+        ("templates", names::<RawTemplates>(), &[]),
+    ] {
+        if let Some(t) = table(doc, name) {
+            unknown.check(t, fields, keywords);
+        }
+    }
+    unknown.into_diagnostics(file, source)
+}
+
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawDialect {
     name: Spanned<String>,
     extension: Spanned<String>,
@@ -802,7 +863,6 @@ struct RawDialect {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
 struct RawWord {
     prefix: Option<Spanned<String>>,
     suffix: Option<Spanned<String>>,
@@ -815,7 +875,6 @@ struct RawWord {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
 struct RawFeed {
     prefix: Option<Spanned<String>>,
     suffix: Option<Spanned<String>>,
@@ -846,7 +905,6 @@ impl RawFeed {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawBlock {
     #[serde(default)]
     order: Vec<String>,
@@ -885,7 +943,6 @@ enum RawInitial {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawMotion {
     #[serde(default = "g0")]
     rapid: String,
@@ -925,7 +982,6 @@ fn yes() -> bool {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawNumbering {
     #[serde(default)]
     enabled: bool,
@@ -973,7 +1029,6 @@ fn ten_spanned() -> Spanned<u64> {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct RawComment {
     #[serde(default = "yes")]
     enabled: bool,
@@ -1001,7 +1056,6 @@ fn semicolon() -> String {
 }
 
 #[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
 struct RawTemplates {
     header: Option<Spanned<String>>,
     footer: Option<Spanned<String>>,

@@ -67,3 +67,36 @@ fn rendered_diagnostic() {
     let s = e.to_string();
     assert!(s.contains("--> my.toml:3:1"), "{s}");
 }
+
+#[test]
+fn every_unknown_key_and_value_at_once() {
+    let src = "name = \"x\"\nextension = \"nc\"\ncolour = 1\n[linear]\nprefx = \"X\"\n\
+               [axis.A]\ndecimal = 3\ntrailing_zeros = \"nope\"\n[motion]\ninitial = \"g2\"\n\
+               [templates]\nheadr = \"%\"\n";
+    let e = Dialect::from_toml(src, "my.toml").unwrap_err();
+    let got: Vec<(usize, &str)> = e.0.iter().map(|d| (d.line, d.message.as_str())).collect();
+    let word = "expected one of `prefix`, `suffix`, `decimals`, `trailing_zeros`, `leading_zero`, `plus_sign`, `modulo`, `modal`";
+    assert_eq!(
+        got,
+        [
+            (
+                3,
+                "unknown key `colour`, expected one of `name`, `extension`, `description`, `kind`, `block`, `linear`, `rotary`, `endless`, `axis`, `pressure`, `feed`, `motion`, `numbering`, `comment`, `templates`"
+            ),
+            (5, &format!("unknown key `prefx`, {word}")[..]),
+            (7, &format!("unknown key `decimal`, {word}")[..]),
+            (
+                8,
+                "unknown value `nope`, expected one of `keep`, `point`, `trim`"
+            ),
+            (
+                10,
+                "unknown value `g2`, expected one of `none`, `rapid`, `feed`"
+            ),
+            (
+                12,
+                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`"
+            ),
+        ]
+    );
+}
