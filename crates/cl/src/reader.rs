@@ -994,17 +994,11 @@ impl<R: BufRead> ClReader<R> {
                 ));
             }
         }
-        let v = [
-            last[0] + d[0],
-            last[1] + d[1],
-            last[2] + d[2],
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-        ];
+        // A three-value GOTO to the moved point.
+        let mut v = [0.0; 9];
+        for k in 0..3 {
+            v[k] = last[k] + d[k];
+        }
         let (point, axis, motion) = self.goto_move(args, v, 3)?;
         Ok(ClEvent::Goto {
             point,
@@ -1453,7 +1447,6 @@ fn floor_char_boundary(s: &str, i: usize) -> usize {
     i
 }
 
-/// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
 /// `text` without one pair of enclosing quotes (`'1001'`, `"A B"`), as
 /// APT writers quote names.
 fn unquote(text: &str) -> &str {
@@ -1465,6 +1458,7 @@ fn unquote(text: &str) -> &str {
     text
 }
 
+/// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
 fn normalize(v: Vec3) -> Option<Vec3> {
     let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if n2 == 1.0 {
