@@ -51,6 +51,19 @@ impl Unknown {
     }
 }
 
+/// What to report when serde refuses the file after `unknown` was found:
+/// the unknown names, and serde's own error unless it is one of them (its
+/// first unknown value) at the same place.
+pub fn with_serde_error(mut unknown: Vec<Diagnostic>, serde: Diagnostic) -> Vec<Diagnostic> {
+    if !unknown
+        .iter()
+        .any(|d| (d.line, d.column) == (serde.line, serde.column))
+    {
+        unknown.push(serde);
+    }
+    unknown
+}
+
 /// The table `name` of `table`, if it is one.
 pub fn table<'a, 'i>(table: &'a DeTable<'i>, name: &str) -> Option<&'a DeTable<'i>> {
     match table.get(name).map(|v| v.get_ref()) {

@@ -358,15 +358,11 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
     let unknown = unknown_names(source, file);
     let raw: RawMachine = match toml::from_str(source) {
         Ok(raw) => raw,
-        // An unknown value is among `unknown`; any other mistake of type
-        // goes after them.
         Err(e) => {
-            let mut all = unknown;
             let first = toml_error(&e, file, source, false);
-            if !all.contains(&first) {
-                all.push(first);
-            }
-            return Err(Diagnostics(all));
+            return Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
+                unknown, first,
+            )));
         }
     };
     let mut c = Checker {

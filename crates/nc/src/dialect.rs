@@ -289,15 +289,9 @@ impl Dialect {
                     e.span().unwrap_or(0..0),
                     e.message().trim_end().to_string(),
                 );
-                let mut all = unknown;
-                // An unknown value is among them already.
-                if !all
-                    .iter()
-                    .any(|d| (d.line, d.column) == (first.line, first.column))
-                {
-                    all.push(first);
-                }
-                return Err(Diagnostics(all));
+                return Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
+                    unknown, first,
+                )));
             }
         };
         let mut errors = unknown;
