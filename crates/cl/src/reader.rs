@@ -1376,41 +1376,94 @@ fn trim_end_ascii(line: &[u8]) -> usize {
 
 /// A plain `GOTO` line at the start of `buf`, the common case: `GOTO/`,
 /// then numbers [`plain_number`] takes, separated by commas, then the line
-/// end (`\n` or `\r\n`), nothing else (no blanks). Returns the number of
-/// values (at most 9, in `v`) and the length of the line without and with
-/// its line end; `None` for anything else, and near the end of `buf` (fewer
-/// than [`PLAIN_CHUNK`] bytes from the start of a number).
+/// end (`\n` or `\r\n`), nothing else (no blanks), all within
+/// [`GOTO_WINDOW`] bytes after `GOTO/`. Returns the number of values (at
+/// most 9, in `v`) and the length of the line without and with its line
+/// end; `None` for anything else, which the general path reads.
 ///
 /// As the numbers are read, the line is checked on the way: it is ASCII
 /// without `$` (the bytes taken are digits, signs, points and commas).
 #[inline(always)]
 fn plain_goto(buf: &[u8], v: &mut [f64; 9]) -> Option<PlainGoto> {
-    let mut rest = buf.strip_prefix(b"GOTO/")?;
-    // The count of values is what `slots` has left, not a counter: one
-    // instruction less per number.
-    let mut slots = v.iter_mut();
-    while let Some(slot) = slots.next() {
-        let chunk = rest.first_chunk::<PLAIN_CHUNK>()?;
+    let rest = buf.strip_prefix(b"GOTO/")?;
+    let line = match rest.first_chunk::<{ GOTO_WINDOW + PLAIN_CHUNK }>() {
+        Some(window) => plain_goto_window(window, v),
+        // The end of the input (or of the reader's buffer): zeros are
+        // neither separators nor digits.
+        None => {
+            let mut window = [0; GOTO_WINDOW + PLAIN_CHUNK];
+            window[..rest.len()].copy_from_slice(rest);
+            plain_goto_window(&window, v)
+        }
+    }?;
+    Some(PlainGoto {
+        count: line.count,
+        end: line.end + 5,
+        next: line.next + 5,
+    })
+}
+
+/// The bytes after `GOTO/` in which [`plain_goto`] looks for the line end.
+const GOTO_WINDOW: usize = 64;
+
+/// [`plain_goto`] on the bytes after `GOTO/` (lengths counted from there).
+///
+/// The separators are found first, for the whole window at once, and
+/// every number is then read from where they say it starts: the numbers
+/// do not wait for each other (reading one to find where the next starts
+/// made the line one long chain of dependent operations). Each number must
+/// end exactly at its separator.
+#[inline(always)]
+fn plain_goto_window(
+    window: &[u8; GOTO_WINDOW + PLAIN_CHUNK],
+    v: &mut [f64; 9],
+) -> Option<PlainGoto> {
+    let mut separators = 0u64;
+    for (k, word) in window.chunks_exact(8).take(GOTO_WINDOW / 8).enumerate() {
+        let word = u64::from_le_bytes(word.try_into().expect("eight bytes"));
+        let found = equal_bytes(word, b',') | equal_bytes(word, b'\n');
+        // The high bit of byte i moved to bit i (the products of distinct
+        // bits land on distinct bits: nothing carries).
+        let bits = (found >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56;
+        separators |= bits << (8 * k);
+    }
+    let mut start = 0;
+    for (count, slot) in v.iter_mut().enumerate() {
+        if separators == 0 {
+            return None; // no line end in the window
+        }
+        let at = separators.trailing_zeros() as usize;
+        separators &= separators - 1;
+        let line_end = window[at] == b'\n';
+        // `\r\n`: the last number ends at the `\r`.
+        let end = at - usize::from(line_end && at > start && window[at - 1] == b'\r');
+        let chunk = window[start..].first_chunk::<PLAIN_CHUNK>()?;
         let (x, len) = plain_number(chunk)?;
+        if start + len != end {
+            return None;
+        }
         *slot = x;
-        // `len` is at most 10: the byte after the number is in the chunk.
-        let line_end = match chunk[len] {
-            b',' => {
-                rest = &rest[len + 1..];
-                continue;
-            }
-            b'\n' => 1,
-            b'\r' if rest.get(len + 1) == Some(&b'\n') => 2,
-            _ => return None,
-        };
-        let end = buf.len() - rest.len() + len;
-        return Some(PlainGoto {
-            count: 9 - slots.len(),
-            end,
-            next: end + line_end,
-        });
+        if line_end {
+            return Some(PlainGoto {
+                count: count + 1,
+                end,
+                next: at + 1,
+            });
+        }
+        start = at + 1;
     }
     None // more than 9 values
+}
+
+/// The high bit of each byte of `word` that equals `byte`, exactly (no
+/// borrow from one byte to the next).
+#[inline(always)]
+fn equal_bytes(word: u64, byte: u8) -> u64 {
+    const LOW_BITS: u64 = !HIGH_BITS;
+    let x = word ^ (ONES * u64::from(byte));
+    // High bit set for a byte of `x` that is not zero: its low seven bits
+    // carry into it, or it is set already.
+    !(((x & LOW_BITS) + LOW_BITS) | x) & HIGH_BITS
 }
 
 /// A plain `GOTO` line found by [`plain_goto`].

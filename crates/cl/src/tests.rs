@@ -581,6 +581,13 @@ fn fast_paths_agree_with_the_general_path() {
         "GOTO/1,2,3,0,0,1\nGOTO/4,5,6",
         "GOTO/1,2,3,0,0,1\nGOTO/4,5,6\r",
         "GOTO/1,2,3,0,0,1,0,1,0,7\nGOTO/1e999,2,3,0,0,1\nGOTO/0.00000001,2,3,0,0,1\n",
+        // The fast path looks for the line end in the 64 bytes after `GOTO/`:
+        // lines of 63 and 64 bytes, a `\r\n` at 62 and at 63, nine values.
+        "GOTO/-1234.5678,-1234.5678,-1234.567,-0.123456,-0.123456,-0.98765432\n\
+         GOTO/-1234.5678,-1234.5678,-1234.5678,-0.123456,-0.123456,-0.98765432\n\
+         GOTO/-1234.5678,-1234.567,-1234.567,-0.123456,-0.123456,-0.98765432\r\n\
+         GOTO/-1234.5678,-1234.5678,-1234.567,-0.123456,-0.123456,-0.98765432\r\n\
+         GOTO/-1234.5678,-1234.5678,-1234.5678,-0.1234567,-0.1234567,-0.9876543,-0.1234567,-0.1234567,-0.9876543\n",
     ];
     for text in texts {
         let general = transcript(std::io::BufReader::with_capacity(1, text.as_bytes()));
