@@ -1,14 +1,36 @@
 //! Fuzz target: any bytes fed to the CL reader, with and without a default
 //! tool axis, must never panic or loop, and every diagnostic must point into
-//! the input. Run with `cargo +nightly fuzz run cl_reader` from the
-//! repository root.
+//! the input. The fast paths (whole input in memory) must read exactly what
+//! the general path (a one-byte buffer) reads. Run with
+//! `cargo +nightly fuzz run cl_reader` from the repository root.
 
 #![no_main]
+
+use std::io::BufRead;
 
 use kinpost_cl::{ClEvent, ClReader};
 use libfuzzer_sys::fuzz_target;
 
+/// Everything the reader gives, in order, as text.
+fn transcript<R: BufRead>(mut reader: ClReader<R>) -> Vec<String> {
+    let mut out = Vec::new();
+    loop {
+        let result = reader.next_statement();
+        let end = matches!(result, Ok(None));
+        out.push(format!("{result:?}"));
+        out.extend(reader.take_warnings().iter().map(|w| format!("{w:?}")));
+        if end || out.len() > 100_000 {
+            return out;
+        }
+    }
+}
+
 fuzz_target!(|data: &[u8]| {
+    assert_eq!(
+        transcript(ClReader::new(data, "fuzz.cls")),
+        transcript(ClReader::new(std::io::BufReader::with_capacity(1, data), "fuzz.cls")),
+        "the fast paths read differently from the general path"
+    );
     let lines = data.split(|&b| b == b'\n').count();
     for default_axis in [false, true] {
         let mut reader = ClReader::new(data, "fuzz.cls");

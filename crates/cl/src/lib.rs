@@ -97,12 +97,13 @@ pub use reader::ClReader;
 pub type Vec3 = [f64; 3];
 
 /// How the tool moves to a [`ClEvent::Goto`] point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Motion {
     /// Positioning move at the machine's rapid rate (the statement before the
     /// `GOTO` was `RAPID`).
     Rapid,
     /// Cutting move at the current feed rate.
+    #[default]
     Feed,
 }
 
@@ -239,6 +240,33 @@ pub enum ClEvent {
     },
     /// `FINI`: end of the CL file.
     Fini,
+}
+
+/// A `GOTO` written by [`ClReader::next_move`]: the fields of
+/// [`ClEvent::Goto`] and the line of the statement.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Move {
+    /// 1-based line of the statement.
+    pub line: usize,
+    /// Tool tip point.
+    pub point: Vec3,
+    /// Tool axis, unit length.
+    pub axis: Vec3,
+    /// Reference direction, unit length, if one was ever given.
+    pub reference: Option<Vec3>,
+    /// Rapid if the previous motion statement was `RAPID`.
+    pub motion: Motion,
+}
+
+/// What [`ClReader::next_move`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Next {
+    /// A `GOTO`, written into the caller's [`Move`].
+    Move,
+    /// Any other statement (a `GOTO` too, when its line is not plain).
+    Statement(Statement),
+    /// The end of the input.
+    End,
 }
 
 /// One logical CL statement (possibly several physical lines).

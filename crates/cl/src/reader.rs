@@ -6,7 +6,7 @@ use kinpost_diag::{Diagnostic, Severity};
 
 use crate::number::{PLAIN_CHUNK, parse_number, plain_number, scan_number};
 use crate::words::suggest;
-use crate::{ClEvent, FeedUnit, Motion, SpindleDir, Statement, Units, Vec3};
+use crate::{ClEvent, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units, Vec3};
 
 /// A byte range in the logical statement text.
 type Span = (usize, usize);
@@ -203,16 +203,50 @@ impl<R: BufRead> ClReader<R> {
     /// An `Err` is an error diagnostic (never a warning): the input cannot be
     /// posted as it is. See the type's documentation for what happens after.
     pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
+        let mut goto = Move::default();
+        Ok(match self.next_move(&mut goto)? {
+            Next::Move => Some(Statement {
+                line: goto.line,
+                event: ClEvent::Goto {
+                    point: goto.point,
+                    axis: goto.axis,
+                    reference: goto.reference,
+                    motion: goto.motion,
+                },
+            }),
+            Next::Statement(statement) => Some(statement),
+            Next::End => None,
+        })
+    }
+
+    /// [`next_statement`](Self::next_statement) for a caller that reads
+    /// mostly moves: the `GOTO` of a plain line (the bulk of a CL file) is
+    /// written into `goto`, field by field, and only said to be there
+    /// ([`Next::Move`]); every other statement, and a `GOTO` of any other
+    /// shape, comes as a [`Statement`]. (A move returned inside the
+    /// statement enum was copied from place to place on its way.)
+    #[inline(always)]
+    pub fn next_move(&mut self, goto: &mut Move) -> Result<Next, Diagnostic> {
         if self.finished {
-            return Ok(None);
+            return Ok(Next::End);
         }
-        // The bulk of a CL file, a plain `GOTO` line, is read and turned
-        // into its event right here; everything else is left to
+        // Everything but a plain `GOTO` line is left to
         // `next_statement_general`, out of line, so that this stays small.
         let mut values = [0.0; 9];
         match self.begin_statement(&mut values)? {
-            Begin::PlainGoto { count, end } => self.plain_goto_statement(values, count, end),
-            begun => self.next_statement_general(begun, values),
+            Begin::PlainGoto { count, end } => {
+                let (point, axis, motion) = self.goto_move((5, end), values, count)?;
+                goto.line = self.line;
+                goto.point = point;
+                goto.axis = axis;
+                goto.reference = self.reference;
+                goto.motion = motion;
+                Ok(Next::Move)
+            }
+            begun => Ok(match self.next_statement_general(begun, values)? {
+                Some(statement) => Next::Statement(statement),
+                None => Next::End,
+            }),
         }
     }
 
@@ -1421,10 +1455,9 @@ fn plain_goto_window(
     let mut separators = 0u64;
     for (k, word) in window.chunks_exact(8).take(GOTO_WINDOW / 8).enumerate() {
         let word = u64::from_le_bytes(word.try_into().expect("eight bytes"));
-        let found = equal_bytes(word, b',') | equal_bytes(word, b'\n');
         // The high bit of byte i moved to bit i (the products of distinct
         // bits land on distinct bits: nothing carries).
-        let bits = (found >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56;
+        let bits = (below_minus(word) >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56;
         separators |= bits << (8 * k);
     }
     let mut start = 0;
@@ -1434,20 +1467,24 @@ fn plain_goto_window(
         }
         let at = separators.trailing_zeros() as usize;
         separators &= separators - 1;
-        let line_end = window[at] == b'\n';
-        // `\r\n`: the last number ends at the `\r`.
-        let end = at - usize::from(line_end && at > start && window[at - 1] == b'\r');
+        // The length of the separator: a comma, or the line end.
+        let (line_end, width) = match window[at] {
+            b',' => (false, 1),
+            b'\n' => (true, 1),
+            b'\r' if window[at + 1] == b'\n' => (true, 2),
+            _ => return None, // a blank, `$`, `+`, …: the general path reads it
+        };
         let chunk = window[start..].first_chunk::<PLAIN_CHUNK>()?;
         let (x, len) = plain_number(chunk)?;
-        if start + len != end {
+        if start + len != at {
             return None;
         }
         *slot = x;
         if line_end {
             return Some(PlainGoto {
                 count: count + 1,
-                end,
-                next: at + 1,
+                end: at,
+                next: at + width,
             });
         }
         start = at + 1;
@@ -1455,15 +1492,13 @@ fn plain_goto_window(
     None // more than 9 values
 }
 
-/// The high bit of each byte of `word` that equals `byte`, exactly (no
-/// borrow from one byte to the next).
+/// The high bit of each ASCII byte of `word` below `-` (0x2D): the
+/// separators `,` and `\n`, but also `\r`, blanks, `$` and `+`, which the
+/// caller tells apart. Exact for every byte: `(b | 0x80) − 0x2D` never
+/// borrows from the next byte, and keeps its high bit iff `b ≥ 0x2D`.
 #[inline(always)]
-fn equal_bytes(word: u64, byte: u8) -> u64 {
-    const LOW_BITS: u64 = !HIGH_BITS;
-    let x = word ^ (ONES * u64::from(byte));
-    // High bit set for a byte of `x` that is not zero: its low seven bits
-    // carry into it, or it is set already.
-    !(((x & LOW_BITS) + LOW_BITS) | x) & HIGH_BITS
+fn below_minus(word: u64) -> u64 {
+    !(((word | HIGH_BITS) - ONES * u64::from(b'-')) | word) & HIGH_BITS
 }
 
 /// A plain `GOTO` line found by [`plain_goto`].

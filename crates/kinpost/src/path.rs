@@ -87,8 +87,11 @@ pub(crate) struct PathPlan {
     turn: f64,
     across: bool,
     free: bool,
-    /// Tool axis and reference of the last point.
-    previous_axes: Option<(Vector3<f64>, Option<Vector3<f64>>)>,
+    /// Tool axis and reference of the last point. (Two fields, not an
+    /// option of a pair: that was written in pieces and read back whole,
+    /// which stalls the processor.)
+    previous_axis: Option<Vector3<f64>>,
+    previous_reference: Option<Vector3<f64>>,
     /// Distance from the tool axis of the last point to the singular
     /// direction (`None`: no singularity, or no point yet).
     previous_pole: Option<Pole>,
@@ -133,7 +136,8 @@ impl PathPlan {
             turn: 0.0,
             across: false,
             free: true,
-            previous_axes: None,
+            previous_axis: None,
+            previous_reference: None,
             previous_pole: None,
             folds: kin.folds(),
             planned_fold: None,
@@ -186,7 +190,8 @@ impl PathPlan {
             self.free = true;
         }
         let pole = self.singularity.map(|s| Pole(s.sin_cos(&pose.axis)));
-        if let Some((axis, reference)) = &self.previous_axes {
+        if let Some(axis) = &self.previous_axis {
+            let reference = &self.previous_reference;
             let axis_turn = angle_between_deg(axis, &pose.axis);
             let mut turn = axis_turn;
             if let (Some(a), Some(b)) = (reference, &pose.reference) {
@@ -211,7 +216,8 @@ impl PathPlan {
                 self.fold_reached |= f.reached(axis, &pose.axis, FOLD_SLACK_RAD);
             }
         }
-        self.previous_axes = Some((pose.axis, pose.reference));
+        self.previous_axis = Some(pose.axis);
+        self.previous_reference = pose.reference;
         self.previous_pole = pole;
         // The hint picks the turn of axes without limits: near the cheapest
         // configuration of the previous point.

@@ -9,7 +9,7 @@
 use std::io::{BufRead, Write};
 use std::time::Instant;
 
-use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, SpindleDir, Units};
+use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Units};
 use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::{Kinematics, Machine, OutputMode, Pose};
 use kinpost_nc::{
@@ -256,7 +256,16 @@ pub fn post<R: BufRead, W: Write>(
     let mut tool_loaded = false;
     let mut remarked = Remarked::default();
 
-    while let Some(statement) = reader.next_statement()? {
+    let mut goto = Move::default();
+    loop {
+        let statement = match reader.next_move(&mut goto)? {
+            Next::Move => {
+                job.goto(&goto, &reader, &mut warnings, &mut remarked)?;
+                continue;
+            }
+            Next::Statement(statement) => statement,
+            Next::End => break,
+        };
         let line = statement.line;
         match statement.event {
             ClEvent::Goto {
@@ -265,18 +274,14 @@ pub fn post<R: BufRead, W: Write>(
                 reference,
                 motion,
             } => {
-                let s = job.scale;
-                let pose = Pose {
-                    point: Vector3::new(point[0] * s, point[1] * s, point[2] * s),
-                    axis: Vector3::from(axis),
-                    reference: reference.map(Vector3::from),
+                let goto = Move {
+                    line,
+                    point,
+                    axis,
+                    reference,
+                    motion,
                 };
-                if let Some(r) = &pose.reference
-                    && let Some(message) = reference_remark(machine, &pose.axis, r, &mut remarked)
-                {
-                    warnings.push(reader.statement_diagnostic(Severity::Warning, message));
-                }
-                job.motion(&pose, motion, line, &reader)?;
+                job.goto(&goto, &reader, &mut warnings, &mut remarked)?;
             }
             ClEvent::Feedrate { value, unit } => {
                 let mm = match unit {
@@ -604,6 +609,30 @@ impl<W: Write> Job<'_, W> {
         if let Some(s) = &mut self.setup {
             s.path.break_segment();
         }
+    }
+
+    /// A `GOTO`: its pose in the part frame (mm), then [`Job::motion`].
+    #[inline(always)]
+    fn goto<R: BufRead>(
+        &mut self,
+        goto: &Move,
+        reader: &ClReader<R>,
+        warnings: &mut Vec<Diagnostic>,
+        remarked: &mut Remarked,
+    ) -> Result<(), PostError> {
+        let s = self.scale;
+        let [x, y, z] = goto.point;
+        let pose = Pose {
+            point: Vector3::new(x * s, y * s, z * s),
+            axis: Vector3::from(goto.axis),
+            reference: goto.reference.map(Vector3::from),
+        };
+        if let Some(r) = &pose.reference
+            && let Some(message) = reference_remark(self.machine, &pose.axis, r, remarked)
+        {
+            warnings.push(reader.statement_diagnostic(Severity::Warning, message));
+        }
+        self.motion(&pose, goto.motion, goto.line, reader)
     }
 
     /// One CL point: solve and hand it to the planner, which writes it once
