@@ -15,7 +15,7 @@ use kinpost_nc::{Block, Motion, NcWriter};
 use nalgebra::Vector3;
 
 use crate::check::{CheckStats, Tolerance, angle_between, pose_error};
-use crate::post::{FeedMode, PostError, describe};
+use crate::post::{FeedMode, Pending, PostError, describe, write_pending};
 use crate::solve::{Hold, Near, interpolate, solve_near};
 use crate::summary::{FeedClamp, Planning, Reconfiguration};
 
@@ -103,6 +103,10 @@ pub(crate) struct Emitter<W: Write> {
     /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
     /// measures it: one unit of the last decimal of every free axis.
     rounding_travel: (f64, f64),
+    /// One unit of the last written decimal of the free linear axes (the
+    /// finest of them, at most 1 µm), mm: a shorter move of the tool point
+    /// only turns.
+    tip_resolution: f64,
     /// Axes with a maximum velocity (index, units per minute).
     vmax: Vec<(usize, f64)>,
     names: Vec<String>,
@@ -111,6 +115,14 @@ pub(crate) struct Emitter<W: Write> {
     /// The pressure of the blocks being written.
     pressure: f64,
     last: Option<Last>,
+    /// Where the tool is before the next block is not known: at the start
+    /// and after a tool change (the machine went to where it changes
+    /// tools). A feed block from there has no length, hence no time.
+    start_unknown: bool,
+    /// Inverse-time feed (`inverse_time_on`) is in force: switched on for
+    /// the first feed block with a known start, off again for a feed block
+    /// without one (see [`Emitter::block`]).
+    pub inverse_time_on: bool,
     written: Joints,
     /// The sines and cosines of the written rotary values, for the next
     /// block's check.
@@ -132,9 +144,15 @@ impl<W: Write> Emitter<W> {
                 .sum::<f64>()
         };
         let rounding_travel = (free(true).to_radians(), free(false));
+        let tip_resolution = (0..axes.len())
+            .filter(|&i| axes[i].is_free() && !axes[i].is_rotary())
+            .map(|i| settings.resolution[i])
+            .fold(f64::INFINITY, f64::min)
+            .min(1e-3);
         Emitter {
             writer,
             rounding_travel,
+            tip_resolution,
             settings,
             n: axes.len(),
             rotary: machine.free_rotary_axes().collect(),
@@ -149,6 +167,8 @@ impl<W: Write> Emitter<W> {
             has_pressure: machine.pressure.is_some(),
             pressure: f64::NAN,
             last: None,
+            start_unknown: true,
+            inverse_time_on: false,
             written: [0.0; MAX_AXES],
             sin_cos: SinCosMemo::default(),
             solutions: Vec::with_capacity(16),
@@ -157,6 +177,15 @@ impl<W: Write> Emitter<W> {
             blocks: 0,
             planning: Planning::default(),
         }
+    }
+
+    /// Writes a statement of the CL between motion blocks (comment, tool
+    /// change, spindle, coolant, insert).
+    pub fn write_pending(&mut self, p: Pending) -> Result<(), PostError> {
+        if matches!(p, Pending::ToolChange(..)) {
+            self.start_unknown = true;
+        }
+        write_pending(&mut self.writer, p)
     }
 
     /// Writes one planned CL point and whatever must come before it.
@@ -506,7 +535,23 @@ impl<W: Write> Emitter<W> {
                             .into(),
                     ));
                 };
-                Some(self.feed_word(f, node, &values, line))
+                // Inverse time says how long a block takes, which a block
+                // from an unknown start does not know: it is written at the
+                // CL feed rate per minute (G94), inverse time resumes after.
+                if self.settings.feed_mode == FeedMode::InverseTime
+                    && self.inverse_time_on == self.start_unknown
+                {
+                    self.inverse_time_on = !self.start_unknown;
+                    self.writer.inverse_time(self.inverse_time_on)?;
+                }
+                let word = self.feed_word(f, node, &values, line);
+                if word < 1.0 && self.writer.feed_rounds_to_zero(word) {
+                    return Err(at(format!(
+                        "the feed word {word} rounds to 0 with the dialect's feed decimals (CL feed rate {f} mm/min): \
+                         the controller would not move; check the FEDRAT"
+                    )));
+                }
+                Some(word)
             }
         };
         if motion == Motion::Feed
@@ -532,12 +577,19 @@ impl<W: Write> Emitter<W> {
         let mut row = [f64::NAN; MAX_AXES + 1];
         row[..MAX_AXES].copy_from_slice(&values);
         row[n] = self.pressure;
-        self.writer.block(&Block {
-            cl_line,
-            motion,
-            axes: &row[..n + usize::from(self.has_pressure)],
-            feed,
-        })?;
+        self.writer
+            .block(&Block {
+                cl_line,
+                motion,
+                axes: &row[..n + usize::from(self.has_pressure)],
+                feed,
+            })
+            .map_err(|e| match e.kind() {
+                // A value the dialect cannot write: the CL point's fault.
+                std::io::ErrorKind::InvalidInput => at(e.to_string()),
+                _ => PostError::Io(e),
+            })?;
+        self.start_unknown = false;
         self.blocks += 1;
         Ok(())
     }
@@ -549,7 +601,7 @@ impl<W: Write> Emitter<W> {
     /// its maximum velocity; the word says that time in the feed mode's
     /// terms.
     fn feed_word(&mut self, feed: f64, node: &Node, values: &Joints, line: usize) -> f64 {
-        let Some(last) = &self.last else {
+        let Some(last) = self.last.as_ref().filter(|_| !self.start_unknown) else {
             return feed;
         };
         let length = (node.pose.point - last.node.pose.point).norm();
@@ -558,7 +610,17 @@ impl<W: Write> Emitter<W> {
             .iter()
             .map(|&i| (node.joints[i] - last.node.joints[i]).abs())
             .fold(0.0, f64::max);
-        let distance = if length > 1e-9 { length } else { turn };
+        // A tool point that moves less than the last written decimal of
+        // the linear axes does not move as far as the program can say: the
+        // block only turns, and takes its largest rotary change in degrees
+        // over the feed rate taken as degrees per minute. (Its length
+        // instead would make the block an instant: F without bound where F
+        // is the block time.)
+        let distance = if length >= self.tip_resolution {
+            length
+        } else {
+            turn
+        };
         if distance <= 1e-9 || feed <= 0.0 {
             return feed;
         }

@@ -19,7 +19,7 @@ use nalgebra::Vector3;
 
 use crate::check::angle_between;
 use crate::emit::{Emitter, Node, Target};
-use crate::post::{Pending, PostError, select, write_pending};
+use crate::post::{Pending, PostError, select};
 use crate::pressure::Wheel;
 use crate::solve::{Hold, Near, solve_near};
 use crate::summary::SingularStretch;
@@ -339,7 +339,7 @@ impl PathPlan {
         while k < end {
             if !self.points[k].singular {
                 while let Some((_, p)) = pending.next_if(|(at, _)| *at <= k) {
-                    write_pending(&mut emitter.writer, p)?;
+                    emitter.write_pending(p)?;
                 }
                 let choice = self.choices[c];
                 c += 1;
@@ -365,7 +365,7 @@ impl PathPlan {
             self.fill_run(kin, wheel, k..e, next)?;
             for j in k..e {
                 while let Some((_, p)) = pending.next_if(|(at, _)| *at <= j) {
-                    write_pending(&mut emitter.writer, p)?;
+                    emitter.write_pending(p)?;
                 }
                 let decided = self.run[j - k];
                 self.write_point(machine, kin, wheel, emitter, j, decided)?;
@@ -373,7 +373,7 @@ impl PathPlan {
             k = e;
         }
         for (_, p) in pending {
-            write_pending(&mut emitter.writer, p)?;
+            emitter.write_pending(p)?;
         }
         for o in &mut outputs {
             o.0 -= end;

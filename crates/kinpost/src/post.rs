@@ -165,7 +165,6 @@ struct Setup<W: Write> {
     kin: Kinematics,
     path: PathPlan,
     emitter: Emitter<W>,
-    inverse_time: bool,
     /// The pressure axis, whose kinematics `kin` is in force.
     wheel: Option<Wheel>,
 }
@@ -377,7 +376,7 @@ pub fn post<R: BufRead, W: Write>(
     )?;
     let emitter = setup.emitter;
     let mut writer = emitter.writer;
-    if setup.inverse_time {
+    if emitter.inverse_time_on {
         writer.inverse_time(false)?;
     }
     if emitter.settings.tcp.is_some() {
@@ -521,17 +520,16 @@ impl<W: Write> Job<'_, W> {
                 .feed_mode
                 .or(self.dialect.default_feed_mode().and_then(FeedMode::parse))
                 .unwrap_or_default();
-            let inverse_time = feed_mode == FeedMode::InverseTime;
-            if inverse_time {
-                if self.dialect.kind() != DialectKind::Csv
-                    && self.dialect.template(TemplateKind::InverseTimeOn).is_none()
-                {
-                    return Err(PostError::Setup(format!(
-                        "dialect `{}` has no `inverse_time_on` template: it cannot write inverse-time feeds",
-                        self.dialect.name()
-                    )));
-                }
-                writer.inverse_time(true)?;
+            // (Inverse time is switched on by the emitter, at the first feed
+            // block whose start is known.)
+            if feed_mode == FeedMode::InverseTime
+                && self.dialect.kind() != DialectKind::Csv
+                && self.dialect.template(TemplateKind::InverseTimeOn).is_none()
+            {
+                return Err(PostError::Setup(format!(
+                    "dialect `{}` has no `inverse_time_on` template: it cannot write inverse-time feeds",
+                    self.dialect.name()
+                )));
             }
             // A modulo axis reaches every angle: its limits only bound the
             // counter, so the kinematics sees it without them and takes the
@@ -583,7 +581,6 @@ impl<W: Write> Job<'_, W> {
                 wheel: Wheel::new(&planned, !self.options.no_pressure_compensation),
                 machine,
                 six_axis,
-                inverse_time,
             });
         }
         Ok(())
@@ -593,7 +590,7 @@ impl<W: Write> Job<'_, W> {
     /// is set up).
     fn emit(&mut self, p: Pending) -> Result<(), PostError> {
         match &mut self.setup {
-            Some(s) if s.path.is_idle() => write_pending(&mut s.emitter.writer, p),
+            Some(s) if s.path.is_idle() => s.emitter.write_pending(p),
             Some(s) => {
                 s.path.push_output(p);
                 Ok(())

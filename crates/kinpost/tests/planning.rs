@@ -603,6 +603,90 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
     }
 }
 
+/// Posts `cl` on the built-in trunnion to `dialect` without linearization.
+fn post_trunnion(cl: &str, dialect: &str, mode: kinpost::FeedMode) -> Result<String, PostError> {
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let dialect = Dialect::builtin(dialect).unwrap();
+    let options = PostOptions {
+        feed_mode: Some(mode),
+        lintol_mm: Some(0.0),
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    post(cl.as_bytes(), &m, &dialect, &mut out, &options)?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+#[test]
+fn a_block_that_turns_while_the_tool_point_barely_moves_takes_the_turning_time() {
+    // A turns 30° while the tool point moves 1e-7 mm (less than the last
+    // written decimal): at F1000 the block takes 30° / 1000 °/min, not
+    // 1e-7 mm / 1000 mm/min (F ≈ 1e10 in inverse time).
+    let cl = "RAPID\nGOTO/0,0,10,0,0,1\nFEDRAT/1000\nGOTO/0,0,10.0000001,0,0.5,0.8660254\n";
+    for (mode, want) in [
+        (kinpost::FeedMode::InverseTime, 1000.0 / 30.0),
+        (kinpost::FeedMode::Tip, 1000.0),
+    ] {
+        let csv = post_trunnion(cl, "csv", mode).unwrap();
+        let last = csv.lines().last().unwrap();
+        let f: f64 = last.rsplit(',').next().unwrap().parse().unwrap();
+        assert!((f - want).abs() < 1e-5, "{mode:?}: {last}");
+    }
+}
+
+#[test]
+fn inverse_time_starts_where_the_start_is_known() {
+    // The first feed move and the first after a tool change start where the
+    // machine happens to be: no block time, so they are written at the CL
+    // feed rate per minute (G94), inverse time (G93) in between.
+    let cl = "FEDRAT/MMPM,100\nGOTO/0,0,50,0,0,1\nGOTO/0,0,10\nLOAD/TOOL,2\nGOTO/10,0,10\nGOTO/20,0,10\n";
+    let nc = post_trunnion(cl, "fanuc", kinpost::FeedMode::InverseTime).unwrap();
+    let body: Vec<&str> = nc
+        .lines()
+        .skip_while(|l| !l.starts_with("T1"))
+        .take_while(|l| !l.starts_with("M05"))
+        .collect();
+    assert_eq!(
+        body,
+        [
+            "T1 M06",
+            "G01 X0.000 Y0.000 Z50.000 A0.000 C0.000 F100.",
+            "G93",
+            "Z10.000 F2.5",
+            "T2 M06",
+            "G94",
+            "X10.000 Y0.000 Z10.000 A0.000 C0.000 F100.",
+            "G93",
+            "X20.000 F10.",
+            "G94",
+        ],
+        "{nc}"
+    );
+}
+
+#[test]
+fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
+    // Fanuc's feed word has too few decimals for 0.0001 mm/min: F0.
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,0.0001\nGOTO/0,0,10\n";
+    let e = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap_err();
+    let PostError::Input(d) = e else {
+        panic!("{e}")
+    };
+    assert_eq!(d.line, 4);
+    assert!(d.message.contains("rounds to 0"), "{}", d.message);
+    // Too large to be written: the CL line, once.
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/1e13\nGOTO/0,0,10\n";
+    let e = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap_err();
+    let PostError::Input(d) = e else {
+        panic!("{e}")
+    };
+    assert_eq!(d.line, 4);
+    assert_eq!(
+        d.message,
+        "cannot write feed = 10000000000000: value is too large to be written"
+    );
+}
+
 #[test]
 fn deciding_point_by_point_keeps_the_branch_it_is_on() {
     // A limited to negative values puts the path on one branch of the

@@ -878,6 +878,12 @@ impl<W: Write> NcWriter<W> {
         Ok(n)
     }
 
+    /// Whether the feed word of a positive feed `f` reads 0: the
+    /// dialect's feed decimals are too few for it.
+    pub fn feed_rounds_to_zero(&self, f: f64) -> bool {
+        f > 0.0 && self.feed.fmt.units(f).is_ok_and(|n| n == 0)
+    }
+
     fn motion_word(&self, motion: Motion) -> &[u8] {
         match motion {
             Motion::Rapid => &self.motion_rapid,
