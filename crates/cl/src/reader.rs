@@ -1182,6 +1182,15 @@ impl<R: BufRead> ClReader<R> {
                 return Err(self.error((second.0, args.1), "expected `UNITS/MM` or `UNITS/INCHES`"));
             }
         };
+        // The last point (for `GODLTA`) is kept in the units it was
+        // written in: into the new ones, as the deltas that follow are.
+        if let Some(p) = &mut self.last_point {
+            match (self.units, units) {
+                (Units::Inch, Units::Mm) => *p = p.map(|v| v * 25.4),
+                (Units::Mm, Units::Inch) => *p = p.map(|v| v / 25.4),
+                _ => {}
+            }
+        }
         self.units = units;
         Ok(ClEvent::Units(units))
     }

@@ -676,6 +676,25 @@ fn tlaxis_sets_the_axis_of_three_value_gotos() {
 }
 
 #[test]
+fn godlta_after_a_change_of_units_moves_in_the_new_ones() {
+    // 1 inch, then 25.4 mm along X: 50.8 mm, i.e. 2 inches, from the origin.
+    let e = events(
+        "UNITS/INCHES\nGOTO/1,0,1,0,0,1\nUNITS/MM\nGODLTA/25.4,0,0\nUNITS/INCHES\nGODLTA/1,0,0\n",
+    );
+    assert_eq!(
+        e,
+        vec![
+            ClEvent::Units(Units::Inch),
+            goto([1., 0., 1.], [0., 0., 1.], Motion::Feed),
+            ClEvent::Units(Units::Mm),
+            goto([50.8, 0., 25.4], [0., 0., 1.], Motion::Feed),
+            ClEvent::Units(Units::Inch),
+            goto([3., 0., 1.], [0., 0., 1.], Motion::Feed),
+        ]
+    );
+}
+
+#[test]
 fn godlta_moves_from_the_last_point() {
     let e = events("GOTO/1,2,3,0,0,1\nGODLTA/0,0,-5\nRAPID\nGODLTA/10\nGODLTA/1,1,1\n");
     assert_eq!(
