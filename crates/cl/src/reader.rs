@@ -89,6 +89,8 @@ pub struct ClReader<R> {
     warnings: Vec<Diagnostic>,
     axis: Option<Vec3>,
     reference: Option<Vec3>,
+    /// A tool axis far from unit length was reported.
+    axis_length_noted: bool,
     /// The point of the last `GOTO` (CL units), for `GODLTA`.
     last_point: Option<Vec3>,
     /// The first `MSYS` (origin and axes as given) and its line: a later
@@ -116,6 +118,7 @@ impl<R: BufRead> ClReader<R> {
             warnings: Vec::new(),
             axis: None,
             reference: None,
+            axis_length_noted: false,
             last_point: None,
             msys: None,
             rapid: false,
@@ -776,6 +779,10 @@ impl<R: BufRead> ClReader<R> {
         }
         let point = [v[0], v[1], v[2]];
         let axis = if count >= 6 {
+            let n2 = v[3] * v[3] + v[4] * v[4] + v[5] * v[5];
+            if !(AXIS_LENGTH2.0..=AXIS_LENGTH2.1).contains(&n2) && !self.axis_length_noted {
+                self.axis_length(args, n2);
+            }
             match normalize([v[3], v[4], v[5]]) {
                 Some(axis) => axis,
                 None => {
@@ -844,6 +851,27 @@ impl<R: BufRead> ClReader<R> {
                 if count == 1 { "" } else { "s" }
             ),
         )
+    }
+
+    /// The warning for a tool axis given far from unit length (once a
+    /// file; a zero or non-finite one is an error of its own).
+    #[cold]
+    #[inline(never)]
+    fn axis_length(&mut self, args: Span, n2: f64) {
+        if !(n2.is_finite() && n2 > 0.0) {
+            return;
+        }
+        self.axis_length_noted = true;
+        self.split(args);
+        let span = (self.fields[3].0, self.fields[5].1);
+        self.warn(
+            span,
+            format!(
+                "the tool axis (i,j,k) has length {:.6}, not 1: it is scaled to unit length \
+                 (further ones are not reported)",
+                n2.sqrt()
+            ),
+        );
     }
 
     /// The error about the values `first..first + 3` of a `GOTO`.
@@ -1554,6 +1582,11 @@ fn unquote(text: &str) -> &str {
     }
     text
 }
+
+/// Squared lengths of a tool axis taken as unit length without a remark:
+/// CAM systems write seven or more decimals (lengths within 1e-6 of 1); a
+/// length off by more than 0.1 % is a hand-made or garbled vector.
+const AXIS_LENGTH2: (f64, f64) = (0.998, 1.002);
 
 /// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
 fn normalize(v: Vec3) -> Option<Vec3> {

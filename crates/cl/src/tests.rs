@@ -48,7 +48,20 @@ fn goto(point: Vec3, axis: Vec3, motion: Motion) -> ClEvent {
 
 #[test]
 fn goto_rapid_is_one_shot_and_axis_is_modal() {
-    let e = events("RAPID\nGOTO/1,2,3,0,0,2\nGOTO/4,5,6\nRAPID/\nGOTO/7,8,9\nGOTO/1,1,1,0,3,4\n");
+    let (s, w) =
+        read("RAPID\nGOTO/1,2,3,0,0,2\nGOTO/4,5,6\nRAPID/\nGOTO/7,8,9\nGOTO/1,1,1,0,3,4\n");
+    let e: Vec<ClEvent> = s.into_iter().map(|s| s.event).collect();
+    // Axes far from unit length are scaled to it, with one warning.
+    assert_eq!(
+        w.iter()
+            .map(|w| (w.line, w.column, w.width))
+            .collect::<Vec<_>>(),
+        [(2, 12, 5)]
+    );
+    assert_eq!(
+        w[0].message,
+        "the tool axis (i,j,k) has length 2.000000, not 1: it is scaled to unit length (further ones are not reported)"
+    );
     assert_eq!(
         e,
         vec![
