@@ -11,7 +11,9 @@
 //! Problems are reported as [`Diagnostic`]s that name the file, the line and
 //! the column and carry the source line: errors are returned by
 //! [`ClReader::next_statement`], warnings are collected and handed out by
-//! [`ClReader::take_warnings`].
+//! [`ClReader::take_warnings`]. A caller that reads mostly moves can ask
+//! [`ClReader::next_move`] instead: it writes the `GOTO` of a plain line into
+//! a [`Move`] of the caller's and hands every other statement out as usual.
 //!
 //! # Example
 //!
