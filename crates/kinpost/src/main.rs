@@ -66,7 +66,8 @@ enum Command {
         /// Tool axis in the part frame: i,j,k.
         #[arg(long, allow_hyphen_values = true)]
         axis: String,
-        /// Reference direction u,v,w (machines with three free rotary axes).
+        /// Reference direction u,v,w (machines with three free rotary axes;
+        /// it frees the axes marked `free_with_reference`).
         #[arg(long, allow_hyphen_values = true)]
         reference: Option<String>,
         /// Pressure of the machine's pressure axis (default: its reference).
@@ -601,7 +602,7 @@ fn machine_at_pressure(m: &Machine, pressure: Option<f64>) -> Result<Machine> {
 }
 
 fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
-    let m = load_machine(machine)?;
+    let mut m = load_machine(machine)?;
     let mut q = m.home_joints();
     let mut pressure = pressure;
     for v in values {
@@ -623,16 +624,10 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
         let i = m
             .axis_index(name.trim())
             .ok_or_else(|| anyhow!("machine `{}` has no axis `{name}`", m.name))?;
-        if m.axes[i].fixed.is_some_and(|f| f != value) {
-            eprintln!(
-                "warning: axis {} is fixed at {} in this machine file; using {value}",
-                m.axes[i].name,
-                m.axes[i].fixed.unwrap_or(0.0)
-            );
-        }
         if !m.axes[i].accepts(value) {
             eprintln!("warning: {name}={value} is outside the axis limits");
         }
+        set_axis(&mut m, i, value);
         q[i] = value;
     }
     let pose = Kinematics::new(&machine_at_pressure(&m, pressure)?).fk(&q);
@@ -644,6 +639,26 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
         println!("reference {:.9} {:.9} {:.9}", r.x, r.y, r.z);
     }
     Ok(())
+}
+
+/// Puts axis `i` of the machine `fk` turns at `value`. The kinematics
+/// build a locked axis into the chain at its `fixed` value, so a value given
+/// for one must change the machine, not only the joint vector: an axis free
+/// with a reference direction is unlocked (as for 6-axis CL points); any
+/// other locked axis is locked at the value given, with a warning.
+fn set_axis(m: &mut Machine, i: usize, value: f64) {
+    let axis = &mut m.axes[i];
+    match axis.fixed {
+        Some(_) if axis.free_with_reference => axis.fixed = None,
+        Some(f) if f != value => {
+            eprintln!(
+                "warning: axis {} is fixed at {f} in this machine file; using {value}",
+                axis.name
+            );
+            axis.fixed = Some(value);
+        }
+        _ => {}
+    }
 }
 
 fn ik(
@@ -658,6 +673,13 @@ fn ik(
         point: Vector3::from(parse_vector(point, "point")?),
         axis: unit_vector(axis, "axis")?,
         reference: reference.map(|r| unit_vector(r, "reference")).transpose()?,
+    };
+    // A reference direction frees the axes locked only without one, as it
+    // does for 6-axis CL points in `post`.
+    let m = if pose.reference.is_some() {
+        m.with_reference_axes_free()
+    } else {
+        m
     };
     let kin = Kinematics::new(&machine_at_pressure(&m, pressure)?);
     let mut sols = Vec::new();

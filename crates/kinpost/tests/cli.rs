@@ -698,3 +698,83 @@ fn kinematics_at_a_pressure() {
         stderr(&o)
     );
 }
+
+/// Standard output of a command that must succeed.
+#[track_caller]
+fn success(args: &[&str]) -> String {
+    let o = run(args);
+    assert_exit(&o, 0);
+    stdout(&o)
+}
+
+#[test]
+fn fk_and_ik_turn_an_axis_free_with_reference() {
+    // The mts1600's C axis is locked at 0 but free with a reference
+    // direction: fk and ik must agree with a copy where C is simply free.
+    let dir = tempfile::tempdir().unwrap();
+    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let unlocked = src
+        .replace("fixed = 0\n", "")
+        .replace("free_with_reference = true\n", "");
+    assert_ne!(unlocked, src);
+    let free = dir.path().join("free.toml");
+    std::fs::write(&free, &unlocked).unwrap();
+    let fk = |m: &str| {
+        let o = run(&[
+            "fk",
+            "-m",
+            m,
+            "X=459",
+            "Y=8.807",
+            "Z=361.368",
+            "A=0",
+            "B=20",
+            "C=90",
+        ]);
+        assert_exit(&o, 0);
+        assert!(!stderr(&o).contains("fixed"), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let posed = fk("mts1600");
+    assert_eq!(posed, fk(free.to_str().unwrap()));
+    let r = triple(&posed, "reference");
+    assert!((r[0] + 0.939692621).abs() < 1e-9, "{posed}");
+
+    let ik = |m: &str| {
+        success(&[
+            "ik",
+            "-m",
+            m,
+            "--point",
+            "-444.188385,69.19,16.41578",
+            "--axis",
+            "0.342020143,0,0.939692621",
+            "--reference",
+            "-0.939692621,0,0.342020143",
+        ])
+    };
+    let solved = ik("mts1600");
+    assert_eq!(solved, ik(free.to_str().unwrap()));
+    assert!(
+        solved.lines().any(|l| l.contains("90.000000  ok")),
+        "{solved}"
+    );
+
+    // An axis locked for good is locked at the value fk is given.
+    let locked = dir.path().join("locked.toml");
+    std::fs::write(&locked, src.replace("free_with_reference = true\n", "")).unwrap();
+    let o = run(&[
+        "fk",
+        "-m",
+        locked.to_str().unwrap(),
+        "X=459",
+        "Y=8.807",
+        "Z=361.368",
+        "A=0",
+        "B=20",
+        "C=90",
+    ]);
+    assert_exit(&o, 0);
+    assert!(stderr(&o).contains("using 90"), "{}", stderr(&o));
+    assert_eq!(triple(&stdout(&o), "point"), triple(&posed, "point"));
+}
