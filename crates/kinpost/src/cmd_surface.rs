@@ -13,10 +13,10 @@ use kinpost_surface::svg::{Curvature, plot_surface};
 use kinpost_surface::{Ends, FitOptions, Method, Parameterisation, Surface};
 use kinpost_toolpath::cl::{ClOptions, write_cl};
 use kinpost_toolpath::plot::plot_path;
-use kinpost_toolpath::{Direction, PathOptions, Side, Spacing, Wheel, plan};
+use kinpost_toolpath::{Direction, PathError, PathOptions, Side, Spacing, Wheel, plan};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
-use crate::report;
+use crate::{report, usage};
 
 #[derive(clap::Subcommand)]
 pub enum SurfaceCommand {
@@ -202,21 +202,24 @@ fn numbers(text: &str, count: usize, what: &str) -> Result<Vec<f64>> {
         .split(',')
         .map(|p| p.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
         .collect();
-    match values {
-        Some(v) if v.len() == count => Ok(v),
-        _ => bail!("{what} `{text}`: expected {count} numbers separated by commas"),
-    }
+    values.filter(|v| v.len() == count).ok_or_else(|| {
+        usage(format!(
+            "{what} `{text}`: expected {count} numbers separated by commas"
+        ))
+    })
 }
 
 fn counts(text: &str, what: &str) -> Result<(usize, usize)> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     match parts.as_slice() {
-        [a, b] => match (a.parse::<usize>(), b.parse::<usize>()) {
-            (Ok(a), Ok(b)) => Ok((a, b)),
-            _ => bail!("{what} `{text}`: expected two whole numbers, e.g. 20,30"),
-        },
-        _ => bail!("{what} `{text}`: expected two whole numbers, e.g. 20,30"),
+        [a, b] => a.parse().ok().zip(b.parse().ok()),
+        _ => None,
     }
+    .ok_or_else(|| {
+        usage(format!(
+            "{what} `{text}`: expected two whole numbers, e.g. 20,30"
+        ))
+    })
 }
 
 fn read_text(path: &Path, what: &str) -> Result<String> {
@@ -244,14 +247,18 @@ fn fit(args: FitArgs) -> Result<()> {
         None => read_grid(&text, &name).map_err(report)?,
         Some(1) => read_blade_table(&text, &name, BladeSide::Theta1).map_err(report)?,
         Some(2) => read_blade_table(&text, &name, BladeSide::Theta2).map_err(report)?,
-        Some(n) => bail!("--blade-side {n}: a blade table has sides 1 and 2"),
+        Some(n) => {
+            return Err(usage(format!(
+                "--blade-side {n}: a blade table has sides 1 and 2"
+            )));
+        }
     };
     let grid = match &args.every {
         None => grid,
         Some(t) => {
             let (i, j) = counts(t, "--every")?;
             if i == 0 || j == 0 {
-                bail!("--every {t}: steps start at 1");
+                return Err(usage(format!("--every {t}: steps start at 1")));
             }
             grid.reduced(i, j)
         }
@@ -322,7 +329,9 @@ fn eval(args: EvalArgs) -> Result<()> {
     if let Some(g) = &args.grid {
         let (nu, nv) = counts(g, "--grid")?;
         if nu < 2 || nv < 2 || nu * nv > 10_000_000 {
-            bail!("--grid {g}: between 2 and a few thousand values per direction");
+            return Err(usage(format!(
+                "--grid {g}: between 2 and a few thousand values per direction"
+            )));
         }
         for i in 0..nu {
             for j in 0..nv {
@@ -342,7 +351,7 @@ fn eval(args: EvalArgs) -> Result<()> {
         uv.push((v[0], v[1]));
     }
     if uv.is_empty() {
-        bail!("nothing to evaluate: give --uv U,V or --grid NU,NV");
+        return Err(usage("nothing to evaluate: give --uv U,V or --grid NU,NV"));
     }
     let mut out = String::from("u,v,x,y,z,nx,ny,nz,gaussian,mean\n");
     let mut degenerate = 0;
@@ -399,31 +408,39 @@ fn plot(args: PlotArgs) -> Result<()> {
 
 /// `wheel:radius=R,width=W`.
 fn parse_wheel(text: &str) -> Result<Wheel> {
-    let usage = || anyhow!("--tool `{text}`: expected wheel:radius=R,width=W (mm)");
-    let rest = text.strip_prefix("wheel:").ok_or_else(usage)?;
+    let malformed = || {
+        usage(format!(
+            "--tool `{text}`: expected wheel:radius=R,width=W (mm)"
+        ))
+    };
+    let rest = text.strip_prefix("wheel:").ok_or_else(malformed)?;
     let (mut radius, mut width) = (None, None);
     for part in rest.split(',') {
-        let (k, v) = part.split_once('=').ok_or_else(usage)?;
+        let (k, v) = part.split_once('=').ok_or_else(malformed)?;
         let v: f64 = v
             .trim()
             .parse()
             .ok()
             .filter(|v: &f64| v.is_finite() && *v > 0.0)
             .ok_or_else(|| {
-                anyhow!(
+                usage(format!(
                     "--tool `{text}`: `{}` must be a positive number of mm",
                     part.trim()
-                )
+                ))
             })?;
         match k.trim() {
             "radius" | "r" => radius = Some(v),
             "width" | "w" => width = Some(v),
-            other => bail!("--tool `{text}`: unknown wheel setting `{other}` (radius, width)"),
+            other => {
+                return Err(usage(format!(
+                    "--tool `{text}`: unknown wheel setting `{other}` (radius, width)"
+                )));
+            }
         }
     }
     Ok(Wheel {
-        radius: radius.ok_or_else(usage)?,
-        width: width.ok_or_else(usage)?,
+        radius: radius.ok_or_else(malformed)?,
+        width: width.ok_or_else(malformed)?,
     })
 }
 
@@ -433,19 +450,23 @@ fn placement(rotate: &[String], translate: Option<&str>) -> Result<Isometry3<f64
     for r in rotate {
         let (axis, deg) = r
             .split_once(':')
-            .ok_or_else(|| anyhow!("--rotate `{r}`: expected AXIS:DEG, e.g. x:90"))?;
+            .ok_or_else(|| usage(format!("--rotate `{r}`: expected AXIS:DEG, e.g. x:90")))?;
         let axis = match axis.trim().to_ascii_lowercase().as_str() {
             "x" => Vector3::x_axis(),
             "y" => Vector3::y_axis(),
             "z" => Vector3::z_axis(),
-            _ => bail!("--rotate `{r}`: the axis is x, y or z"),
+            _ => return Err(usage(format!("--rotate `{r}`: the axis is x, y or z"))),
         };
         let deg: f64 = deg
             .trim()
             .parse()
             .ok()
             .filter(|d: &f64| d.is_finite())
-            .ok_or_else(|| anyhow!("--rotate `{r}`: `{deg}` is not a number of degrees"))?;
+            .ok_or_else(|| {
+                usage(format!(
+                    "--rotate `{r}`: `{deg}` is not a number of degrees"
+                ))
+            })?;
         rotation = UnitQuaternion::from_axis_angle(&axis, deg.to_radians()) * rotation;
     }
     let t = match translate {
@@ -466,7 +487,7 @@ pub fn path(args: PathArgs) -> Result<()> {
     let side = match args.side.trim() {
         "+" | "plus" => Side::Plus,
         "-" | "minus" => Side::Minus,
-        s => bail!("--side `{s}`: + or -"),
+        s => return Err(usage(format!("--side `{s}`: + or -"))),
     };
     let region = match &args.region {
         None => [0.0, 1.0, 0.0, 1.0],
@@ -485,17 +506,21 @@ pub fn path(args: PathArgs) -> Result<()> {
                 .ok()
                 .filter(|v: &f64| v.is_finite() && *v >= 0.0)
                 .ok_or_else(|| {
-                    anyhow!("--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0")
+                    usage(format!(
+                        "--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0"
+                    ))
                 })?;
             let word = word.trim();
             if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric()) {
-                bail!("--pressure `{p}`: the word is letters and digits, e.g. H1");
+                return Err(usage(format!(
+                    "--pressure `{p}`: the word is letters and digits, e.g. H1"
+                )));
             }
             Some((word.to_string(), value))
         }
     };
     if !(args.feed.is_finite() && args.feed > 0.0) {
-        bail!("--feed must be a positive number of mm/min");
+        return Err(usage("--feed must be a positive number of mm/min"));
     }
     let options = PathOptions {
         wheel,
@@ -512,8 +537,14 @@ pub fn path(args: PathArgs) -> Result<()> {
         region,
         placement: placement(&args.rotate, args.translate.as_deref())?,
     };
-    let toolpath =
-        plan(&surface, &options).map_err(|e| anyhow!("{}: {e}", args.surface.display()))?;
+    let toolpath = plan(&surface, &options).map_err(|e| {
+        let message = format!("{}: {e}", args.surface.display());
+        // Options the path cannot be planned with are usage errors.
+        match e {
+            PathError::Options(_) => usage(message),
+            _ => anyhow!(message),
+        }
+    })?;
     let r = &toolpath.report;
     let stem = args.surface.file_stem().map_or_else(
         || "GRIND".to_string(),

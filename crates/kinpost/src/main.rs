@@ -228,6 +228,24 @@ impl std::fmt::Display for Reported {
 
 impl std::error::Error for Reported {}
 
+/// A command-line value that cannot be used: exit 2, like clap's own usage
+/// errors (exit 1 is for bad input files).
+#[derive(Debug)]
+struct Usage(String);
+
+impl std::fmt::Display for Usage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Usage {}
+
+/// A [`Usage`] error.
+fn usage(message: impl Into<String>) -> anyhow::Error {
+    anyhow::Error::new(Usage(message.into()))
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
@@ -236,7 +254,11 @@ fn main() -> ExitCode {
             if e.downcast_ref::<Reported>().is_none() {
                 eprintln!("error: {e:#}");
             }
-            ExitCode::from(1)
+            if e.downcast_ref::<Usage>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
         }
     }
 }
@@ -393,16 +415,23 @@ fn parse_vector(text: &str, what: &str) -> Result<[f64; 3]> {
         .iter()
         .map(|p| p.parse::<f64>().ok().filter(|v| v.is_finite()))
         .collect::<Option<_>>()
-        .ok_or_else(|| anyhow!("{what} `{text}`: expected three numbers separated by commas"))?;
-    <[f64; 3]>::try_from(values)
-        .map_err(|_| anyhow!("{what} `{text}`: expected three numbers separated by commas"))
+        .ok_or_else(|| {
+            usage(format!(
+                "{what} `{text}`: expected three numbers separated by commas"
+            ))
+        })?;
+    <[f64; 3]>::try_from(values).map_err(|_| {
+        usage(format!(
+            "{what} `{text}`: expected three numbers separated by commas"
+        ))
+    })
 }
 
 fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
     let v = Vector3::from(parse_vector(text, what)?);
     let n = v.norm();
     if n < 1e-12 {
-        return Err(anyhow!("{what} `{text}` is a zero vector"));
+        return Err(usage(format!("{what} `{text}` is a zero vector")));
     }
     Ok(v / n)
 }
@@ -454,26 +483,24 @@ fn post(args: PostArgs) -> Result<()> {
         no_pressure_compensation: args.no_pressure_compensation,
     };
     if !(args.lintol.is_finite() && args.lintol >= 0.0) {
-        return Err(anyhow!("--lintol must be a distance of 0 or more (mm)"));
+        return Err(usage("--lintol must be a distance of 0 or more (mm)"));
     }
     if let Some(c) = args.singular_cone
         && !(c.is_finite() && (0.0..45.0).contains(&c))
     {
-        return Err(anyhow!(
-            "--singular-cone must be an angle from 0 to less than 45 degrees"
+        return Err(usage(
+            "--singular-cone must be an angle from 0 to less than 45 degrees",
         ));
     }
     if let Some(r) = args.retract
         && !(r.is_finite() && r > 0.0)
     {
-        return Err(anyhow!(
-            "--retract must be a distance greater than zero (mm)"
-        ));
+        return Err(usage("--retract must be a distance greater than zero (mm)"));
     }
     if let Some(t) = args.tolerance
         && !(t.is_finite() && t > 0.0)
     {
-        return Err(anyhow!("--tolerance must be a positive number of mm"));
+        return Err(usage("--tolerance must be a positive number of mm"));
     }
     let progress = progress_bar(&args);
     let input: Box<dyn BufRead> = if args.input == "-" {
@@ -579,7 +606,7 @@ fn check_pressure_value(v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(anyhow!("--pressure must be a number not below 0"))
+        Err(usage("--pressure must be a number not below 0"))
     }
 }
 
@@ -608,13 +635,13 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
     for v in values {
         let (name, value) = v
             .split_once('=')
-            .ok_or_else(|| anyhow!("`{v}`: expected AXIS=VALUE, e.g. X=459"))?;
+            .ok_or_else(|| usage(format!("`{v}`: expected AXIS=VALUE, e.g. X=459")))?;
         let value: f64 = value
             .trim()
             .parse()
             .ok()
             .filter(|x: &f64| x.is_finite())
-            .ok_or_else(|| anyhow!("`{v}`: `{value}` is not a number"))?;
+            .ok_or_else(|| usage(format!("`{v}`: `{value}` is not a number")))?;
         if let Some(p) = &m.pressure
             && p.name.eq_ignore_ascii_case(name.trim())
         {
@@ -710,7 +737,7 @@ fn wheel(args: &WheelArgs) -> Result<()> {
         .map(|&v| check_pressure_value(v))
         .collect::<Result<Vec<f64>>>()?;
     if let Some(t) = &args.table {
-        pressures.extend(kinpost::wheel::parse_table(t).map_err(|e| anyhow!("{e}"))?);
+        pressures.extend(kinpost::wheel::parse_table(t).map_err(usage)?);
     }
     if pressures.is_empty() {
         pressures = kinpost::wheel::default_pressures(p);
