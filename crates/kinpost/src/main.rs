@@ -10,11 +10,14 @@ use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
 use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
 use kinpost::nc::Dialect;
-use kinpost::output::{AtomicFile, write_atomically};
+use kinpost::output::write_atomically;
 use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
 mod cmd_surface;
+mod sinks;
+
+use sinks::{Sink, deliver, refuse_same_files};
 
 #[derive(Parser)]
 #[command(
@@ -437,6 +440,7 @@ fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
 }
 
 fn post(args: PostArgs) -> Result<()> {
+    refuse_overwriting(&args)?;
     let machine = load_machine(&args.machine)?;
     let dialect_name = args
         .dialect
@@ -520,29 +524,15 @@ fn post(args: PostArgs) -> Result<()> {
         ))
     };
 
-    let result = match &args.output_file {
-        Some(path) => {
-            let mut file = AtomicFile::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?;
-            let summary = kinpost::post(input, &machine, &dialect, &mut file, &options);
-            if summary.is_ok() {
-                file.commit()
-                    .with_context(|| format!("cannot write {}", path.display()))?;
-            }
-            summary
-        }
-        None => {
-            // Held in memory so that a failed run prints no partial program.
-            let mut buffer = Vec::new();
-            let summary = kinpost::post(input, &machine, &dialect, &mut buffer, &options);
-            if summary.is_ok() {
-                let mut out = io::stdout().lock();
-                out.write_all(&buffer)?;
-                out.flush()?;
-            }
-            summary
-        }
-    };
+    // Both outputs exist (as temporary files) before the run, so that one
+    // that cannot be created leaves the other unwritten too.
+    let mut program = Sink::open(args.output_file.as_deref())?;
+    let json = args
+        .json
+        .as_deref()
+        .map(|p| Sink::open(Some(p)))
+        .transpose()?;
+    let result = kinpost::post(input, &machine, &dialect, &mut program, &options);
     if let Some(bar) = &progress {
         bar.finish_and_clear();
     }
@@ -551,17 +541,45 @@ fn post(args: PostArgs) -> Result<()> {
         Err(PostError::Input(d)) => return Err(report(d)),
         Err(e) => return Err(e.into()),
     };
+    let mut sinks = vec![program];
+    if let Some(mut json) = json {
+        json.write_all(summary.to_json().as_bytes())
+            .context("cannot write the JSON summary")?;
+        sinks.push(json);
+    }
+    deliver(sinks)?;
     for w in &summary.warnings {
         eprintln!("{w}\n");
-    }
-    if let Some(json) = &args.json {
-        write_atomically(json, summary.to_json().as_bytes())
-            .with_context(|| format!("cannot write {}", json.display()))?;
     }
     if !args.quiet {
         eprintln!("{}", summary.one_line());
     }
     Ok(())
+}
+
+/// Refuses outputs that would replace an input file (the CL, machine or
+/// dialect file) or each other.
+fn refuse_overwriting(args: &PostArgs) -> Result<()> {
+    let mut inputs = Vec::new();
+    if args.input != "-" {
+        inputs.push(("CL file", Path::new(&args.input)));
+    }
+    for (what, name) in [
+        ("machine file", Some(&args.machine)),
+        ("dialect file", args.dialect.as_ref()),
+    ] {
+        if let Some(name) = name.filter(|n| Path::new(n).is_file()) {
+            inputs.push((what, Path::new(name)));
+        }
+    }
+    let mut outputs = Vec::new();
+    if let Some(path) = &args.output_file {
+        outputs.push(("-o", path.as_path()));
+    }
+    if let Some(path) = &args.json {
+        outputs.push(("--json", path.as_path()));
+    }
+    refuse_same_files(&inputs, &outputs)
 }
 
 /// A progress bar over the bytes of the CL file, on a terminal only (never

@@ -32,6 +32,13 @@ impl AtomicFile {
 
     /// Flushes and renames the file into place.
     pub fn commit(self) -> io::Result<()> {
+        self.finish()?.persist()
+    }
+
+    /// Flushes the file to disk, ready to be renamed into place: what can
+    /// fail for want of space happens here, so that several outputs can be
+    /// finished first and renamed together.
+    pub fn finish(self) -> io::Result<Finished> {
         let temp = self.temp.into_inner().map_err(|e| e.into_error())?;
         // The temporary file is private (0600); the result gets the mode of
         // the file it replaces, or an ordinary file's 0644.
@@ -45,7 +52,23 @@ impl AtomicFile {
                 .set_permissions(std::fs::Permissions::from_mode(mode))?;
         }
         temp.as_file().sync_all()?;
-        temp.persist(&self.target).map_err(|e| e.error)?;
+        Ok(Finished {
+            temp,
+            target: self.target,
+        })
+    }
+}
+
+/// An output file written to disk, not yet in place (dropped: removed).
+pub struct Finished {
+    temp: NamedTempFile,
+    target: PathBuf,
+}
+
+impl Finished {
+    /// Renames the file into place.
+    pub fn persist(self) -> io::Result<()> {
+        self.temp.persist(&self.target).map_err(|e| e.error)?;
         Ok(())
     }
 }
@@ -91,6 +114,23 @@ mod tests {
         f.write_all(b"new").unwrap();
         f.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+    }
+
+    #[test]
+    fn finished_file_appears_only_when_persisted() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.json");
+        let mut f = AtomicFile::create(&target).unwrap();
+        f.write_all(b"{}").unwrap();
+        let finished = f.finish().unwrap();
+        assert!(!target.exists());
+        finished.persist().unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "{}");
+        let mut f = AtomicFile::create(&target).unwrap();
+        f.write_all(b"[]").unwrap();
+        drop(f.finish().unwrap());
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "{}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[cfg(unix)]

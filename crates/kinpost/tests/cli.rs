@@ -851,3 +851,60 @@ fn fk_and_ik_turn_an_axis_free_with_reference() {
     assert!(stderr(&o).contains("using 90"), "{}", stderr(&o));
     assert_eq!(triple(&stdout(&o), "point"), triple(&posed, "point"));
 }
+
+#[test]
+fn outputs_never_replace_inputs_or_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let cl = dir.path().join("part.cls");
+    std::fs::copy(example("flat-part.cls"), &cl).unwrap();
+    let original = std::fs::read(&cl).unwrap();
+    let machine = dir.path().join("m.toml");
+    std::fs::write(
+        &machine,
+        kinpost::machine::builtin::source("mts1600").unwrap(),
+    )
+    .unwrap();
+    let link = dir.path().join("link.cls");
+    std::fs::hard_link(&cl, &link).unwrap();
+    let d = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (cl, machine) = (d("part.cls"), d("m.toml"));
+    for (outputs, message) in [
+        (vec!["-o", &cl], "is the CL file"),
+        (vec!["--json", &cl], "is the CL file"),
+        (vec!["-o", &d("link.cls")], "is the CL file"),
+        (vec!["-o", &d("./part.cls")], "is the CL file"),
+        (vec!["--json", &machine], "is the machine file"),
+        (
+            vec!["-o", &d("p.mpf"), "--json", &d("./p.mpf")],
+            "are the same file",
+        ),
+    ] {
+        let mut args = vec!["post", &cl, "-m", &machine];
+        args.extend(outputs.iter().copied());
+        let o = run(&args);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+    }
+    assert_eq!(std::fs::read(&cl).unwrap(), original);
+    assert_eq!(listing(dir.path()), ["link.cls", "m.toml", "part.cls"]);
+
+    // An output that cannot be created leaves the other one unwritten.
+    for outputs in [
+        [d("p.mpf"), d("no-dir/p.json")],
+        [d("no-dir/p.mpf"), d("p.json")],
+    ] {
+        let o = run(&[
+            "post",
+            &cl,
+            "-m",
+            &machine,
+            "-o",
+            &outputs[0],
+            "--json",
+            &outputs[1],
+        ]);
+        assert_exit(&o, 1);
+        assert!(stderr(&o).contains("cannot create"), "{}", stderr(&o));
+        assert_eq!(listing(dir.path()), ["link.cls", "m.toml", "part.cls"]);
+    }
+}
