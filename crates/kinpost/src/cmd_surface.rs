@@ -88,7 +88,7 @@ pub struct EvalArgs {
     /// An NU×NV grid of parameters over the whole domain, ends included.
     #[arg(long, value_name = "NU,NV", conflicts_with = "uv")]
     grid: Option<String>,
-    /// Output CSV file; default: standard output.
+    /// Output CSV file, or - for standard output (the default).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: Option<PathBuf>,
 }
@@ -174,7 +174,7 @@ pub struct PathArgs {
     /// TOOL PATH name (default: the surface file's name).
     #[arg(long)]
     name: Option<String>,
-    /// Output CL file; default: standard output.
+    /// Output CL file, or - for standard output (the default).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: Option<PathBuf>,
     /// Also draw the passes on the surface as SVG.
@@ -376,7 +376,7 @@ fn eval(args: EvalArgs) -> Result<()> {
             "warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan"
         );
     }
-    match &args.output_file {
+    match crate::file_path(&args.output_file) {
         Some(path) => write_atomically(path, out.as_bytes())
             .with_context(|| format!("cannot write {}", path.display())),
         None => {
@@ -578,7 +578,7 @@ pub fn path(args: PathArgs) -> Result<()> {
         reference: matches!(args.reference, ReferenceArg::Feed),
         comments,
     };
-    match &args.output_file {
+    match crate::file_path(&args.output_file) {
         Some(path) => {
             let mut f = AtomicFile::create(path)
                 .with_context(|| format!("cannot create {}", path.display()))?;

@@ -115,11 +115,12 @@ struct PostArgs {
     /// Built-in dialect name or dialect file; default: the machine's.
     #[arg(long, short)]
     dialect: Option<String>,
-    /// Output NC file; default: standard output.
+    /// Output NC file, or - for standard output (the default).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: Option<PathBuf>,
-    /// Write the run summary as JSON to this file.
-    #[arg(long)]
+    /// Write the run summary as JSON to this file, or - for standard output
+    /// (with -o FILE).
+    #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
     /// Closed-loop position tolerance in mm (default: derived from the
     /// output decimals and the machine's largest pivot distance).
@@ -440,7 +441,7 @@ fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
 }
 
 fn post(args: PostArgs) -> Result<()> {
-    refuse_overwriting(&args)?;
+    check_outputs(&args)?;
     let machine = load_machine(&args.machine)?;
     let dialect_name = args
         .dialect
@@ -526,11 +527,11 @@ fn post(args: PostArgs) -> Result<()> {
 
     // Both outputs exist (as temporary files) before the run, so that one
     // that cannot be created leaves the other unwritten too.
-    let mut program = Sink::open(args.output_file.as_deref())?;
+    let mut program = Sink::open(file_path(&args.output_file))?;
     let json = args
         .json
-        .as_deref()
-        .map(|p| Sink::open(Some(p)))
+        .as_ref()
+        .map(|_| Sink::open(file_path(&args.json)))
         .transpose()?;
     let result = kinpost::post(input, &machine, &dialect, &mut program, &options);
     if let Some(bar) = &progress {
@@ -557,9 +558,23 @@ fn post(args: PostArgs) -> Result<()> {
     Ok(())
 }
 
-/// Refuses outputs that would replace an input file (the CL, machine or
-/// dialect file) or each other.
-fn refuse_overwriting(args: &PostArgs) -> Result<()> {
+/// An output's file; none for standard output (`-` or not given).
+fn file_path(path: &Option<PathBuf>) -> Option<&Path> {
+    path.as_deref().filter(|p| *p != Path::new("-"))
+}
+
+/// Refuses the program and the summary both on standard output, and
+/// outputs that would replace an input file (the CL, machine or dialect
+/// file) or each other.
+fn check_outputs(args: &PostArgs) -> Result<()> {
+    if args.json.is_some()
+        && file_path(&args.json).is_none()
+        && file_path(&args.output_file).is_none()
+    {
+        return Err(usage(
+            "--json - writes the summary to standard output: give the program a file with -o FILE",
+        ));
+    }
     let mut inputs = Vec::new();
     if args.input != "-" {
         inputs.push(("CL file", Path::new(&args.input)));
@@ -573,11 +588,11 @@ fn refuse_overwriting(args: &PostArgs) -> Result<()> {
         }
     }
     let mut outputs = Vec::new();
-    if let Some(path) = &args.output_file {
-        outputs.push(("-o", path.as_path()));
+    if let Some(path) = file_path(&args.output_file) {
+        outputs.push(("-o", path));
     }
-    if let Some(path) = &args.json {
-        outputs.push(("--json", path.as_path()));
+    if let Some(path) = file_path(&args.json) {
+        outputs.push(("--json", path));
     }
     refuse_same_files(&inputs, &outputs)
 }

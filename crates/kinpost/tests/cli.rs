@@ -908,3 +908,42 @@ fn outputs_never_replace_inputs_or_each_other() {
         assert_eq!(listing(dir.path()), ["link.cls", "m.toml", "part.cls"]);
     }
 }
+
+#[test]
+fn dash_outputs_are_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let cl = example("flat-part.cls");
+    let cl = cl.to_str().unwrap();
+    let in_dir = |args: &[&str]| {
+        kinpost(args)
+            .current_dir(dir.path())
+            .output()
+            .expect("run kinpost")
+    };
+    let o = in_dir(&[
+        "post", cl, "-m", "mts1600", "-q", "-o", "-", "--json", "s.json",
+    ]);
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains(FIGURE_28_BLOCK), "{}", stdout(&o));
+    assert_eq!(listing(dir.path()), ["s.json"]);
+
+    let o = in_dir(&[
+        "post", cl, "-m", "mts1600", "-q", "-o", "p.mpf", "--json", "-",
+    ]);
+    assert_exit(&o, 0);
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(summary["blocks"], 14);
+    assert_eq!(listing(dir.path()), ["p.mpf", "s.json"]);
+
+    // Program and summary cannot share standard output.
+    for args in [
+        &["post", cl, "-m", "mts1600", "--json", "-"][..],
+        &["post", cl, "-m", "mts1600", "-o", "-", "--json", "-"][..],
+    ] {
+        let o = in_dir(args);
+        assert_exit(&o, 2);
+        assert!(stdout(&o).is_empty());
+        assert!(stderr(&o).contains("--json -"), "{}", stderr(&o));
+    }
+    assert_eq!(listing(dir.path()), ["p.mpf", "s.json"]);
+}
