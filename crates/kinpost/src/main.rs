@@ -2,7 +2,7 @@
 //!
 //! Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error.
 
-use std::io::{self, BufRead, BufReader, Write};
+use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -211,7 +211,10 @@ enum MachineCommand {
     /// Print a built-in machine file.
     Show { name: String },
     /// Validate a machine file.
-    Check { file: PathBuf },
+    Check {
+        /// Machine file, built-in machine name, or - for standard input.
+        file: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -252,8 +255,12 @@ fn usage(message: impl Into<String>) -> anyhow::Error {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    // (Text still buffered is flushed here, where its error can be seen.)
+    match run(cli).and_then(|()| Ok(io::stdout().flush()?)) {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that closed the pipe (`| head`) wants no more: stop
+        // quietly, as Unix tools do.
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             if e.downcast_ref::<Reported>().is_none() {
                 eprintln!("error: {e:#}");
@@ -267,78 +274,35 @@ fn main() -> ExitCode {
     }
 }
 
+/// Whether writing to standard output failed because its reader is gone.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<io::Error>()
+            .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
+    })
+}
+
 fn run(cli: Cli) -> Result<()> {
+    // Standard output through `?`: `print!` panics on a closed pipe.
+    let mut out = io::stdout().lock();
     match cli.command {
         Command::Post(args) => post(args),
         Command::Machines => {
             for name in builtin::names() {
                 let m = builtin::load(name).expect("listed").map_err(report)?;
-                println!("{name:<16} {}", m.description);
+                writeln!(out, "{name:<16} {}", m.description)?;
             }
             Ok(())
         }
         Command::Machine(MachineCommand::Show { name }) => {
             let src = builtin::source(&name).ok_or_else(|| unknown_machine(&name))?;
-            print!("{src}");
-            Ok(())
+            Ok(out.write_all(src.as_bytes())?)
         }
-        Command::Machine(MachineCommand::Check { file }) => {
-            let m = load_machine(&file.to_string_lossy())?;
-            let free: Vec<&str> = m
-                .axes
-                .iter()
-                .filter(|a| a.is_free())
-                .map(|a| a.name.as_str())
-                .collect();
-            let pressure = m.pressure.as_ref().map_or(String::new(), |p| {
-                let [lo, hi] = p.range();
-                format!(
-                    "; pressure {} (reference {}, calibration {lo} .. {hi}; `kinpost wheel` shows it)",
-                    p.name, p.reference
-                )
-            });
-            println!(
-                "{}: machine `{}` is valid: {} axes ({} free: {}){pressure}",
-                file.display(),
-                m.name,
-                m.axes.len(),
-                free.len(),
-                free.join(" ")
-            );
-            for a in m.axes.iter().filter(|a| a.is_endless()) {
-                let limits = a.limits.map_or(String::new(), |[lo, hi]| {
-                    format!("; its limits [{lo}, {hi}] are not applied")
-                });
-                println!("  {} turns without end (wrap = \"modulo\"){limits}", a.name);
-            }
-            if let Some(folds) = Kinematics::new(&m).folds() {
-                // Two rotary axes at another angle than the tool makes with
-                // the inner one: say which tool axes exist at all, from the
-                // end of the singular direction the band lies nearer.
-                let [lo, hi] = folds.edges.map(|e| e.to_degrees());
-                let (lo, hi) = (
-                    if lo.is_nan() { 0.0 } else { lo },
-                    if hi.is_nan() { 180.0 } else { hi },
-                );
-                let flip = lo + hi > 180.0;
-                let (lo, hi, d) = if flip {
-                    (180.0 - hi, 180.0 - lo, -folds.direction)
-                } else {
-                    (lo, hi, folds.direction)
-                };
-                // (+ 0.0: no "-0.0000000".)
-                let d = d.map(|v| v + 0.0);
-                println!(
-                    "  the tool axis reaches only the directions {lo:.4}° to {hi:.4}° from ({:.7}, {:.7}, {:.7}); at an edge that is not 0° or 180° the two solutions meet (a fold)",
-                    d.x, d.y, d.z
-                );
-            }
-            Ok(())
-        }
+        Command::Machine(MachineCommand::Check { file }) => machine_check(&file, &mut out),
         Command::Dialects => {
             for name in Dialect::builtin_names() {
                 let d = Dialect::builtin(name).expect("listed");
-                println!("{name:<12} .{:<5} {}", d.extension(), d.description());
+                writeln!(out, "{name:<12} .{:<5} {}", d.extension(), d.description())?;
             }
             Ok(())
         }
@@ -349,26 +313,107 @@ fn run(cli: Cli) -> Result<()> {
                     Dialect::builtin_names().join(", ")
                 )
             })?;
-            print!("{src}");
-            Ok(())
+            Ok(out.write_all(src.as_bytes())?)
         }
         Command::Fk {
             machine,
             values,
             pressure,
-        } => fk(&machine, &values, pressure),
+        } => fk(&machine, &values, pressure, &mut out),
         Command::Ik {
             machine,
             point,
             axis,
             reference,
             pressure,
-        } => ik(&machine, &point, &axis, reference.as_deref(), pressure),
-        Command::Wheel(args) => wheel(&args),
+        } => ik(
+            &machine,
+            &point,
+            &axis,
+            reference.as_deref(),
+            pressure,
+            &mut out,
+        ),
+        Command::Wheel(args) => wheel(&args, &mut out),
         Command::Surface(c) => cmd_surface::surface(c),
         Command::Path(a) => cmd_surface::path(*a),
     }
 }
+
+/// `kinpost machine check FILE` (`-`: standard input).
+fn machine_check(file: &Path, out: &mut impl Write) -> Result<()> {
+    let (name, m) = if file == Path::new("-") {
+        let mut src = String::new();
+        io::stdin()
+            .read_to_string(&mut src)
+            .context("cannot read the machine file from standard input")?;
+        (
+            STDIN_NAME.to_string(),
+            machine_from_toml(&src, STDIN_NAME).map_err(report)?,
+        )
+    } else {
+        let name = file.to_string_lossy();
+        (name.to_string(), load_machine(&name)?)
+    };
+    let free: Vec<&str> = m
+        .axes
+        .iter()
+        .filter(|a| a.is_free())
+        .map(|a| a.name.as_str())
+        .collect();
+    let pressure = m.pressure.as_ref().map_or(String::new(), |p| {
+        let [lo, hi] = p.range();
+        format!(
+            "; pressure {} (reference {}, calibration {lo} .. {hi}; `kinpost wheel` shows it)",
+            p.name, p.reference
+        )
+    });
+    writeln!(
+        out,
+        "{name}: machine `{}` is valid: {} axes ({} free: {}){pressure}",
+        m.name,
+        m.axes.len(),
+        free.len(),
+        free.join(" ")
+    )?;
+    for a in m.axes.iter().filter(|a| a.is_endless()) {
+        let limits = a.limits.map_or(String::new(), |[lo, hi]| {
+            format!("; its limits [{lo}, {hi}] are not applied")
+        });
+        writeln!(
+            out,
+            "  {} turns without end (wrap = \"modulo\"){limits}",
+            a.name
+        )?;
+    }
+    if let Some(folds) = Kinematics::new(&m).folds() {
+        // Two rotary axes at another angle than the tool makes with
+        // the inner one: say which tool axes exist at all, from the
+        // end of the singular direction the band lies nearer.
+        let [lo, hi] = folds.edges.map(|e| e.to_degrees());
+        let (lo, hi) = (
+            if lo.is_nan() { 0.0 } else { lo },
+            if hi.is_nan() { 180.0 } else { hi },
+        );
+        let flip = lo + hi > 180.0;
+        let (lo, hi, d) = if flip {
+            (180.0 - hi, 180.0 - lo, -folds.direction)
+        } else {
+            (lo, hi, folds.direction)
+        };
+        // (+ 0.0: no "-0.0000000".)
+        let d = d.map(|v| v + 0.0);
+        writeln!(
+            out,
+            "  the tool axis reaches only the directions {lo:.4}° to {hi:.4}° from ({:.7}, {:.7}, {:.7}); at an edge that is not 0° or 180° the two solutions meet (a fold)",
+            d.x, d.y, d.z
+        )?;
+    }
+    Ok(())
+}
+
+/// The name diagnostics give standard input, as `post -` does.
+const STDIN_NAME: &str = "<stdin>";
 
 /// Prints diagnostics and turns them into a [`Reported`] error.
 fn report(d: impl std::fmt::Display) -> anyhow::Error {
@@ -451,7 +496,7 @@ fn post(args: PostArgs) -> Result<()> {
     let dialect = load_dialect(&dialect_name)?;
     let options = PostOptions {
         cl_file: if args.input == "-" {
-            "<stdin>".to_string()
+            STDIN_NAME.to_string()
         } else {
             args.input.clone()
         },
@@ -661,7 +706,7 @@ fn machine_at_pressure(m: &Machine, pressure: Option<f64>) -> Result<Machine> {
     Ok(m.at_pressure(h))
 }
 
-fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
+fn fk(machine: &str, values: &[String], pressure: Option<f64>, out: &mut impl Write) -> Result<()> {
     let mut m = load_machine(machine)?;
     let mut q = m.home_joints();
     let mut pressure = pressure;
@@ -693,10 +738,10 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>) -> Result<()> {
     let pose = Kinematics::new(&machine_at_pressure(&m, pressure)?).fk(&q);
     let p = pose.point;
     let a = pose.axis;
-    println!("point     {:.6} {:.6} {:.6}", p.x, p.y, p.z);
-    println!("axis      {:.9} {:.9} {:.9}", a.x, a.y, a.z);
+    writeln!(out, "point     {:.6} {:.6} {:.6}", p.x, p.y, p.z)?;
+    writeln!(out, "axis      {:.9} {:.9} {:.9}", a.x, a.y, a.z)?;
     if let Some(r) = pose.reference {
-        println!("reference {:.9} {:.9} {:.9}", r.x, r.y, r.z);
+        writeln!(out, "reference {:.9} {:.9} {:.9}", r.x, r.y, r.z)?;
     }
     Ok(())
 }
@@ -727,6 +772,7 @@ fn ik(
     axis: &str,
     reference: Option<&str>,
     pressure: Option<f64>,
+    out: &mut impl Write,
 ) -> Result<()> {
     let m = load_machine(machine)?;
     let pose = Pose {
@@ -746,7 +792,7 @@ fn ik(
     kin.ik_all_branches(&pose, None, &mut sols)
         .map_err(|e| anyhow!("no solution: {e}"))?;
     let names: Vec<String> = m.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
-    println!("branch {}  status", names.join(""));
+    writeln!(out, "branch {}  status", names.join(""))?;
     for s in &sols {
         let values: Vec<String> = (0..m.axes.len())
             .map(|i| format!("{:>12.6}", s.joints[i]))
@@ -756,12 +802,12 @@ fn ik(
             None => "ok".to_string(),
             Some(v) => format!("outside travel: {}", m.axes[v.axis].name),
         };
-        println!("{:>6} {}  {status}", s.branch, values.join(""));
+        writeln!(out, "{:>6} {}  {status}", s.branch, values.join(""))?;
     }
     Ok(())
 }
 
-fn wheel(args: &WheelArgs) -> Result<()> {
+fn wheel(args: &WheelArgs, out: &mut impl Write) -> Result<()> {
     let m = load_machine(&args.machine)?;
     let p = kinpost::wheel::pressure_axis(&m).map_err(|e| anyhow!("{e}"))?;
     let mut pressures = args
@@ -776,10 +822,8 @@ fn wheel(args: &WheelArgs) -> Result<()> {
         pressures = kinpost::wheel::default_pressures(p);
     }
     let rows = kinpost::wheel::rows(&m, &pressures).map_err(|e| anyhow!("{e}"))?;
-    print!(
-        "{}",
-        kinpost::wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?
-    );
+    let table = kinpost::wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?;
+    out.write_all(table.as_bytes())?;
     if let Some(path) = &args.svg {
         let svg = kinpost::wheel::svg(&m, &rows).map_err(|e| anyhow!("{e}"))?;
         write_atomically(path, svg.as_bytes())

@@ -947,3 +947,66 @@ fn dash_outputs_are_standard_output() {
     }
     assert_eq!(listing(dir.path()), ["p.mpf", "s.json"]);
 }
+
+#[test]
+fn machine_check_reads_standard_input() {
+    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let o = run_with_stdin(&["machine", "check", "-"], src.as_bytes());
+    assert_exit(&o, 0);
+    assert!(
+        stdout(&o).starts_with("<stdin>: machine `mts1600` is valid"),
+        "{}",
+        stdout(&o)
+    );
+    let bad = src.replace("limits = [-45.2, 45.2]", "limits = [45.2, -45.2]");
+    let o = run_with_stdin(&["machine", "check", "-"], bad.as_bytes());
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("--> <stdin>:"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_closed_standard_output_ends_every_command_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let mpf = dir.path().join("p.mpf");
+    for args in [
+        &["machines"][..],
+        &["machine", "show", "mts1600"][..],
+        &["machine", "check", "mts1600"][..],
+        &["dialects"][..],
+        &["dialect", "show", "sinumerik"][..],
+        &["fk", "-m", "mts1600", "X=459"][..],
+        &[
+            "ik",
+            "-m",
+            "mts1600",
+            "--point",
+            "-416,70.3931,11.3684",
+            "--axis",
+            "0,0,1",
+        ][..],
+        &["wheel", "-m", "mts1600"][..],
+        &["post", "examples/flat-part.cls", "-m", "mts1600"][..],
+        &[
+            "post",
+            "examples/flat-part.cls",
+            "-m",
+            "mts1600",
+            "-o",
+            mpf.to_str().unwrap(),
+            "--json",
+            "-",
+        ][..],
+    ] {
+        // A pipe whose reader is gone before the command writes.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = kinpost(args)
+            .stdout(writer)
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        assert_exit(&o, 0);
+        assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("error"), "{args:?}: {}", stderr(&o));
+    }
+}
