@@ -438,6 +438,7 @@ fn load_machine(name: &str) -> Result<Machine> {
     }
     match builtin::load(name) {
         Some(m) => m.map_err(report),
+        None if path.is_dir() => Err(anyhow!("machine file {name} is a directory")),
         None => Err(unknown_machine(name)),
     }
 }
@@ -450,12 +451,16 @@ fn load_dialect(name: &str) -> Result<Dialect> {
             .with_context(|| format!("cannot read dialect file {name}"))?;
         return Dialect::from_toml(&src, name).map_err(report);
     }
-    Dialect::builtin(name).ok_or_else(|| {
-        anyhow!(
-            "no built-in dialect `{name}` and no such file (built in: {})",
-            Dialect::builtin_names().join(", ")
-        )
-    })
+    if let Some(d) = Dialect::builtin(name) {
+        return Ok(d);
+    }
+    if path.is_dir() {
+        return Err(anyhow!("dialect file {name} is a directory"));
+    }
+    Err(anyhow!(
+        "no built-in dialect `{name}` and no such file (built in: {})",
+        Dialect::builtin_names().join(", ")
+    ))
 }
 
 fn parse_vector(text: &str, what: &str) -> Result<[f64; 3]> {
@@ -558,6 +563,11 @@ fn post(args: PostArgs) -> Result<()> {
     } else {
         let f = std::fs::File::open(&args.input)
             .with_context(|| format!("cannot open CL file {}", args.input))?;
+        // Opening a directory succeeds; its first read would fail as if
+        // line 1 of a file were bad.
+        if f.metadata().is_ok_and(|m| m.is_dir()) {
+            return Err(anyhow!("CL file {} is a directory", args.input));
+        }
         if let (Some(bar), Ok(meta)) = (&progress, f.metadata()) {
             bar.set_length(meta.len());
         }

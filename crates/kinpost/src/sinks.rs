@@ -23,6 +23,11 @@ impl Sink {
     pub fn open(path: Option<&Path>) -> Result<Sink> {
         match path {
             None => Ok(Sink::Stdout(Vec::new())),
+            // (The rename at the end would fail, after all the work.)
+            Some(path) if path.is_dir() => Err(usage(format!(
+                "{} is a directory: the output must be a file",
+                path.display()
+            ))),
             Some(path) => {
                 let file = AtomicFile::create(path)
                     .with_context(|| format!("cannot create {}", path.display()))?;

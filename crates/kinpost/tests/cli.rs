@@ -1010,3 +1010,31 @@ fn a_closed_standard_output_ends_every_command_quietly() {
         assert!(!stderr(&o).contains("error"), "{args:?}: {}", stderr(&o));
     }
 }
+
+#[test]
+fn a_directory_is_named_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let flat = "examples/flat-part.cls";
+    for (args, message) in [
+        (&["post", d, "-m", "mts1600"][..], "CL file"),
+        (&["post", flat, "-m", d][..], "machine file"),
+        (
+            &["post", flat, "-m", "mts1600", "-d", d][..],
+            "dialect file",
+        ),
+        (&["machine", "check", d][..], "machine file"),
+    ] {
+        let o = run(args);
+        assert_exit(&o, 1);
+        assert_eq!(
+            stderr(&o),
+            format!("error: {message} {d} is a directory\n"),
+            "{args:?}"
+        );
+    }
+    let o = run(&["post", flat, "-m", "mts1600", "-o", d]);
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("is a directory"), "{}", stderr(&o));
+    assert!(listing(dir.path()).is_empty());
+}
