@@ -164,19 +164,27 @@ const SIGN: [f64; 256] = {
     sign
 };
 
-/// The length of the chunk [`plain_number`] reads: a sign, eight digits, a
-/// point and the byte after the number.
+/// The length of the chunk [`plain_quotient`] reads: a sign, eight digits,
+/// a point and the byte after the number.
 pub(crate) const PLAIN_CHUNK: usize = 11;
+
+/// A number as the quotient of its signed digits and a power of ten: `m /
+/// d` is its value, correctly rounded (Clinger's fast path, exact operands).
+/// The division is left to the caller so that those of several numbers go
+/// into the same instructions (`divpd`: two at a time).
+#[derive(Clone, Copy)]
+pub(crate) struct Quotient(pub f64, pub f64);
 
 /// [`scan_number`] for the shape CL files are made of: `[-+]?d*[.d*]` with
 /// at most 7 digits before the point and at most 8 digits in all, read a
 /// word at a time from a fixed-size chunk (so that no load needs a bounds
-/// check). Returns the value and the length of the number, which is at most
-/// 10: `chunk[len]` is the byte after it. The caller must check that this
-/// byte is a separator, neither a digit (more digits), nor `.`, `e` or `E`:
-/// then the result is what [`scan_number`] gives. `None` for any other shape.
+/// check). Returns the number as a [`Quotient`] and its length, which is at
+/// most 10: `chunk[len]` is the byte after it. The caller must check that
+/// this byte is a separator, neither a digit (more digits), nor `.`, `e` or
+/// `E`: then the quotient is what [`scan_number`] gives. `None` for any
+/// other shape.
 #[inline(always)]
-pub(crate) fn plain_number(chunk: &[u8; PLAIN_CHUNK]) -> Option<(f64, usize)> {
+pub(crate) fn plain_quotient(chunk: &[u8; PLAIN_CHUNK]) -> Option<(Quotient, usize)> {
     let sign = chunk[0];
     let s = usize::from(sign == b'-' || sign == b'+');
     let word = load_word(chunk, s);
@@ -209,10 +217,11 @@ pub(crate) fn plain_number(chunk: &[u8; PLAIN_CHUNK]) -> Option<(f64, usize)> {
     // Through i64, which converts in one instruction, unlike u64. The index
     // is at most 8 (n >= whole when there is a point); the mask only spares
     // a bounds check.
-    let v = (mantissa as i64) as f64 / POW10[(n - whole) & 15];
-    // `-v` without a branch on the sign, which is unpredictable (exact, and
-    // -0 for 0 as `str::parse` has it).
-    Some((v * SIGN[usize::from(sign)], len))
+    // The sign on the digits (`-m / d` is `-(m / d)` exactly, and -0 for 0
+    // as `str::parse` has it), without a branch on it, which is
+    // unpredictable.
+    let m = (mantissa as i64) as f64 * SIGN[usize::from(sign)];
+    Some((Quotient(m, POW10[(n - whole) & 15]), len))
 }
 
 /// The eight bytes at `chunk[i..]` (`i` is 0, 1 or 2), little-endian.
@@ -223,13 +232,13 @@ fn load_word(chunk: &[u8; PLAIN_CHUNK], i: usize) -> u64 {
     u64::from_le_bytes(word)
 }
 
-/// [`plain_number`] on `b[start..]`: the value and the index just after the
+/// [`plain_quotient`] on `b[start..]`, divided: the value and the index just after the
 /// number. `None` also if `b` has fewer than [`PLAIN_CHUNK`] bytes from
 /// `start` (pad the buffer).
 #[cfg(test)]
 fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
-    let (v, len) = plain_number(b.get(start..)?.first_chunk()?)?;
-    Some((v, start + len))
+    let (Quotient(m, d), len) = plain_quotient(b.get(start..)?.first_chunk()?)?;
+    Some((m / d, start + len))
 }
 
 #[cfg(test)]
