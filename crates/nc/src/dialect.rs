@@ -16,6 +16,8 @@ use crate::{AxisSpec, Motion};
 
 /// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
 const MAX_PREFIX: usize = 24;
+/// Most digits a block number is padded to (the writer's number buffer).
+const MAX_NUMBER_DIGITS: usize = 24;
 
 /// A built-in dialect: its name and the text of `dialects/NAME.toml`.
 macro_rules! dialect {
@@ -424,23 +426,18 @@ impl Dialect {
             .resolve("F");
         whole(&raw_feed_word, std::slice::from_ref(&feed_word));
 
+        check_numbering(&raw.numbering, &mut err);
         let numbering = Numbering {
             enabled: raw.numbering.enabled,
             prefix: raw.numbering.prefix,
-            start: raw.numbering.start,
+            start: *raw.numbering.start.get_ref(),
             step: *raw.numbering.step.get_ref(),
-            digits: raw.numbering.digits,
-            wrap_after: raw.numbering.wrap_after,
+            digits: *raw.numbering.digits.get_ref(),
+            wrap_after: raw.numbering.wrap_after.map(Spanned::into_inner),
             header: raw.numbering.header,
             commands: raw.numbering.commands,
             comments: raw.numbering.comments,
         };
-        if numbering.step == 0 {
-            err(
-                raw.numbering.step.span(),
-                "`step` must be at least 1".into(),
-            );
-        }
         let mut replace = Vec::new();
         for (from, to) in raw.comment.replace {
             if from.is_empty() {
@@ -777,6 +774,35 @@ impl From<&RawWord> for PartialWord {
     }
 }
 
+/// Numbering values that cannot number blocks: a step of 0, more padding
+/// than a number has digits, a wrap that comes back to `start` before the
+/// second number (every block would get the same number).
+fn check_numbering(n: &RawNumbering, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    let (start, step) = (*n.start.get_ref(), *n.step.get_ref());
+    if step == 0 {
+        err(n.step.span(), "`step` must be at least 1".into());
+    }
+    if *n.digits.get_ref() > MAX_NUMBER_DIGITS {
+        err(
+            n.digits.span(),
+            format!("`digits` must be between 0 and {MAX_NUMBER_DIGITS}"),
+        );
+    }
+    if let Some(wrap) = &n.wrap_after {
+        let second = start.checked_add(step.max(1));
+        if second.is_none_or(|second| *wrap.get_ref() < second) {
+            err(
+                wrap.span(),
+                format!(
+                    "`wrap_after` must be at least `start` + `step` ({}): numbering would \
+                     start again at {start} after every block",
+                    second.map_or_else(|| "beyond 2^64".into(), |s| s.to_string())
+                ),
+            );
+        }
+    }
+}
+
 // ---------------------------------------------------------------- raw TOML
 
 /// Every key the dialect file does not know and every unknown value of a
@@ -981,13 +1007,13 @@ struct RawNumbering {
     enabled: bool,
     #[serde(default = "n_prefix")]
     prefix: String,
-    #[serde(default = "ten")]
-    start: u64,
+    #[serde(default = "ten_spanned")]
+    start: Spanned<u64>,
     #[serde(default = "ten_spanned")]
     step: Spanned<u64>,
-    #[serde(default)]
-    digits: usize,
-    wrap_after: Option<u64>,
+    #[serde(default = "zero_spanned")]
+    digits: Spanned<usize>,
+    wrap_after: Option<Spanned<u64>>,
     #[serde(default)]
     header: bool,
     #[serde(default = "yes")]
@@ -1001,9 +1027,9 @@ impl Default for RawNumbering {
         RawNumbering {
             enabled: false,
             prefix: n_prefix(),
-            start: 10,
+            start: ten_spanned(),
             step: ten_spanned(),
-            digits: 0,
+            digits: zero_spanned(),
             wrap_after: None,
             header: false,
             commands: true,
@@ -1015,11 +1041,11 @@ impl Default for RawNumbering {
 fn n_prefix() -> String {
     "N".into()
 }
-fn ten() -> u64 {
-    10
-}
 fn ten_spanned() -> Spanned<u64> {
     Spanned::new(0..0, 10)
+}
+fn zero_spanned() -> Spanned<usize> {
+    Spanned::new(0..0, 0)
 }
 
 #[derive(Deserialize)]

@@ -100,3 +100,55 @@ fn every_unknown_key_and_value_at_once() {
         ]
     );
 }
+
+/// Numbering values that cannot number blocks are refused at their key:
+/// a wrap before the second number would give every block `N10`.
+#[test]
+fn numbering_that_cannot_count() {
+    let head = "name = \"x\"\nextension = \"nc\"\n[numbering]\nenabled = true\n";
+    for (body, line, column, key) in [
+        ("wrap_after = 5\n", 5, 14, "wrap_after"),
+        ("wrap_after = 10\n", 5, 14, "wrap_after"),
+        (
+            "start = 10\nstep = 10\nwrap_after = 19\n",
+            7,
+            14,
+            "wrap_after",
+        ),
+        ("step = 0\n", 5, 8, "step"),
+        ("digits = 25\n", 5, 10, "digits"),
+        (
+            "start = 18446744073709551615\nwrap_after = 18446744073709551615\n",
+            6,
+            14,
+            "wrap_after",
+        ),
+    ] {
+        let d = err(&format!("{head}{body}"));
+        assert_eq!(
+            (d.file.as_str(), d.line, d.column),
+            ("my.toml", line, column),
+            "{body}: {d}"
+        );
+        assert!(d.message.contains(key), "{body}: {d}");
+    }
+    for body in [
+        "start = -1\n",
+        "step = -10\n",
+        "wrap_after = -1\n",
+        "digits = -2\n",
+    ] {
+        let d = err(&format!("{head}{body}"));
+        assert_eq!(
+            (d.line, d.column),
+            (5, body.find('-').unwrap() + 1),
+            "{body}: {d}"
+        );
+    }
+    // Two numbers before the wrap are enough.
+    let d = Dialect::from_toml(
+        &format!("{head}start = 10\nstep = 10\nwrap_after = 20\n"),
+        "my.toml",
+    );
+    assert!(d.is_ok(), "{d:?}");
+}
