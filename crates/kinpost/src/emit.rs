@@ -590,7 +590,7 @@ impl<W: Write> Emitter<W> {
                 _ => PostError::Io(e),
             })?;
         self.start_unknown = false;
-        self.blocks += 1;
+        self.blocks = self.writer.blocks_written();
         Ok(())
     }
 

@@ -676,7 +676,9 @@ impl<W: Write> NcWriter<W> {
     }
 
     /// Writes one motion block. Modal words that did not change are left
-    /// out; a block in which nothing would be written is skipped entirely.
+    /// out; a block in which no axis word would be written is skipped
+    /// entirely (with non-modal axis words every block is written; a CSV
+    /// row is written for every block).
     /// Fails (`InvalidInput`) for a wrong number of axis values, or a value
     /// that is not finite or too large to write.
     #[inline]
@@ -713,6 +715,12 @@ impl<W: Write> NcWriter<W> {
             self.units[k] = n;
             any |= !(w.modal && w.known && w.last == n);
         }
+        // A block that changes no axis word (a repeated point) moves
+        // nothing: no line, and the motion and feed stay unwritten for the
+        // next block that moves.
+        if !any {
+            return Ok(());
+        }
         let motion_word: &[u8] = match block.motion {
             Motion::Rapid => &self.motion_rapid,
             Motion::Feed => &self.motion_feed,
@@ -730,11 +738,6 @@ impl<W: Write> NcWriter<W> {
             if !(self.feed.modal && self.last_feed == Some(n)) {
                 feed_units = Some(n);
             }
-        }
-        // A block is worth writing when it programs something: an axis or
-        // feed word, or a change of a modal motion.
-        if !(any || (write_motion && self.motion_modal) || feed_units.is_some()) {
-            return Ok(());
         }
 
         // Pass 2: format.

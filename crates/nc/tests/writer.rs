@@ -866,3 +866,59 @@ fn after_a_tool_change_every_axis_is_written_again() {
         "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nX459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
     );
 }
+
+/// A block whose axis words all repeat the last ones (a repeated CL point)
+/// writes nothing, not even its motion or feed word, and is not counted;
+/// the next block that moves writes the motion and feed in force. A CSV
+/// table keeps a row for it (a trace of every block).
+#[test]
+fn a_repeated_point_writes_no_block() {
+    let axes = [AxisSpec::linear("X"), AxisSpec::linear("Z")];
+    let blocks: [(Motion, [f64; 2], Option<f64>); 6] = [
+        (Motion::Rapid, [0.0, 50.0], None),
+        (Motion::Feed, [0.0, 10.0], Some(100.0)),
+        (Motion::Feed, [0.0, 10.0], Some(200.0)),
+        (Motion::Feed, [0.0, 10.0001], Some(200.0)),
+        (Motion::Rapid, [0.0, 10.0], None),
+        (Motion::Feed, [5.0, 10.0], Some(200.0)),
+    ];
+    let program = |name: &str| {
+        let d = Dialect::builtin(name).unwrap();
+        let mut w = NcWriter::new(&d, &axes, Vec::new());
+        for (k, (motion, values, feed)) in blocks.iter().enumerate() {
+            w.block(&Block {
+                cl_line: Some(k + 1),
+                motion: *motion,
+                axes: values,
+                feed: *feed,
+            })
+            .unwrap();
+        }
+        let n = w.blocks_written();
+        (text(w), n)
+    };
+    assert_eq!(
+        program("fanuc"),
+        (
+            "G00 X0.000 Z50.000\nG01 Z10.000 F100.\nX5.000 F200.\n".to_string(),
+            3
+        )
+    );
+    assert_eq!(
+        program("linuxcnc"),
+        (
+            "G0 X0.0000 Z50.0000\nG1 Z10.0000 F100\nZ10.0001 F200\nG0 Z10.0000\nG1 X5.0000\n"
+                .to_string(),
+            5
+        )
+    );
+    assert_eq!(
+        program("heidenhain"),
+        (
+            "0 L X+0.000 Z+50.000 R0 FMAX\n1 L Z+10.000 R0 F100\n2 L X+5.000 R0 F200\n".to_string(),
+            3
+        )
+    );
+    let (csv, rows) = program("csv");
+    assert_eq!((csv.lines().count(), rows), (7, 6), "{csv}");
+}
