@@ -146,15 +146,25 @@ impl From<Diagnostic> for PostError {
     }
 }
 
-/// An NC output met before the first CL point decides how the machine is
-/// driven (which axes the program writes); written once it is known.
+/// An NC output of a CL statement other than a point: written in its place
+/// among the points, once the planner has decided them (before the first
+/// point, once that point decides which axes the program writes).
 #[derive(Debug)]
-pub(crate) enum Pending {
+pub(crate) enum Output {
     Comment(String),
     ToolChange(u32, String),
     Spindle(Spindle),
     Coolant(Option<String>),
     Insert(String),
+}
+
+/// An output waiting to be written, with its CL statement (a diagnostic
+/// without its message yet): it is written after the reader has moved on,
+/// and a template that fails on it names that statement.
+#[derive(Debug)]
+pub(crate) struct Pending {
+    output: Output,
+    at: Box<Diagnostic>,
 }
 
 /// The machine as this program drives it, fixed by the first CL point: with
@@ -328,16 +338,18 @@ pub fn post<R: BufRead, W: Write>(
                     job.info.tool = tool.clone();
                 }
                 job.break_segment();
-                job.emit(Pending::Comment(format!("TOOL PATH: {name}")))?;
+                job.emit(Output::Comment(format!("TOOL PATH: {name}")), &reader)?;
             }
-            ClEvent::Comment(text) => job.emit(Pending::Comment(text.trim().to_string()))?,
+            ClEvent::Comment(text) => {
+                job.emit(Output::Comment(text.trim().to_string()), &reader)?
+            }
             ClEvent::LoadTool { number } => {
                 job.break_segment();
                 // The header loads the first tool (it knows `tool_number`).
                 if !tool_loaded && job.setup.is_none() {
                     job.info.tool_number = number;
                 } else {
-                    job.emit(Pending::ToolChange(number, job.info.tool.clone()))?;
+                    job.emit(Output::ToolChange(number, job.info.tool.clone()), &reader)?;
                 }
                 tool_loaded = true;
             }
@@ -347,14 +359,17 @@ pub fn post<R: BufRead, W: Write>(
                 if let Some(per_rev) = job.feed_per_rev {
                     job.feed = Some(per_rev * rpm);
                 }
-                job.emit(Pending::Spindle(match dir {
+                let state = match dir {
                     SpindleDir::Clockwise => Spindle::Cw(rpm),
                     SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
-                }))?
+                };
+                job.emit(Output::Spindle(state), &reader)?
             }
-            ClEvent::SpindleOff => job.emit(Pending::Spindle(Spindle::Off))?,
-            ClEvent::Coolant { on, mode } => job.emit(Pending::Coolant(on.then_some(mode)))?,
-            ClEvent::Insert(text) => job.emit(Pending::Insert(text))?,
+            ClEvent::SpindleOff => job.emit(Output::Spindle(Spindle::Off), &reader)?,
+            ClEvent::Coolant { on, mode } => {
+                job.emit(Output::Coolant(on.then_some(mode)), &reader)?
+            }
+            ClEvent::Insert(text) => job.emit(Output::Insert(text), &reader)?,
             ClEvent::EndOfPath => job.break_segment(),
             ClEvent::Pressure { word, value } => {
                 job.pressure(word.as_deref(), value, &reader, &mut warnings)?;
@@ -588,7 +603,12 @@ impl<W: Write> Job<'_, W> {
 
     /// Writes an NC output in its place among the points (once the program
     /// is set up).
-    fn emit(&mut self, p: Pending) -> Result<(), PostError> {
+    /// Writes `output` of the current CL statement in its place.
+    fn emit<R: BufRead>(&mut self, output: Output, reader: &ClReader<R>) -> Result<(), PostError> {
+        let p = Pending {
+            output,
+            at: Box::new(reader.statement_diagnostic(Severity::Error, "")),
+        };
         match &mut self.setup {
             Some(s) if s.path.is_idle() => s.emitter.write_pending(p),
             Some(s) => {
@@ -773,14 +793,20 @@ pub(crate) fn write_pending<W: Write>(
     writer: &mut NcWriter<W>,
     p: Pending,
 ) -> Result<(), PostError> {
-    match p {
-        Pending::Comment(text) => writer.comment(&text)?,
-        Pending::ToolChange(number, name) => writer.tool_change(number, &name)?,
-        Pending::Spindle(state) => writer.spindle(state)?,
-        Pending::Coolant(mode) => writer.coolant(mode.as_deref())?,
-        Pending::Insert(text) => writer.insert(&text)?,
-    }
-    Ok(())
+    let written = match p.output {
+        Output::Comment(text) => writer.comment(&text).map_err(NcError::Io),
+        Output::ToolChange(number, name) => writer.tool_change(number, &name),
+        Output::Spindle(state) => writer.spindle(state),
+        Output::Coolant(mode) => writer.coolant(mode.as_deref()),
+        Output::Insert(text) => writer.insert(&text).map_err(NcError::Io),
+    };
+    written.map_err(|e| match e {
+        NcError::Io(e) => PostError::Io(e),
+        other => PostError::Input(Box::new(Diagnostic {
+            message: other.to_string(),
+            ..*p.at
+        })),
+    })
 }
 
 /// Puts the kinematics of the written pressure `pressure` (NaN: none) in

@@ -12,7 +12,7 @@ use toml::Spanned;
 use crate::number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
 use crate::template;
 use crate::writer::{MAX_LEAD, MAX_SUFFIX};
-use crate::{AxisSpec, Motion};
+use crate::{AxisSpec, Motion, ProgramInfo};
 
 /// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
 const MAX_PREFIX: usize = 24;
@@ -194,6 +194,18 @@ impl TemplateKind {
         TemplateKind::InverseTimeOn,
         TemplateKind::InverseTimeOff,
     ];
+
+    /// The variables this template gets besides the program's
+    /// ([`ProgramInfo::VARIABLES`](crate::ProgramInfo::VARIABLES)).
+    pub fn variables(self) -> &'static [&'static str] {
+        match self {
+            TemplateKind::ToolChange => &["tool_name"],
+            TemplateKind::SpindleOn => &["speed", "clockwise", "direction"],
+            TemplateKind::CoolantOn => &["mode"],
+            TemplateKind::Pressure => &["pressure", "pressure_word"],
+            _ => &[],
+        }
+    }
 
     /// The key in `[templates]`.
     pub fn key(self) -> &'static str {
@@ -464,6 +476,7 @@ impl Dialect {
                     ),
                 );
             }
+            check_variables(&env, kind_t, t, source, &mut err);
             templates.insert(kind_t, t.get_ref().clone());
         }
 
@@ -771,6 +784,33 @@ impl From<&RawWord> for PartialWord {
             modulo: w.modulo.as_ref().map(|m| *m.get_ref()),
             modal: w.modal,
         }
+    }
+}
+
+/// A variable the template reads but is not given would fail only when a
+/// post reaches the template: it is refused at load, where it is written.
+fn check_variables(
+    env: &Environment<'static>,
+    kind: TemplateKind,
+    t: &Spanned<String>,
+    source: &str,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    let given: Vec<&str> = ProgramInfo::VARIABLES
+        .iter()
+        .chain(kind.variables())
+        .copied()
+        .collect();
+    for (name, range) in template::unknown_variables(env, kind.key(), t.get_ref(), &given) {
+        err(
+            template::template_span_in_toml(source, t.span(), t.get_ref(), Some(range)),
+            format!(
+                "template `{}`: unknown variable `{name}`; its variables are {} (a value the \
+                 caller may pass in `extra` is `extra.{name}`, or `{name}` tested with `is defined`)",
+                kind.key(),
+                given.join(", ")
+            ),
+        );
     }
 }
 

@@ -162,6 +162,20 @@ pub struct ProgramInfo {
 }
 
 impl ProgramInfo {
+    /// The names every template gets from [`ProgramInfo::template_vars`]
+    /// (each extra key too, but those depend on the caller).
+    pub const VARIABLES: [&'static str; 9] = [
+        "program_name",
+        "date",
+        "machine",
+        "tool",
+        "tool_number",
+        "cl_file",
+        "dialect",
+        "axes",
+        "extra",
+    ];
+
     /// The template variables: `program_name`, `date`, `machine`, `tool`,
     /// `tool_number`, `cl_file`, `dialect`, `axes` (list of names), `extra`
     /// and every extra key.
@@ -252,5 +266,20 @@ impl std::error::Error for NcError {
 impl From<std::io::Error> for NcError {
     fn from(e: std::io::Error) -> Self {
         NcError::Io(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The names the dialect loader accepts are the names templates get.
+    #[test]
+    fn template_vars_are_the_documented_variables() {
+        let vars = ProgramInfo::default().template_vars("d", &[AxisSpec::linear("X")]);
+        let names: Vec<&str> = vars.keys().map(String::as_str).collect();
+        let mut documented = ProgramInfo::VARIABLES.to_vec();
+        documented.sort_unstable();
+        assert_eq!(names, documented);
     }
 }

@@ -84,6 +84,96 @@ pub(crate) fn render_str(
         .map_err(|e| to_error(name, &e))
 }
 
+/// The variables template `name` (source `source`) reads that it is not
+/// `given` (nor a global function such as `range`) and never tests with
+/// `is defined` / `is undefined` or gives a `| default`: each with the byte
+/// range of its first use, in template order. minijinja's static analysis
+/// sees every branch, so a misspelt name is found before a post reaches it.
+pub(crate) fn unknown_variables(
+    env: &Environment<'static>,
+    name: &str,
+    source: &str,
+    given: &[&str],
+) -> Vec<(String, Range<usize>)> {
+    let Ok(t) = env.get_template(name) else {
+        return Vec::new();
+    };
+    let mut unknown: Vec<(String, Range<usize>)> = t
+        .undeclared_variables(false)
+        .into_iter()
+        .filter(|v| !given.contains(&v.as_str()) && !env.globals().any(|(g, _)| g == v))
+        .filter(|v| !uses(source, v).any(|at| optional(&source[at + v.len()..])))
+        .map(|v| {
+            let at = uses(source, &v).next().unwrap_or(0);
+            let range = at..at + v.len();
+            (v, range)
+        })
+        .collect();
+    unknown.sort_by_key(|(_, r)| r.start);
+    unknown
+}
+
+/// Byte offsets of `name` as a whole identifier (not an attribute, after
+/// a `.`) inside the tags of `source` (`{{ … }}`, `{% … %}`).
+fn uses<'a>(source: &'a str, name: &'a str) -> impl Iterator<Item = usize> + 'a {
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    tags(source).flat_map(move |tag| {
+        source[tag.clone()]
+            .match_indices(name)
+            .map(move |(i, _)| tag.start + i)
+            .filter(move |&at| {
+                let before = source[..at].chars().next_back();
+                let after = source[at + name.len()..].chars().next();
+                !before.is_some_and(|c| ident(c) || c == '.') && !after.is_some_and(ident)
+            })
+    })
+}
+
+/// The byte ranges inside the expression and statement tags of `source`.
+fn tags(source: &str) -> impl Iterator<Item = Range<usize>> + '_ {
+    let mut at = 0;
+    std::iter::from_fn(move || {
+        loop {
+            let open = at + source.get(at..)?.find('{')?;
+            let close = match source.as_bytes().get(open + 1) {
+                Some(b'{') => "}}",
+                Some(b'%') => "%}",
+                _ => {
+                    at = open + 1;
+                    continue;
+                }
+            };
+            let start = open + 2;
+            let end = source[start..]
+                .find(close)
+                .map_or(source.len(), |i| start + i);
+            at = end;
+            return Some(start..end);
+        }
+    })
+}
+
+/// Whether the text after a variable makes it optional: `is [not]
+/// defined`, `is undefined`, `| default(…)` or `| d(…)`.
+fn optional(after: &str) -> bool {
+    if let Some(rest) = word(after, "is") {
+        let rest = word(rest, "not").unwrap_or(rest);
+        return word(rest, "defined").is_some() || word(rest, "undefined").is_some();
+    }
+    match after.trim_start().strip_prefix('|') {
+        Some(rest) => word(rest, "default").is_some() || word(rest, "d").is_some(),
+        None => false,
+    }
+}
+
+/// The text after the whole word `w` at the start of `s` (blanks before it
+/// skipped).
+fn word<'a>(s: &'a str, w: &str) -> Option<&'a str> {
+    let rest = s.trim_start().strip_prefix(w)?;
+    let next = rest.chars().next();
+    (!next.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')).then_some(rest)
+}
+
 fn to_error(name: &str, e: &minijinja::Error) -> NcError {
     NcError::Template {
         template: name.to_string(),

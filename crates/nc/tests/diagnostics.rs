@@ -152,3 +152,44 @@ fn numbering_that_cannot_count() {
     );
     assert!(d.is_ok(), "{d:?}");
 }
+
+/// A template that reads a variable it is not given fails at load, at the
+/// variable, whichever branch it is in; not only when a post reaches it.
+#[test]
+fn unknown_template_variable_is_found_at_load() {
+    let head = "name = \"x\"\nextension = \"nc\"\n[templates]\n";
+    let d = err(&format!(
+        "{head}tool_change = \"T{{{{ tool_nmber }}}} M6\"\n"
+    ));
+    assert_eq!(
+        (d.file.as_str(), d.line, d.column),
+        ("my.toml", 4, 20),
+        "{d}"
+    );
+    assert!(d.message.contains("template `tool_change`"), "{d}");
+    assert!(d.message.contains("`tool_nmber`"), "{d}");
+    assert!(d.message.contains("tool_number, cl_file"), "{d}");
+    // In a branch a post may never take, and another template's variable.
+    let d = err(&format!(
+        "{head}footer = '''\nM30\n{{% if tool %}}\n({{{{ tool }}}} {{{{ speed }}}})\n{{% endif %}}\n'''\n"
+    ));
+    assert_eq!((d.line, d.column), (7, 16), "{d}");
+    assert!(d.message.contains("`speed`"), "{d}");
+}
+
+/// Every documented variable, minijinja's globals and loop variables, an
+/// attribute of `extra` and extras the template tests for are fine.
+#[test]
+fn documented_and_optional_template_variables_load() {
+    let src = r#"name = "x"
+extension = "nc"
+[templates]
+header = "{{ program_name }}{{ date }}{{ machine }}{{ tool }}{{ tool_number }}{{ cl_file }}{{ dialect }}{{ axes | join(' ') }}{{ extra.program_number }}"
+footer = "{% for a in axes %}{{ loop.index }}{{ a }}{% endfor %}{{ range(2) | length }}{% if part is defined %}{{ part }}{% endif %}{% if not (op is not defined) %}{{ op }}{% endif %}{{ note | default('-') }}{{ other|d('') }}"
+tool_change = "T{{ tool_number }} ({{ tool_name }})"
+spindle_on = "S{{ speed | num(0) }} {{ 'M3' if clockwise else 'M4' }} {{ direction }}"
+coolant_on = "{{ mode }}"
+pressure = "{{ pressure_word }}={{ pressure }}"
+"#;
+    Dialect::from_toml(src, "my.toml").unwrap_or_else(|e| panic!("{e}"));
+}

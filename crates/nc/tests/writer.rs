@@ -922,3 +922,38 @@ fn a_repeated_point_writes_no_block() {
     let (csv, rows) = program("csv");
     assert_eq!((csv.lines().count(), rows), (7, 6), "{csv}");
 }
+
+/// Every template renders with the variables the loader lets it use
+/// (`ProgramInfo::VARIABLES` and `TemplateKind::variables`): what passes the
+/// load-time check is given at post time.
+#[test]
+fn every_template_gets_the_variables_the_loader_accepts() {
+    use kinpost_nc::TemplateKind;
+    let mut src = String::from("name = \"x\"\nextension = \"nc\"\n[pressure]\n[templates]\n");
+    for kind in TemplateKind::ALL {
+        let vars: Vec<String> = ProgramInfo::VARIABLES
+            .iter()
+            .chain(kind.variables())
+            .map(|v| format!("{{{{ {v} }}}}"))
+            .collect();
+        src.push_str(&format!("{} = \"{}\"\n", kind.key(), vars.join(" ")));
+    }
+    let dialect = Dialect::from_toml(&src, "all.toml").unwrap_or_else(|e| panic!("{e}"));
+    let axes = mts_axes_with_pressure();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let info = ProgramInfo::default();
+    w.header(&info, None).unwrap();
+    w.tool_change(2, "BALL").unwrap();
+    w.spindle(Spindle::Cw(3000.0)).unwrap();
+    w.spindle(Spindle::Off).unwrap();
+    w.coolant(Some("MIST")).unwrap();
+    w.coolant(None).unwrap();
+    w.tcp(true).unwrap();
+    w.tcp(false).unwrap();
+    w.inverse_time(true).unwrap();
+    w.inverse_time(false).unwrap();
+    pressure_block(&mut w, 1.0, 3000.0);
+    w.footer(&info, None).unwrap();
+    let out = text(w);
+    assert_eq!(out.lines().count(), TemplateKind::ALL.len() + 2, "{out}");
+}

@@ -1,0 +1,51 @@
+//! What the NC writer cannot write is an error naming the CL statement it
+//! comes from.
+
+use kinpost::machine::builtin;
+use kinpost::nc::Dialect;
+use kinpost::{PostError, PostOptions, post};
+
+/// A built-in dialect with one line of its file replaced.
+fn dialect_with(name: &str, key: &str, line: &str) -> Dialect {
+    let source = Dialect::builtin_source(name).unwrap();
+    assert!(source.lines().any(|l| l.starts_with(key)), "{name}: {key}");
+    let edited: Vec<&str> = source
+        .lines()
+        .map(|l| if l.starts_with(key) { line } else { l })
+        .collect();
+    Dialect::from_toml(&edited.join("\n"), "edited.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn post_error(dialect: &Dialect, cl: &str) -> kinpost::nc::Diagnostic {
+    let machine = builtin::load("trunnion-ac").unwrap().unwrap();
+    let options = PostOptions {
+        cl_file: "job.cls".into(),
+        ..PostOptions::default()
+    };
+    match post(cl.as_bytes(), &machine, dialect, Vec::new(), &options) {
+        Err(PostError::Input(d)) => *d,
+        Err(e) => panic!("not an input error: {e}"),
+        Ok(_) => panic!("posted"),
+    }
+}
+
+/// A template that fails while the post writes it (here on a value the
+/// caller did not pass in `extra`) names the CL statement it was written
+/// for, though the planner writes it after the reader has moved on.
+#[test]
+fn template_error_names_the_cl_line() {
+    let dialect = dialect_with(
+        "linuxcnc",
+        "tool_change =",
+        "tool_change = \"T{{ tool_number }} M6 P{{ extra.slot }}\"",
+    );
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,100\nGOTO/0,0,40\nLOAD/TOOL,2\nGOTO/0,0,60\n";
+    let d = post_error(&dialect, cl);
+    assert_eq!(
+        (d.file.as_str(), d.line, d.column),
+        ("job.cls", 5, 1),
+        "{d}"
+    );
+    assert_eq!(d.source_line, "LOAD/TOOL,2");
+    assert!(d.message.contains("template `tool_change`"), "{d}");
+}
