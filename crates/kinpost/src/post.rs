@@ -794,11 +794,11 @@ pub(crate) fn write_pending<W: Write>(
     p: Pending,
 ) -> Result<(), PostError> {
     let written = match p.output {
-        Output::Comment(text) => writer.comment(&text).map_err(NcError::Io),
+        Output::Comment(text) => writer.comment(&text),
         Output::ToolChange(number, name) => writer.tool_change(number, &name),
         Output::Spindle(state) => writer.spindle(state),
         Output::Coolant(mode) => writer.coolant(mode.as_deref()),
-        Output::Insert(text) => writer.insert(&text).map_err(NcError::Io),
+        Output::Insert(text) => writer.insert(&text),
     };
     written.map_err(|e| match e {
         NcError::Io(e) => PostError::Io(e),

@@ -49,3 +49,24 @@ fn template_error_names_the_cl_line() {
     assert_eq!(d.source_line, "LOAD/TOOL,2");
     assert!(d.message.contains("template `tool_change`"), "{d}");
 }
+
+/// An INSERT longer than the dialect's `max_line_length` (LinuxCNC's 253
+/// bytes with the newline) is code kinpost cannot shorten: an error at its
+/// CL line. A CL comment as long is shortened (see `rs274.rs`).
+#[test]
+fn insert_longer_than_the_controller_reads_names_the_cl_line() {
+    let dialect = Dialect::builtin("linuxcnc").unwrap();
+    let cl = format!(
+        "RAPID\nGOTO/0,0,50,0,0,1\n$$ {}\nINSERT/(MSG, {})\nRAPID\nGOTO/0,0,60\n",
+        "c".repeat(400),
+        "i".repeat(300)
+    );
+    let d = post_error(&dialect, &cl);
+    assert_eq!(
+        (d.file.as_str(), d.line, d.column),
+        ("job.cls", 4, 1),
+        "{d}"
+    );
+    assert!(d.message.contains("INSERT"), "{d}");
+    assert!(d.message.contains("max_line_length of 253"), "{d}");
+}

@@ -538,6 +538,36 @@ fn rs274_rejects_bad_programs() {
     }
 }
 
+/// rs274 reads lines of at most 253 bytes with the newline (`LINELEN` 255),
+/// the dialect's `max_line_length`: a longer CL comment or PARTNO is
+/// shortened to fit, and the program runs.
+#[test]
+fn long_comments_and_names_fit_the_line_length() {
+    let Some(rs274) = interpreter("long_comments_and_names_fit_the_line_length") else {
+        return;
+    };
+    let max = Dialect::builtin("linuxcnc")
+        .unwrap()
+        .block_format()
+        .max_line_length
+        .unwrap();
+    let comment = |n: usize| format!("%\n({})\nG0 X1\nM2\n%\n", "c".repeat(n));
+    assert!(run(&rs274, &comment(max - 3), "longest line").is_ok());
+    assert!(run(&rs274, &comment(max - 2), "one byte more").is_err());
+
+    let cl = format!(
+        "PARTNO/{}\n$$ {}\n$$ {}\nTOOL PATH/T,TOOL,E\nRAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/100\nGOTO/0,0,10\n",
+        "P".repeat(300),
+        "c".repeat(253),
+        "ü".repeat(200)
+    );
+    let machine = builtin::load("trunnion-ac").unwrap().unwrap();
+    compare(&rs274, &machine, &cl, "long.cls");
+    let ngc = post_text(&machine, "linuxcnc", &cl, "long.cls");
+    assert!(ngc.lines().all(|l| l.len() < max), "{ngc}");
+    assert!(ngc.contains(&format!("(PROGRAM: {})\n", "P".repeat(max - 12))));
+}
+
 /// Inverse-time feed (`G93`): the program parses, and the time LinuxCNC
 /// gives every feed block (its move length over the feed rate its canon
 /// derives from F) equals the CL segment length over the CL feed rate

@@ -110,6 +110,9 @@ pub struct BlockFormat {
     /// Literal words written after the axis words of every motion block
     /// (Heidenhain `R0`); empty for none.
     pub after_axes: String,
+    /// Longest line the controller reads, in bytes, `line_end` included:
+    /// longer comments are shortened, other longer lines are errors.
+    pub max_line_length: Option<usize>,
 }
 
 /// Block numbers.
@@ -506,6 +509,7 @@ impl Dialect {
                 }),
             line_end: raw.block.line_end.get_ref().clone(),
             after_axes: raw.block.after_axes,
+            max_line_length: raw.block.max_line_length.as_ref().map(|m| *m.get_ref()),
         };
         if let Some(sep) = &raw.block.separator
             && sep.get_ref().len() > MAX_LEAD - MAX_PREFIX
@@ -534,6 +538,19 @@ impl Dialect {
             err(
                 raw.block.line_end.span(),
                 "`line_end` must end with a newline".into(),
+            );
+        }
+        // The shortest line a limit must hold: an empty comment.
+        let least = block.line_end.len() + raw.comment.prefix.len() + raw.comment.suffix.len();
+        if let Some(max) = &raw.block.max_line_length
+            && *max.get_ref() <= least
+        {
+            err(
+                max.span(),
+                format!(
+                    "`max_line_length` counts the line end: it must be more than {least} bytes \
+                     (line end, comment prefix and suffix)"
+                ),
             );
         }
 
@@ -975,6 +992,7 @@ struct RawBlock {
     line_end: Spanned<String>,
     #[serde(default)]
     after_axes: String,
+    max_line_length: Option<Spanned<usize>>,
 }
 
 impl Default for RawBlock {
@@ -985,6 +1003,7 @@ impl Default for RawBlock {
             separator: None,
             line_end: newline(),
             after_axes: String::new(),
+            max_line_length: None,
         }
     }
 }

@@ -232,6 +232,18 @@ pub enum NcError {
         /// What went wrong.
         message: String,
     },
+    /// A line longer than the dialect's `max_line_length` that is not a
+    /// comment to shorten (a CL `INSERT`, a template line).
+    LineTooLong {
+        /// What wrote it: `INSERT`, `template `header``, ….
+        source: String,
+        /// The line, without its line end.
+        text: String,
+        /// Its length in bytes, line end included.
+        length: usize,
+        /// The dialect's `max_line_length`.
+        max: usize,
+    },
 }
 
 impl std::fmt::Display for NcError {
@@ -250,6 +262,20 @@ impl std::fmt::Display for NcError {
                 }
                 write!(f, ": {message}")
             }
+            NcError::LineTooLong {
+                source,
+                text,
+                length,
+                max,
+            } => {
+                let start: String = text.chars().take(40).collect();
+                let more = if start.len() < text.len() { "…" } else { "" };
+                write!(
+                    f,
+                    "{source}: the line `{start}{more}` has {length} bytes with its line end, \
+                     more than the dialect's max_line_length of {max}"
+                )
+            }
         }
     }
 }
@@ -258,7 +284,7 @@ impl std::error::Error for NcError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             NcError::Io(e) => Some(e),
-            NcError::Template { .. } => None,
+            NcError::Template { .. } | NcError::LineTooLong { .. } => None,
         }
     }
 }

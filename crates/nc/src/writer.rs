@@ -240,6 +240,8 @@ pub struct NcWriter<W: Write> {
     after_axes: Text,
     sep: Text,
     eol: Text,
+    /// `max_line_length` (`usize::MAX` for none), line end included.
+    max_line: usize,
     numbering: Numbering,
     next_number: u64,
     comment: CommentSyntax,
@@ -358,6 +360,7 @@ impl<W: Write> NcWriter<W> {
             after_axes: Text::new(&dialect.block.after_axes),
             sep: Text::new(sep),
             eol: Text::new(&dialect.block.line_end),
+            max_line: dialect.block.max_line_length.unwrap_or(usize::MAX),
             numbering: dialect.numbering.clone(),
             next_number: dialect.numbering.start,
             comment: dialect.comment.clone(),
@@ -552,8 +555,7 @@ impl<W: Write> NcWriter<W> {
         let mut all = self.vars.clone();
         all.extend(vars.iter().map(|(k, v)| (k.clone(), v.clone())));
         let text = template::render_str(&self.env, "template", source, &all)?;
-        self.write_lines(&text, self.numbering.commands)?;
-        Ok(())
+        self.write_lines(&text, self.numbering.commands, "template")
     }
 
     fn command(&mut self, kind: TemplateKind, extra: Vec<(&str, Value)>) -> Result<(), NcError> {
@@ -589,29 +591,44 @@ impl<W: Write> NcWriter<W> {
                 template::render(&self.env, kind.key(), vars)?
             }
         };
-        self.write_lines(&text, numbered)?;
-        Ok(())
+        self.write_lines(&text, numbered, kind.key())
     }
 
-    /// Writes every non-empty line of `text`, numbered if asked.
-    fn write_lines(&mut self, text: &str, numbered: bool) -> io::Result<()> {
+    /// Writes every non-empty line of `text` (of template `template`),
+    /// numbered if asked. A line longer than `max_line_length` loses the
+    /// end of the comment it ends with (the program name in `(PROGRAM:
+    /// …)`); any other is an error.
+    fn write_lines(&mut self, text: &str, numbered: bool, template: &str) -> Result<(), NcError> {
         self.buf.clear();
         for line in text.lines() {
             let line = line.trim_end_matches('\r');
             if line.trim().is_empty() {
                 continue;
             }
+            let start = self.buf.len();
             if numbered && self.numbering.enabled {
                 self.push_number();
             }
-            self.buf.extend_from_slice(line.as_bytes());
+            let used = self.buf.len() - start + self.eol.len();
+            let room = self.max_line.saturating_sub(used);
+            let Some((head, tail)) = fit(line, room, &self.comment) else {
+                return Err(NcError::LineTooLong {
+                    source: format!("template `{template}`"),
+                    text: line.to_string(),
+                    length: used + line.len(),
+                    max: self.max_line,
+                });
+            };
+            self.buf.extend_from_slice(head.as_bytes());
+            self.buf.extend_from_slice(tail.as_bytes());
             self.buf.extend_from_slice(&self.eol);
         }
-        self.out.write_all(&self.buf)
+        Ok(self.out.write_all(&self.buf)?)
     }
 
-    /// A comment line (nothing when the dialect has comments off, or is CSV).
-    pub fn comment(&mut self, text: &str) -> io::Result<()> {
+    /// A comment line (nothing when the dialect has comments off, or is CSV),
+    /// its text cut to fit `max_line_length` (it is only a remark).
+    pub fn comment(&mut self, text: &str) -> Result<(), NcError> {
         if self.kind == DialectKind::Csv || !self.comment.enabled {
             return Ok(());
         }
@@ -626,22 +643,42 @@ impl<W: Write> NcWriter<W> {
                 body = body.replace(from.as_str(), to);
             }
         }
-        self.buf.extend_from_slice(body.as_bytes());
+        let used = self.buf.len() + self.comment.suffix.len() + self.eol.len();
+        let Some(room) = self.max_line.checked_sub(used) else {
+            return Err(NcError::LineTooLong {
+                source: "comment".into(),
+                text: String::from_utf8_lossy(&self.buf).into_owned(),
+                length: used,
+                max: self.max_line,
+            });
+        };
+        let cut = floor_boundary(&body, room);
+        self.buf.extend_from_slice(&body.as_bytes()[..cut]);
         self.buf.extend_from_slice(self.comment.suffix.as_bytes());
         self.buf.extend_from_slice(&self.eol);
-        self.out.write_all(&self.buf)
+        Ok(self.out.write_all(&self.buf)?)
     }
 
-    /// A verbatim line (CL `INSERT`), never numbered; nothing for CSV.
-    pub fn insert(&mut self, text: &str) -> io::Result<()> {
+    /// A verbatim line (CL `INSERT`), never numbered; nothing for CSV. One
+    /// longer than `max_line_length` is an error: it is code, not a remark.
+    pub fn insert(&mut self, text: &str) -> Result<(), NcError> {
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
+        let text = text.replace(['\r', '\n'], " ");
+        let length = text.len() + self.eol.len();
+        if length > self.max_line {
+            return Err(NcError::LineTooLong {
+                source: "INSERT".into(),
+                text,
+                length,
+                max: self.max_line,
+            });
+        }
         self.buf.clear();
-        self.buf
-            .extend_from_slice(text.replace(['\r', '\n'], " ").as_bytes());
+        self.buf.extend_from_slice(text.as_bytes());
         self.buf.extend_from_slice(&self.eol);
-        self.out.write_all(&self.buf)
+        Ok(self.out.write_all(&self.buf)?)
     }
 
     /// The next block number, with prefix and separator, into `out`.
@@ -665,6 +702,26 @@ impl<W: Write> NcWriter<W> {
         let mut buf = std::mem::take(&mut self.buf);
         self.number_into(&mut buf);
         self.buf = buf;
+    }
+
+    /// The line in `self.line` is longer than `max_line_length`.
+    #[cold]
+    fn too_long(&self, cl_line: Option<usize>) -> io::Error {
+        let text = String::from_utf8_lossy(self.line.as_slice());
+        let of = cl_line.map_or_else(
+            || "a block the post added".into(),
+            |l| format!("CL line {l}"),
+        );
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "the line `{}` for {of} has {} bytes with its line end, more than the dialect's \
+                 max_line_length of {}",
+                text.trim_end(),
+                self.line.len,
+                self.max_line
+            ),
+        )
     }
 
     fn bad_value(&self, axis: usize, value: f64, e: crate::NumberError) -> io::Error {
@@ -699,7 +756,7 @@ impl<W: Write> NcWriter<W> {
         if let Some(p) = &self.pressure
             && !block.axes[p.word.index].is_nan()
         {
-            self.pressure_line(block.axes)?;
+            self.pressure_line(block)?;
         }
         if self.plain {
             return self.plain_block(block);
@@ -781,8 +838,11 @@ impl<W: Write> NcWriter<W> {
             line.put(&self.feed_rapid);
         }
         line.put(&self.eol);
+        if self.line.len > self.max_line {
+            return Err(self.too_long(block.cl_line));
+        }
         self.blocks += 1;
-        self.out.write_all(line.as_slice())
+        self.out.write_all(self.line.as_slice())
     }
 
     /// Starts the motion block line: empty, or the block number when
@@ -865,6 +925,9 @@ impl<W: Write> NcWriter<W> {
         }
         len = put_text(buf, len, &self.eol);
         self.line.len = len;
+        if len > self.max_line {
+            return Err(self.too_long(block.cl_line));
+        }
         self.motion_state = Some(block.motion);
         self.blocks += 1;
         self.out.write_all(self.line.as_slice())
@@ -897,11 +960,11 @@ impl<W: Write> NcWriter<W> {
     /// The pressure word on its own line, when the block's pressure differs
     /// from the last one written (then the `pressure` template, if any, e.g.
     /// a dwell while the wheel settles). NaN: no pressure programmed.
-    fn pressure_line(&mut self, axes: &[f64]) -> io::Result<()> {
+    fn pressure_line(&mut self, block: &Block) -> io::Result<()> {
         let Some(p) = &self.pressure else {
             return Ok(());
         };
-        let (index, value) = (p.word.index, axes[p.word.index]);
+        let (index, value) = (p.word.index, block.axes[p.word.index]);
         if value.is_nan() {
             return Ok(());
         }
@@ -936,6 +999,9 @@ impl<W: Write> NcWriter<W> {
         p.word.known = true;
         self.line.put_word(&p.word, n, true);
         self.line.put(&self.eol);
+        if self.line.len > self.max_line {
+            return Err(self.too_long(block.cl_line));
+        }
         self.out.write_all(self.line.as_slice())?;
         let written = p.word.fmt.quantize(value);
         let name = Value::from(p.name.as_str());
@@ -1009,6 +1075,9 @@ impl<W: Write> NcWriter<W> {
         }
         len = put_text(&mut self.line.bytes, len, &self.eol);
         self.line.len = len;
+        if len > self.max_line {
+            return Err(self.too_long(block.cl_line));
+        }
         self.blocks += 1;
         self.out.write_all(self.line.as_slice())
     }
@@ -1021,4 +1090,46 @@ impl<W: Write> NcWriter<W> {
         self.out.flush()?;
         Ok(self.out)
     }
+}
+
+/// `line` cut to `room` bytes, as a head and a tail to join: the end of the
+/// text of the comment it ends with goes (a remark; the code before it stays
+/// whole). `None` when that is not enough.
+fn fit<'a>(line: &'a str, room: usize, comment: &CommentSyntax) -> Option<(&'a str, &'a str)> {
+    if line.len() <= room {
+        return Some((line, ""));
+    }
+    let body = comment_body(line, comment)?;
+    let excess = line.len() - room;
+    if excess > body.len() {
+        return None;
+    }
+    let keep = floor_boundary(line, body.end - excess);
+    Some((&line[..keep], &line[body.end..]))
+}
+
+/// The byte range of the text of the comment `line` ends with, in the
+/// dialect's comment syntax: after the last prefix before the suffix, or
+/// after the first prefix where comments run to the end of the line.
+fn comment_body(line: &str, comment: &CommentSyntax) -> Option<std::ops::Range<usize>> {
+    let (prefix, suffix) = (comment.prefix.as_str(), comment.suffix.as_str());
+    if prefix.is_empty() {
+        return None;
+    }
+    let end = line.strip_suffix(suffix)?.len();
+    let start = if suffix.is_empty() {
+        line.find(prefix)?
+    } else {
+        line[..end].rfind(prefix)?
+    };
+    Some(start + prefix.len()..end)
+}
+
+/// The largest char boundary of `s` at or before `at`.
+fn floor_boundary(s: &str, at: usize) -> usize {
+    let mut at = at.min(s.len());
+    while !s.is_char_boundary(at) {
+        at -= 1;
+    }
+    at
 }

@@ -193,3 +193,17 @@ pressure = "{{ pressure_word }}={{ pressure }}"
 "#;
     Dialect::from_toml(src, "my.toml").unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// A `max_line_length` that cannot hold an empty comment with its line end.
+#[test]
+fn max_line_length_too_small() {
+    let d = err("name = \"x\"\nextension = \"nc\"\n[block]\nmax_line_length = 3\n");
+    assert_eq!((d.line, d.column), (4, 19), "{d}");
+    assert!(d.message.contains("max_line_length"), "{d}");
+    let d = Dialect::from_toml(
+        "name = \"x\"\nextension = \"nc\"\n[block]\nmax_line_length = 4\n",
+        "my.toml",
+    )
+    .unwrap();
+    assert_eq!(d.block_format().max_line_length, Some(4));
+}

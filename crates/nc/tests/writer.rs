@@ -957,3 +957,78 @@ fn every_template_gets_the_variables_the_loader_accepts() {
     let out = text(w);
     assert_eq!(out.lines().count(), TemplateKind::ALL.len() + 2, "{out}");
 }
+
+/// `max_line_length` (LinuxCNC: 253 bytes with the newline): a comment, or
+/// the comment a template line ends with (the program name), is cut to fit
+/// at a character boundary; an INSERT, a template line that is not a
+/// comment and a motion block are not shortened: errors.
+#[test]
+fn lines_fit_the_dialect_max_line_length() {
+    let d = Dialect::builtin("linuxcnc").unwrap();
+    assert_eq!(d.block_format().max_line_length, Some(253));
+    assert_eq!(
+        Dialect::builtin("sinumerik")
+            .unwrap()
+            .block_format()
+            .max_line_length,
+        Some(512)
+    );
+    let axes = [AxisSpec::linear("X")];
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let info = ProgramInfo {
+        program_name: "P".repeat(300),
+        ..ProgramInfo::default()
+    };
+    w.header(&info, None).unwrap();
+    w.comment(&"c".repeat(251)).unwrap();
+    w.comment(&format!("{}äb", "c".repeat(249))).unwrap();
+    w.comment(&"c".repeat(250)).unwrap();
+    let e = w
+        .insert(&format!("(MSG, {})", "i".repeat(246)))
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            NcError::LineTooLong {
+                length: 254,
+                max: 253,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("INSERT"), "{e}");
+    w.insert(&format!("(MSG, {})", "i".repeat(245))).unwrap();
+    let out = text(w);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[1], format!("(PROGRAM: {})", "P".repeat(241)));
+    let tail = &lines[lines.len() - 4..];
+    assert_eq!(tail[0], format!("({})", "c".repeat(250)));
+    assert_eq!(tail[1], format!("({})", "c".repeat(249)));
+    assert_eq!(tail[2], format!("({})", "c".repeat(250)));
+    assert_eq!(tail[3].len(), 252);
+    assert!(out.lines().all(|l| l.len() < 253), "{out}");
+
+    // A template line that is not a comment, a block, a numbered comment.
+    let src = "name = \"x\"\nextension = \"nc\"\n[block]\nmax_line_length = 20\n\
+               [numbering]\nenabled = true\ncomments = true\n[comment]\nprefix = \"(\"\nsuffix = \")\"\n[templates]\n\
+               header = \"(T) {{ program_name }}\"\ntool_change = \"T{{ tool_number }} (TOOL {{ tool_name }})\"\n";
+    let d = Dialect::from_toml(src, "x.toml").unwrap();
+    let axes = [AxisSpec::linear("X"), AxisSpec::linear("Y")];
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let e = w.header(&info, None).unwrap_err();
+    assert!(matches!(e, NcError::LineTooLong { .. }), "{e}");
+    assert!(e.to_string().contains("template `header`"), "{e}");
+    w.tool_change(12, "BALL NOSE 6 MM").unwrap();
+    w.comment("a remark longer than twenty").unwrap();
+    let e = w
+        .block(&Block {
+            cl_line: Some(7),
+            motion: Motion::Feed,
+            axes: &[1.0, 2.0],
+            feed: Some(100.0),
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("CL line 7"), "{e}");
+    assert_eq!(text(w), "N10 T12 (TOOL BALL)\nN20 (a remark long)\n");
+}
