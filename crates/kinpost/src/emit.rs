@@ -182,7 +182,7 @@ impl<W: Write> Emitter<W> {
     /// Writes a statement of the CL between motion blocks (comment, tool
     /// change, spindle, coolant, insert).
     pub fn write_pending(&mut self, p: Pending) -> Result<(), PostError> {
-        if matches!(p, Pending::ToolChange(..)) {
+        if p.changes_tool() {
             self.start_unknown = true;
         }
         write_pending(&mut self.writer, p)

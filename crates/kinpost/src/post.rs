@@ -167,6 +167,13 @@ pub(crate) struct Pending {
     at: Box<Diagnostic>,
 }
 
+impl Pending {
+    /// A tool change: the machine goes where it changes tools.
+    pub(crate) fn changes_tool(&self) -> bool {
+        matches!(self.output, Output::ToolChange(..))
+    }
+}
+
 /// The machine as this program drives it, fixed by the first CL point: with
 /// reference directions, axes marked `free_with_reference` are free.
 struct Setup<W: Write> {
