@@ -9,7 +9,7 @@
 use std::io::{BufRead, Write};
 use std::time::Instant;
 
-use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Units};
+use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units};
 use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::{Kinematics, Machine, OutputMode, Pose};
 use kinpost_nc::{
@@ -268,123 +268,28 @@ pub fn post<R: BufRead, W: Write>(
         }));
         job.pressure = Some(value);
     }
-    let mut named = options.program_name.is_some();
-    let mut tool_loaded = false;
-    let mut remarked = Remarked::default();
-
+    let mut reading = Reading {
+        warnings,
+        remarked: Remarked::default(),
+        named: options.program_name.is_some(),
+        tool_loaded: false,
+    };
+    // The loop over the points stays small: every other statement is read
+    // out of line (`statement`), so that what it does cannot crowd the
+    // registers of the points' code.
     let mut goto = Move::default();
     loop {
-        let statement = match reader.next_move(&mut goto)? {
-            Next::Move => {
-                job.goto(&goto, &reader, &mut warnings, &mut remarked)?;
-                continue;
+        match reader.next_move(&mut goto)? {
+            Next::Move => job.goto(&goto, &reader, &mut reading.warnings, &mut reading.remarked)?,
+            Next::Statement(s) => {
+                if !statement(&mut job, &mut reading, s, &reader)? {
+                    break;
+                }
             }
-            Next::Statement(statement) => statement,
             Next::End => break,
-        };
-        let line = statement.line;
-        match statement.event {
-            ClEvent::Goto {
-                point,
-                axis,
-                reference,
-                motion,
-            } => {
-                let goto = Move {
-                    line,
-                    point,
-                    axis,
-                    reference,
-                    motion,
-                };
-                job.goto(&goto, &reader, &mut warnings, &mut remarked)?;
-            }
-            ClEvent::Feedrate { value, unit } => {
-                let mm = match unit {
-                    FeedUnit::Mmpm | FeedUnit::Mmpr => value,
-                    FeedUnit::Ipm | FeedUnit::Ipr => value * 25.4,
-                };
-                job.feed_per_rev = None;
-                job.feed = Some(if matches!(unit, FeedUnit::Mmpr | FeedUnit::Ipr) {
-                    // The feed word is per minute: per revolution times the
-                    // spindle speed, now and after every speed change.
-                    let Some(rpm) = job.rpm else {
-                        return Err(reader
-                            .statement_diagnostic(
-                                Severity::Error,
-                                "a feed per revolution needs the spindle speed: give SPINDL/rpm before it",
-                            )
-                            .into());
-                    };
-                    job.feed_per_rev = Some(mm);
-                    mm * rpm
-                } else {
-                    mm
-                });
-            }
-            ClEvent::Units(units) => {
-                job.scale = match units {
-                    Units::Mm => 1.0,
-                    Units::Inch => 25.4,
-                };
-            }
-            ClEvent::PartNo(name) => {
-                if !named && !name.trim().is_empty() {
-                    job.info.program_name = name.trim().to_string();
-                    named = true;
-                }
-            }
-            ClEvent::ToolPath { name, words } => {
-                if !named && !name.trim().is_empty() {
-                    job.info.program_name = name.trim().to_string();
-                    named = true;
-                }
-                if let Some(pos) = words.iter().position(|w| w.eq_ignore_ascii_case("TOOL"))
-                    && let Some(tool) = words.get(pos + 1)
-                {
-                    job.info.tool = tool.clone();
-                }
-                job.break_segment();
-                job.emit(Output::Comment(format!("TOOL PATH: {name}")), &reader)?;
-            }
-            ClEvent::Comment(text) => {
-                job.emit(Output::Comment(text.trim().to_string()), &reader)?
-            }
-            ClEvent::LoadTool { number } => {
-                job.break_segment();
-                // The header loads the first tool (it knows `tool_number`).
-                if !tool_loaded && job.setup.is_none() {
-                    job.info.tool_number = number;
-                } else {
-                    job.emit(Output::ToolChange(number, job.info.tool.clone()), &reader)?;
-                }
-                tool_loaded = true;
-            }
-            ClEvent::SelectTool { .. } => {}
-            ClEvent::Spindle { rpm, dir } => {
-                job.rpm = Some(rpm);
-                if let Some(per_rev) = job.feed_per_rev {
-                    job.feed = Some(per_rev * rpm);
-                }
-                let state = match dir {
-                    SpindleDir::Clockwise => Spindle::Cw(rpm),
-                    SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
-                };
-                job.emit(Output::Spindle(state), &reader)?
-            }
-            ClEvent::SpindleOff => job.emit(Output::Spindle(Spindle::Off), &reader)?,
-            ClEvent::Coolant { on, mode } => {
-                job.emit(Output::Coolant(on.then_some(mode)), &reader)?
-            }
-            ClEvent::Insert(text) => job.emit(Output::Insert(text), &reader)?,
-            ClEvent::EndOfPath => job.break_segment(),
-            ClEvent::Pressure { word, value } => {
-                job.pressure(word.as_deref(), value, &reader, &mut warnings)?;
-            }
-            ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
-            ClEvent::Fini => break,
         }
     }
+    let mut warnings = reading.warnings;
     job.open(false)?;
     let Some(mut setup) = job.setup.take() else {
         unreachable!("`open` sets the job up")
@@ -438,6 +343,125 @@ pub fn post<R: BufRead, W: Write>(
         seconds: started.elapsed().as_secs_f64(),
         planning,
     })
+}
+
+/// What the reading of the CL keeps besides the job.
+struct Reading {
+    warnings: Vec<Diagnostic>,
+    remarked: Remarked,
+    /// The program has its name (from the options, `PARTNO` or the first
+    /// `TOOL PATH`).
+    named: bool,
+    tool_loaded: bool,
+}
+
+/// A CL statement other than a plain `GOTO` line: `false` at `FINI`.
+#[inline(never)]
+fn statement<R: BufRead, W: Write>(
+    job: &mut Job<'_, W>,
+    r: &mut Reading,
+    statement: Statement,
+    reader: &ClReader<R>,
+) -> Result<bool, PostError> {
+    let line = statement.line;
+    match statement.event {
+        ClEvent::Goto {
+            point,
+            axis,
+            reference,
+            motion,
+        } => {
+            let goto = Move {
+                line,
+                point,
+                axis,
+                reference,
+                motion,
+            };
+            job.goto(&goto, reader, &mut r.warnings, &mut r.remarked)?;
+        }
+        ClEvent::Feedrate { value, unit } => {
+            let mm = match unit {
+                FeedUnit::Mmpm | FeedUnit::Mmpr => value,
+                FeedUnit::Ipm | FeedUnit::Ipr => value * 25.4,
+            };
+            job.feed_per_rev = None;
+            job.feed = Some(if matches!(unit, FeedUnit::Mmpr | FeedUnit::Ipr) {
+                // The feed word is per minute: per revolution times the
+                // spindle speed, now and after every speed change.
+                let Some(rpm) = job.rpm else {
+                    return Err(reader
+                        .statement_diagnostic(
+                            Severity::Error,
+                            "a feed per revolution needs the spindle speed: give SPINDL/rpm before it",
+                        )
+                        .into());
+                };
+                job.feed_per_rev = Some(mm);
+                mm * rpm
+            } else {
+                mm
+            });
+        }
+        ClEvent::Units(units) => {
+            job.scale = match units {
+                Units::Mm => 1.0,
+                Units::Inch => 25.4,
+            };
+        }
+        ClEvent::PartNo(name) => {
+            if !r.named && !name.trim().is_empty() {
+                job.info.program_name = name.trim().to_string();
+                r.named = true;
+            }
+        }
+        ClEvent::ToolPath { name, words } => {
+            if !r.named && !name.trim().is_empty() {
+                job.info.program_name = name.trim().to_string();
+                r.named = true;
+            }
+            if let Some(pos) = words.iter().position(|w| w.eq_ignore_ascii_case("TOOL"))
+                && let Some(tool) = words.get(pos + 1)
+            {
+                job.info.tool = tool.clone();
+            }
+            job.break_segment();
+            job.emit(Output::Comment(format!("TOOL PATH: {name}")), reader)?;
+        }
+        ClEvent::Comment(text) => job.emit(Output::Comment(text.trim().to_string()), reader)?,
+        ClEvent::LoadTool { number } => {
+            job.break_segment();
+            // The header loads the first tool (it knows `tool_number`).
+            if !r.tool_loaded && job.setup.is_none() {
+                job.info.tool_number = number;
+            } else {
+                job.emit(Output::ToolChange(number, job.info.tool.clone()), reader)?;
+            }
+            r.tool_loaded = true;
+        }
+        ClEvent::SelectTool { .. } => {}
+        ClEvent::Spindle { rpm, dir } => {
+            job.rpm = Some(rpm);
+            if let Some(per_rev) = job.feed_per_rev {
+                job.feed = Some(per_rev * rpm);
+            }
+            let state = match dir {
+                SpindleDir::Clockwise => Spindle::Cw(rpm),
+                SpindleDir::CounterClockwise => Spindle::Ccw(rpm),
+            };
+            job.emit(Output::Spindle(state), reader)?
+        }
+        ClEvent::SpindleOff => job.emit(Output::Spindle(Spindle::Off), reader)?,
+        ClEvent::Coolant { on, mode } => job.emit(Output::Coolant(on.then_some(mode)), reader)?,
+        ClEvent::Insert(text) => job.emit(Output::Insert(text), reader)?,
+        ClEvent::EndOfPath => job.break_segment(),
+        ClEvent::Pressure { word, value } => {
+            job.pressure(word.as_deref(), value, reader, &mut r.warnings)?;
+        }
+        ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
+        ClEvent::Fini => return Ok(false),
+    }
+    Ok(true)
 }
 
 impl<W: Write> Job<'_, W> {
@@ -608,9 +632,11 @@ impl<W: Write> Job<'_, W> {
         Ok(())
     }
 
-    /// Writes an NC output in its place among the points (once the program
-    /// is set up).
-    /// Writes `output` of the current CL statement in its place.
+    /// Writes `output` of the current CL statement in its place among the
+    /// points (once the program is set up). Out of line: six statements
+    /// call it, and copies of it inlined into `post` crowd the registers of
+    /// the loop that reads the points.
+    #[inline(never)]
     fn emit<R: BufRead>(&mut self, output: Output, reader: &ClReader<R>) -> Result<(), PostError> {
         let p = Pending {
             output,
