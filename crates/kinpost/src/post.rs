@@ -273,6 +273,7 @@ pub fn post<R: BufRead, W: Write>(
         remarked: Remarked::default(),
         named: options.program_name.is_some(),
         tool_loaded: false,
+        spindle_tool: None,
     };
     // The loop over the points stays small: every other statement is read
     // out of line (`statement`), so that what it does cannot crowd the
@@ -353,6 +354,8 @@ struct Reading {
     /// `TOOL PATH`).
     named: bool,
     tool_loaded: bool,
+    /// The tool changed to last (`None`: the header's, `tool_number`).
+    spindle_tool: Option<u32>,
 }
 
 /// A CL statement other than a plain `GOTO` line: `false` at `FINI`.
@@ -434,9 +437,12 @@ fn statement<R: BufRead, W: Write>(
             // The header loads the first tool (it knows `tool_number`).
             if !r.tool_loaded && job.setup.is_none() {
                 job.info.tool_number = number;
-            } else {
+            } else if number != r.spindle_tool.unwrap_or(job.info.tool_number) {
                 job.emit(Output::ToolChange(number, job.info.tool.clone()), reader)?;
+                r.spindle_tool = Some(number);
             }
+            // (The tool in the spindle again, as CAM systems write at the
+            // start of every operation: no tool change cycle.)
             r.tool_loaded = true;
         }
         ClEvent::SelectTool { .. } => {}

@@ -665,6 +665,17 @@ fn inverse_time_starts_where_the_start_is_known() {
 }
 
 #[test]
+fn loading_the_tool_in_the_spindle_again_is_no_tool_change() {
+    // CAM systems write LOAD/TOOL at the start of every operation, the
+    // same tool too: only a different tool is a tool change cycle.
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nLOAD/TOOL,1\nFEDRAT/MMPM,100\nGOTO/0,0,10\n\
+              LOAD/TOOL,2\nGOTO/10,0,10\nLOAD/TOOL,2\nGOTO/20,0,10\nLOAD/TOOL,1\nGOTO/30,0,10\n";
+    let nc = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap();
+    let changes: Vec<&str> = nc.lines().filter(|l| l.contains("M06")).collect();
+    assert_eq!(changes, ["T1 M06", "T2 M06", "T1 M06"], "{nc}");
+}
+
+#[test]
 fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
     // Fanuc's feed word has too few decimals for 0.0001 mm/min: F0.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,0.0001\nGOTO/0,0,10\n";
