@@ -150,6 +150,10 @@ pub struct CommentSyntax {
     /// Replacements applied to the text, e.g. `(` → `[`; line breaks always
     /// become spaces.
     pub replace: Vec<(String, String)>,
+    /// The controller reads ASCII only: control characters (a tab) become
+    /// blanks and anything beyond ASCII `?` (the template filter `ascii`
+    /// does the same for template text).
+    pub ascii: bool,
 }
 
 /// The templates a dialect may define.
@@ -586,6 +590,7 @@ impl Dialect {
                 prefix: raw.comment.prefix,
                 suffix: raw.comment.suffix,
                 replace,
+                ascii: raw.comment.ascii,
             },
             templates,
             env: Arc::new(env),
@@ -1117,6 +1122,8 @@ struct RawComment {
     suffix: String,
     #[serde(default)]
     replace: BTreeMap<String, String>,
+    #[serde(default)]
+    ascii: bool,
 }
 
 impl Default for RawComment {
@@ -1126,6 +1133,7 @@ impl Default for RawComment {
             prefix: semicolon(),
             suffix: String::new(),
             replace: BTreeMap::new(),
+            ascii: false,
         }
     }
 }

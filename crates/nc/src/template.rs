@@ -24,7 +24,22 @@ pub(crate) fn environment() -> Environment<'static> {
     env.set_debug(true);
     env.add_filter("num", num);
     env.add_filter("name", name);
+    env.add_filter("ascii", ascii);
     env
+}
+
+/// `{{ text | ascii }}`: text for a controller that reads ASCII only (a
+/// Fanuc): control characters (a tab) become blanks, anything beyond ASCII
+/// `?`.
+pub fn ascii(value: &str) -> String {
+    value
+        .chars()
+        .map(|c| match c {
+            c if c.is_ascii_control() => ' ',
+            c if c.is_ascii() => c,
+            _ => '?',
+        })
+        .collect()
 }
 
 /// `{{ program_name | name }}`: a name every controller takes as one word:
@@ -289,6 +304,18 @@ mod tests {
             )
             .unwrap();
         assert_eq!(got, "TEST__V2____A_B_Geh_use-1");
+    }
+
+    #[test]
+    fn ascii_filter() {
+        let env = environment();
+        let got = env
+            .render_str(
+                "{{ n | ascii }}",
+                minijinja::context! { n => "Gehäuse\tTeil – 1" },
+            )
+            .unwrap();
+        assert_eq!(got, "Geh?use Teil ? 1");
     }
 
     #[test]

@@ -638,6 +638,9 @@ impl<W: Write> NcWriter<W> {
         }
         self.buf.extend_from_slice(self.comment.prefix.as_bytes());
         let mut body: String = text.replace(['\r', '\n'], " ");
+        if self.comment.ascii {
+            body = crate::template::ascii(&body);
+        }
         for (from, to) in &self.comment.replace {
             if body.contains(from.as_str()) {
                 body = body.replace(from.as_str(), to);

@@ -1032,3 +1032,22 @@ fn lines_fit_the_dialect_max_line_length() {
     assert!(e.to_string().contains("CL line 7"), "{e}");
     assert_eq!(text(w), "N10 T12 (TOOL BALL)\nN20 (a remark long)\n");
 }
+
+#[test]
+fn fanuc_comments_and_header_names_are_ascii() {
+    // A Fanuc reads ISO code: a tab or a character beyond ASCII in a
+    // comment (from a CL `$$` or PARTNO) would stop the program loading.
+    let d = Dialect::builtin("fanuc").unwrap();
+    let axes = [AxisSpec::linear("X")];
+    let mut w = NcWriter::new(&d, &axes, Vec::new());
+    let info = ProgramInfo {
+        program_name: "Gehäuse (5x)".into(),
+        ..Default::default()
+    };
+    w.header(&info, None).unwrap();
+    w.comment("Schrupp\tfräsen").unwrap();
+    let out = String::from_utf8(w.finish().unwrap()).unwrap();
+    assert!(out.contains("O0001 (Geh?use [5x])\n"), "{out}");
+    assert!(out.contains("(Schrupp fr?sen)\n"), "{out}");
+    assert!(out.is_ascii(), "{out}");
+}
