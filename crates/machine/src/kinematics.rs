@@ -910,32 +910,39 @@ impl Kinematics {
         out: &mut Vec<Solution>,
     ) {
         let mut joints = self.fixed;
-        // Arrays of the slots there are: no setup of unused ones.
+        // Arrays of the slots there are: no setup of unused ones. (The
+        // rotary values go into the joints only as a solution is pushed:
+        // the linear solve reads the angles' cosines and sines, and the
+        // joints written in pieces just before being read whole stall the
+        // processor.)
         let mut ranges = [SlotRange::default(); N];
         for ((slot, a), r) in self.slots.iter().zip(&mut b.angles).zip(&mut ranges) {
             *r = slot.range(a.in_degrees(), hint);
-            joints[slot.axis] = r.raw;
         }
         if self.solve_linear(&mut joints, &b.angles, point) {
             self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
         }
     }
 
-    /// With every rotary angle set in `q` (and their cosines and sines in
-    /// `angles`, by slot), solves the free linear axes so that the tool
-    /// point lands on `target` (part frame), in place (no copies of the
-    /// joints in and out); `false` when they cannot.
+    /// With the cosines and sines of the rotary angles in `angles` (by
+    /// slot), solves the free linear axes so that the tool point lands on
+    /// `target` (part frame), into `q` (no copies of the joints in and
+    /// out; its other values are those of `self.fixed`); `false` when they
+    /// cannot.
     ///
     /// (Inlined for the precomputed solve of most machines, the general one
     /// out of line.)
     #[inline(always)]
     fn solve_linear(&self, q: &mut Joints, angles: &[SlotAngle], target: &V3) -> bool {
-        // Bring the target inside the steps outside the linear axes.
+        // Bring the target inside the steps outside the linear axes. (The
+        // values of locked axes are read from `self.fixed`, which `q`
+        // starts as: `q` was just written, and reading it back in other
+        // pieces than it was written in stalls the processor.)
         let mut y = *target;
         for step in &self.steps[..self.split] {
             match step {
                 // Locked linear axes only: the split is at the first free one.
-                Step::Linear { axis, dir, .. } => y -= dir * q[*axis],
+                Step::Linear { axis, dir, .. } => y -= dir * self.fixed[*axis],
                 Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
             }
         }
@@ -946,7 +953,7 @@ impl Kinematics {
         let mut point = self.tip;
         for step in self.inner_fixed.iter().rev() {
             match step {
-                Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                Step::Linear { axis, dir, .. } => point += dir * self.fixed[*axis],
                 Step::Rotary(t) => point = t.move_point(&turned(angles, t), &point),
             }
         }
@@ -979,7 +986,7 @@ impl Kinematics {
                     dir,
                     ..
                 } => c[*k] = *dir,
-                Step::Linear { axis, dir, .. } => point += dir * q[*axis],
+                Step::Linear { axis, dir, .. } => point += dir * self.fixed[*axis],
                 Step::Rotary(t) => {
                     let r = &turned(angles, t);
                     point = t.move_point(r, &point);
@@ -1043,6 +1050,9 @@ impl Kinematics {
     ) {
         if let Some(slot) = ranges.iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
+            for (s, r) in self.slots.iter().zip(ranges) {
+                joints[s.axis] = r.raw;
+            }
             out.push(Solution {
                 joints,
                 branch,
@@ -1059,15 +1069,18 @@ impl Kinematics {
         let violation = self.linear_violation(&joints);
         let mut turn: [f64; N] = ranges.map(|r| r.first);
         loop {
-            for k in 0..N {
-                joints[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
-            }
+            // Pushed, then its rotary values written in place (not into
+            // `joints` and copied whole right after: see `solve_branch`).
             out.push(Solution {
                 joints,
                 branch,
                 singular,
                 violation,
             });
+            let pushed = &mut out.last_mut().expect("just pushed").joints;
+            for k in 0..N {
+                pushed[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
+            }
             if violation.is_some() {
                 return;
             }
