@@ -601,6 +601,11 @@ impl<W: Write> Emitter<W> {
     /// its maximum velocity; the word says that time in the feed mode's
     /// terms.
     fn feed_word(&mut self, feed: f64, node: &Node, values: &Joints, line: usize) -> f64 {
+        // At the tool point, only a maximum velocity can make a block
+        // slower than the CL feed rate.
+        if self.settings.feed_mode == FeedMode::Tip && self.vmax.is_empty() {
+            return feed;
+        }
         let Some(last) = self.last.as_ref().filter(|_| !self.start_unknown) else {
             return feed;
         };

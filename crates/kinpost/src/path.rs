@@ -189,7 +189,7 @@ impl PathPlan {
             self.segment += 1;
             self.free = true;
         }
-        let pole = self.singularity.map(|s| Pole(s.sin_cos(&pose.axis)));
+        let pole = self.singularity.map(|s| Pole::new(&s, &pose.axis));
         if let Some(axis) = &self.previous_axis {
             let reference = &self.previous_reference;
             let axis_turn = angle_between_deg(axis, &pose.axis);
@@ -573,36 +573,66 @@ impl PathPlan {
 /// settled by a lower bound, without the `atan2` of
 /// [`Singularity::distance`], which is exact (the same bits) where the
 /// bound does not settle them.
+///
+/// The sine term is kept squared: far from the pole, the tests are settled
+/// without its square root ([`Pole::surely_beyond`]).
 #[derive(Debug, Clone, Copy)]
-struct Pole((f64, f64));
+struct Pole {
+    /// `|d × a|²` (the square of [`Singularity::sin_cos`]'s first term).
+    sin2: f64,
+    /// `|d · a|`.
+    cos: f64,
+}
 
 impl Pole {
     /// Relative slack of the lower bound: far above the rounding of the
     /// bound and of `atan2` (a few ulp each).
     const SLACK: f64 = 1e-12;
 
+    fn new(s: &Singularity, axis: &Vector3<f64>) -> Pole {
+        Pole {
+            sin2: s.direction.cross(axis).norm_squared(),
+            cos: s.direction.dot(axis).abs(),
+        }
+    }
+
+    /// The sine term, `|d × a|` (the same bits as [`Singularity::sin_cos`]).
+    fn sin(self) -> f64 {
+        self.sin2.sqrt()
+    }
+
     /// The angle, radians (as [`Singularity::distance`]).
     fn exact_rad(self) -> f64 {
-        let (s, c) = self.0;
-        atan2_rad(s, c)
+        atan2_rad(self.sin(), self.cos)
     }
 
     /// A lower bound of the angle, radians: its sine `s / √(s² + c²)` is at
     /// least `s / max(s² + c², 1)`, and an angle of [0, π/2] is at least its
     /// sine.
     fn lower_rad(self) -> f64 {
-        let (s, c) = self.0;
+        let (s, c) = (self.sin(), self.cos);
         s / (s * s + c * c).max(1.0) * (1.0 - Self::SLACK)
+    }
+
+    /// The lower bound is surely above `rad`, without a square root: with
+    /// `s² + c² ≤ 1.0001` (a unit tool axis) the bound is at least
+    /// `0.99989·s`, and `s² · 0.9996 > rad²` makes `s` above `rad / 0.9998`.
+    /// (`false` says nothing.)
+    fn surely_beyond(self, rad: f64) -> bool {
+        self.sin2 + self.cos * self.cos <= 1.0001 && self.sin2 * 0.9996 > rad * rad
     }
 
     /// Whether the angle is below `cone_rad`.
     fn within(self, cone_rad: f64) -> bool {
-        self.lower_rad() < cone_rad && self.exact_rad() < cone_rad
+        !self.surely_beyond(cone_rad) && self.lower_rad() < cone_rad && self.exact_rad() < cone_rad
     }
 
     /// Whether the two angles, in degrees, add up to at most `limit`.
     fn sum_within(a: Pole, b: Pole, limit: f64) -> bool {
-        (a.lower_rad() + b.lower_rad()).to_degrees() <= limit
+        let limit_rad = limit.to_radians();
+        !a.surely_beyond(limit_rad)
+            && !b.surely_beyond(limit_rad)
+            && (a.lower_rad() + b.lower_rad()).to_degrees() <= limit
             && a.exact_rad().to_degrees() + b.exact_rad().to_degrees() <= limit
     }
 }
@@ -689,7 +719,8 @@ mod tests {
             let a = unit(a);
             let b = (s.direction + near * unit(b)).normalize();
             let nudge = |x: f64| f64::from_bits((x.to_bits() as i64 + ulps) as u64);
-            let (pa, pb) = (Pole(s.sin_cos(&a)), Pole(s.sin_cos(&b)));
+            let (pa, pb) = (Pole::new(&s, &a), Pole::new(&s, &b));
+            proptest::prop_assert_eq!(pa.sin().to_bits(), s.sin_cos(&a).0.to_bits());
             for (pole, axis) in [(pa, &a), (pb, &b)] {
                 let exact = s.distance(axis);
                 proptest::prop_assert_eq!(pole.exact_rad().to_bits(), exact.to_bits());
