@@ -199,14 +199,53 @@ impl<W: Write> Emitter<W> {
         if let Some(last) = &mut self.last
             && last.pressure.to_bits() != t.pressure.to_bits()
         {
-            // The wheel moved with the pressure: the last block's axes put
-            // the contact point elsewhere now, and the move starts there.
-            let here = kin.fk(&last.node.joints[..self.n]);
-            last.node.pose = Pose {
-                reference: last.node.pose.reference.and(here.reference),
-                ..here
+            // The wheel moves with the pressure (seed 001): the last block's
+            // axes put the contact point elsewhere now. Before a feed move,
+            // the axes bring it back onto the last point first, in a block
+            // of its own with the new pressure word; otherwise (a rapid
+            // follows, or the point cannot be reached at the new pressure)
+            // the move starts where the contact point went.
+            let near = Near {
+                joints: &last.node.joints,
+                hold: last.node.hold,
+                branch: Some(last.node.branch),
             };
-            last.lever = f64::INFINITY;
+            let back = match t.motion {
+                Motion::Feed => solve_near(
+                    kin,
+                    &last.node.pose,
+                    &near,
+                    &self.rotary,
+                    &mut self.solutions,
+                ),
+                Motion::Rapid => None,
+            };
+            if let Some((pose, sol)) = back {
+                let node = Node {
+                    pose,
+                    joints: sol.joints,
+                    hold: last.node.hold,
+                    branch: sol.branch,
+                };
+                self.block(
+                    machine,
+                    kin,
+                    &node,
+                    Motion::Feed,
+                    None,
+                    t.line,
+                    t.feed,
+                    t.at,
+                )?;
+                self.planning.inserted_blocks += 1;
+            } else {
+                let here = kin.fk(&last.node.joints[..self.n]);
+                last.node.pose = Pose {
+                    reference: last.node.pose.reference.and(here.reference),
+                    ..here
+                };
+                last.lever = f64::INFINITY;
+            }
         }
         if let Some(last) = &self.last
             && t.motion == Motion::Feed

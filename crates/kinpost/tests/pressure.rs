@@ -322,16 +322,39 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let mut seen = 0;
     let mut cache: Vec<(Option<f64>, Kinematics)> = Vec::new();
+    // What each block reaches, in order (for the NC read back below).
+    let mut reached: Vec<Pose> = Vec::new();
+    let mut previous: Option<usize> = None;
     for row in rows {
         let f: Vec<&str> = row.split(',').collect();
-        let line: usize = f[col("line")].parse().unwrap();
-        let (pose, p) = want[line].expect("a GOTO line");
-        // The pressure column: the one in force, empty when none.
+        // A block the post inserted (no linearization here): at a change
+        // of pressure, the move back onto the last point with the wheel
+        // where the new pressure puts it.
+        let cl_line: Option<usize> = f[col("line")].parse().ok();
+        let line = cl_line.or(previous).expect("a block after a CL point");
+        let (pose, in_force) = want[line].expect("a GOTO line");
+        previous = Some(line);
+        reached.push(pose);
+        // The pressure column: the one in force, empty when none (that of
+        // the next point for a move back).
         let written = match f[col(&g.word)] {
             "" => None,
             v => Some(v.parse::<f64>().unwrap()),
         };
-        prop_assert_eq!(written, p, "line {}", line);
+        let p = match cl_line {
+            Some(_) => {
+                prop_assert_eq!(written, in_force, "line {}", line);
+                in_force
+            }
+            None => {
+                prop_assert!(
+                    written != in_force,
+                    "a move back without a change, line {}",
+                    line
+                );
+                written
+            }
+        };
         let values: Vec<f64> = machine
             .axes
             .iter()
@@ -363,7 +386,7 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
             (miss - offset).abs() <= summary.tolerance_mm + 1e-8,
             "line {line}: {miss} vs offset {offset}"
         );
-        seen += 1;
+        seen += usize::from(cl_line.is_some());
     }
     prop_assert_eq!(seen, 40);
     // Pressures outside the calibration are warned about.
@@ -388,9 +411,8 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
     let axes = kinpost::axis_specs(&machine);
     let blocks = read_program(&Dialect::builtin("sinumerik").unwrap(), &axes, "r.mpf", &nc)
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
-    let poses: Vec<&(Pose, Option<f64>)> = want.iter().flatten().collect();
-    prop_assert_eq!(blocks.len(), poses.len());
-    for (b, (pose, _)) in blocks.iter().zip(&poses) {
+    prop_assert_eq!(blocks.len(), reached.len());
+    for (b, pose) in blocks.iter().zip(&reached) {
         let values: Vec<f64> = b.axes[..5].iter().map(|v| v.unwrap()).collect();
         // Sinumerik writes whole pressures: the wheel is where the
         // written value puts it.
@@ -535,8 +557,15 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
     // The job's poses, and a CL that changes the pressure between them.
     let mut cl = String::new();
     let mut poses = Vec::new();
+    // What the blocks reach, in order: before a feed move at another
+    // pressure, the move back onto the last point at the new one.
+    let mut reached: Vec<(Pose, f64)> = Vec::new();
+    let mut rapid = false;
     let pressures = [3000.0, 3100.0, 3475.0, 3600.0, 2500.0];
     for (k, line) in job.lines().enumerate() {
+        if line.trim() == "RAPID" {
+            rapid = true;
+        }
         if let Some(v) = line.strip_prefix("GOTO/") {
             let h1 = pressures[poses.len() % pressures.len()];
             cl.push_str(&format!("PRESSURE/H1,{h1}\n"));
@@ -546,7 +575,15 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
                 axis: Vector3::new(v[3], v[4], v[5]).normalize(),
                 reference: None,
             };
+            if let Some(&(last, h0)) = reached.last()
+                && h0 != h1
+                && !rapid
+            {
+                reached.push((last, h1));
+            }
+            reached.push((pose, h1));
             poses.push((pose, h1, k));
+            rapid = false;
         }
         cl.push_str(line);
         cl.push('\n');
@@ -562,25 +599,11 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
         let (nc, summary) = post_text(&cl, &machine, dialect, &PostOptions::default()).unwrap();
         let d = Dialect::builtin(dialect).unwrap();
         let blocks = read_program(&d, &kinpost::axis_specs(&machine), "job", &nc).unwrap();
-        let blocks = &blocks[blocks.len() - poses.len()..];
-        for (b, (want, h1, _)) in blocks.iter().zip(&poses) {
+        let blocks = &blocks[blocks.len() - reached.len()..];
+        for (b, (want, h1)) in blocks.iter().zip(&reached) {
             assert_eq!(b.axes[6], Some(*h1), "{dialect} line {}", b.line);
             let q: Vec<f64> = b.axes[..6].iter().map(|v| v.unwrap_or(0.0)).collect();
-            // The wheel offset of the block's pressure: the linkage of the
-            // mts1600 file, L = 250 mm, α from its calibration, plane Y Z
-            // with home directions −y and +z.
-            let alpha =
-                |h: f64| lerp(&[[3000.0, -6.73], [3250.0, -5.0], [3600.0, 5.0]], h, 1).to_radians();
-            let (a, r) = (alpha(*h1), alpha(3475.0));
-            let offset = Vector3::new(
-                0.0,
-                -250.0 * (a.cos() - r.cos()),
-                250.0 * (a.sin() - r.sin()),
-            );
-            let mut at = machine.clone();
-            at.pressure = None;
-            at.tool.point += offset;
-            let got = Kinematics::new(&at).fk(&q);
+            let got = Kinematics::new(&mts1600_at(*h1)).fk(&q);
             let dp = (got.point - want.point).norm();
             // The CL itself is rounded to 4 / 7 decimals.
             assert!(
@@ -589,6 +612,61 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
             );
             assert!(angle(&got.axis, &want.axis) <= summary.tolerance_rad + 1e-6);
         }
+    }
+}
+
+/// mts1600 with its wheel where pressure `h1` puts it (the linkage of the
+/// mts1600 file, L = 250 mm, α from its calibration, plane Y Z with home
+/// directions −y and +z), as a machine without a pressure axis.
+fn mts1600_at(h1: f64) -> Machine {
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let alpha = |h: f64| lerp(&[[3000.0, -6.73], [3250.0, -5.0], [3600.0, 5.0]], h, 1).to_radians();
+    let (a, r) = (alpha(h1), alpha(3475.0));
+    let mut at = machine;
+    at.pressure = None;
+    at.tool.point += Vector3::new(
+        0.0,
+        -250.0 * (a.cos() - r.cos()),
+        250.0 * (a.sin() - r.sin()),
+    );
+    at
+}
+
+#[test]
+fn a_pressure_change_between_two_points_keeps_the_contact_point_on_the_cl() {
+    // The wheel drops by tens of millimetres from the reference to 3000:
+    // the axes bring the contact point back onto the first point before
+    // the cut to the second, and the blocks the linearization inserts
+    // follow the CL segment at the pressure they are written with.
+    let machine = builtin::load("mts1600").unwrap().unwrap();
+    let cl = "FEDRAT/MMPM,300\nGOTO/-416,70,10,0.2,-0.1,0.9746794\nPRESSURE/H1,3000\n\
+              GOTO/-406,67,10.5,0.3,-0.2,0.9327379\n";
+    let lintol = 0.002;
+    let options = PostOptions {
+        lintol_mm: Some(lintol),
+        ..Default::default()
+    };
+    let (csv, summary) = post_text(cl, &machine, "csv", &options).unwrap();
+    let (a, b) = (
+        Vector3::new(-416.0, 70.0, 10.0),
+        Vector3::new(-406.0, 67.0, 10.5),
+    );
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|r| r.split(',').collect())
+        .collect();
+    assert!(rows.len() > 3, "{csv}");
+    for f in &rows {
+        let h1 = f[8].parse::<f64>().unwrap_or(3475.0);
+        let q: Vec<f64> = f[2..8].iter().map(|v| v.parse().unwrap()).collect();
+        let p = Kinematics::new(&mts1600_at(h1)).fk(&q).point;
+        let t = ((p - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+        let off = (a + (b - a) * t - p).norm();
+        assert!(
+            off <= lintol + summary.tolerance_mm + 1e-4,
+            "{off} mm off the CL segment at H1={h1}: {f:?}\n{csv}"
+        );
     }
 }
 
