@@ -12,7 +12,9 @@ use std::ops::Range;
 
 use kinpost_diag::Diagnostic;
 use kinpost_machine::angle::{atan2_deg, atan2_rad};
-use kinpost_machine::{Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_machine::{
+    Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, Wrap,
+};
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
 use nalgebra::Vector3;
@@ -70,6 +72,8 @@ pub(crate) struct PathPlan {
     /// Singular cone half-angle, rad (0: only exactly singular points).
     cone_rad: f64,
     rotary: Vec<usize>,
+    /// Free rotary axes with `wrap = "unwind"`.
+    unwind: Vec<usize>,
     names: Vec<String>,
     file: String,
     /// The waiting points, in path order. The buffers of the plan keep their
@@ -128,6 +132,10 @@ impl PathPlan {
             singularity: kin.singularity(),
             cone_rad: cone_deg.to_radians(),
             rotary: machine.free_rotary_axes().collect(),
+            unwind: machine
+                .free_rotary_axes()
+                .filter(|&i| axes[i].wrap == Wrap::Unwind)
+                .collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
             file: file.to_string(),
             points: Vec::new(),
@@ -220,8 +228,15 @@ impl PathPlan {
         self.previous_reference = pose.reference;
         self.previous_pole = pole;
         // The hint picks the turn of axes without limits: near the cheapest
-        // configuration of the previous point.
-        let hint: Joints = self.trellis.best_last().copied().unwrap_or([0.0; MAX_AXES]);
+        // configuration of the previous point; at the start of a segment,
+        // near zero for the axes that unwind there (the turn nearest zero
+        // is then among the candidates however far the last cut turned).
+        let mut hint: Joints = self.trellis.best_last().copied().unwrap_or([0.0; MAX_AXES]);
+        if starts_segment {
+            for &i in &self.unwind {
+                hint[i] = 0.0;
+            }
+        }
         let n = kin.axis_count();
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
             .map_err(|e| PointError::Ik(e.to_string()))?;

@@ -287,6 +287,41 @@ fn limits_of_more_than_a_turn_are_kept_unless_the_axis_is_modulo() {
     );
 }
 
+/// A C axis without limits that unwinds (`wrap = "unwind"`) is back at
+/// the turn nearest zero at the start of the next segment, however far the
+/// last cut turned it (before: only the turns within 210° of the last
+/// point were candidates).
+#[test]
+fn an_unwinding_axis_without_limits_unwinds_after_two_turns() {
+    let source = builtin::source("trunnion-ac").unwrap().replace(
+        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+        "point = [0, 0, 0]\nwrap = \"unwind\"",
+    );
+    let m = machine_from_toml(&source, "unwind-c.toml").unwrap();
+    let ic = m.axis_index("C").unwrap();
+    assert_eq!(m.axes[ic].limits, None);
+    let tilt = 20f64.to_radians();
+    let at = |phi: f64| {
+        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
+        goto(
+            &Vector3::new(40.0 * phi.cos(), 40.0 * phi.sin(), 0.0),
+            &axis,
+        )
+    };
+    let mut cl = String::from("FEDRAT/MMPM,500\n");
+    for k in 0..=144 {
+        cl.push_str(&at((5.0 * k as f64).to_radians()));
+    }
+    cl.push_str("RAPID\n");
+    cl.push_str(&at(0.0));
+    let (csv, _) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    let all = rows(&csv, m.axes.len());
+    let turned = all.iter().map(|r| r.2[ic].abs()).fold(0.0, f64::max);
+    assert!(turned > 600.0, "the cut turns C twice: {turned}°");
+    let last = all.last().unwrap().2[ic];
+    assert!(last.abs() <= 180.0, "C {last}° after the rapid");
+}
+
 /// Tool axis tilted 25° turning about the part's Z by 270°: more than C's
 /// range on either A branch.
 fn long_turn() -> String {
