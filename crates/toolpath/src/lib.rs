@@ -22,7 +22,9 @@
 //!   width); the scallop is the largest over X of the smaller clearance. A negative clearance is
 //!   the wheel's edge cutting under the design surface (a concave section
 //!   across the pass, where a rigid straight wheel would gouge; real contact
-//!   wheels yield), reported as the wheel-edge interference.
+//!   wheels yield), reported as the wheel-edge interference, looked for
+//!   over each wheel's whole width (out to its edges, beyond the
+//!   neighbouring pass when the step is smaller than half the width).
 //!
 //! Passes start and end with a lead along the normal and are joined by
 //! rapids. [`cl::write_cl`] writes the NX-style CL file, [`plot::plot_path`]

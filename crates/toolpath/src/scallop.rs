@@ -199,17 +199,21 @@ pub fn gap(
             g.scallop = f64::INFINITY;
             continue;
         };
-        g.stepover = g.stepover.max((fa.point - fb.point).norm());
+        let step = (fa.point - fb.point).norm();
+        g.stepover = g.stepover.max(step);
+        // The clearance to one wheel (`b` or else `a`) of the surface point
+        // a fraction `q` of the way from pass `a` to pass `b` (across, at
+        // the same `s`).
+        let clearance_at = |q: f64, to_b: bool| {
+            let cross = a.cross + (b.cross - a.cross) * q;
+            let x = PassCurve { cross, ..*a }.frame(surface, s)?;
+            let pass = if to_b { b } else { a };
+            let f = foot_point(surface, pass, &x.point, s)?;
+            clearance(wheel, &f, &x.point, &x.normal)
+        };
         for k in 1..=between {
             let q = k as f64 / (between + 1) as f64;
-            let cross = a.cross + (b.cross - a.cross) * q;
-            let mid = PassCurve { cross, ..*a };
-            let Some(x) = mid.frame(surface, s) else {
-                continue;
-            };
-            let (n, x) = (x.normal, x.point);
-            let ca = foot_point(surface, a, &x, s).and_then(|f| clearance(wheel, &f, &x, &n));
-            let cb = foot_point(surface, b, &x, s).and_then(|f| clearance(wheel, &f, &x, &n));
+            let (ca, cb) = (clearance_at(q, false), clearance_at(q, true));
             let left = match (ca, cb) {
                 (Some(p), Some(q)) => p.min(q),
                 (Some(p), None) | (None, Some(p)) => p,
@@ -218,6 +222,31 @@ pub fn gap(
             g.scallop = g.scallop.max(left.max(0.0));
             for c in [ca, cb].into_iter().flatten() {
                 g.interference = g.interference.max(-c);
+            }
+        }
+        // A wheel's edges reach half its width from its contact point:
+        // beyond the neighbouring pass when the step is smaller. Each
+        // wheel's interference is also looked for out to its edges, both
+        // sides (a fixed number of points, the edges themselves included;
+        // the scallop only between the passes).
+        let reach = if step > 0.0 {
+            0.5 * wheel.width / step
+        } else {
+            0.0
+        };
+        if reach > 0.0 && reach.is_finite() {
+            let out = between / 2 + 1;
+            // Evenly out to the edge, and just inside it: the reach counts
+            // the step as a chord, the points lie along the surface, so the
+            // last one may fall outside the width.
+            let edge = [0.995, 0.98, 0.95].map(|f| f * reach);
+            let even = (1..=out).map(|k| reach * k as f64 / out as f64);
+            for t in even.chain(edge) {
+                for (q, to_b) in [(-t, false), (t, false), (1.0 - t, true), (1.0 + t, true)] {
+                    if let Some(c) = clearance_at(q, to_b) {
+                        g.interference = g.interference.max(-c);
+                    }
+                }
             }
         }
     }
