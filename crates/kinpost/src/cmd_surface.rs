@@ -34,7 +34,8 @@ pub enum SurfaceCommand {
 pub struct FitArgs {
     /// Points: CSV `row,col,x,y,z`, a whitespace table (`x y z` rows
     /// separated by blank lines, or `row col x y z`), or with --blade-side a
-    /// NASA blade table (Rotor 37 / 67: Z, R in cm, θ1, θ2 per stream surface).
+    /// NASA blade table (Rotor 37: Z, R in cm, θ1, θ2 per stream surface;
+    /// Rotor 67: blocks of axial distance, r·θ, thickness, radius in feet).
     points: PathBuf,
     /// Output surface file (JSON).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]

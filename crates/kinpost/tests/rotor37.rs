@@ -135,3 +135,26 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
         "one block with a CL line per CL point"
     );
 }
+
+/// The Rotor 67 file (stream surfaces in blocks of eight values, feet)
+/// reads as 14 stream surfaces of the blade from JLE = 16 to JTE = 85, both
+/// sides (it gave an error a line before).
+#[test]
+fn rotor67_reads_both_blade_sides() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    for side in ["1", "2"] {
+        let o = kinpost(&[
+            "surface",
+            "fit",
+            "../shared/data/nasa-rotors/rotor67geometry.dat",
+            "--blade-side",
+            side,
+            "-o",
+            &p(&format!("r67_{side}.json")),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert!(err.contains("14 × 70 points"), "{err}");
+    }
+}

@@ -1,6 +1,7 @@
 //! Grids of measured points: `row,col,x,y,z` CSV files (as
 //! `../shared/data/seed002/points.csv`), whitespace tables, and NASA blade
-//! geometry tables (Rotor 37 / Rotor 67: per stream surface Z, R, θ1, θ2).
+//! geometry tables (Rotor 37: per stream surface Z, R, θ1, θ2; Rotor 67:
+//! blocks of axial distance, r·θ, thickness and radius per stream surface).
 //!
 //! Every problem is a [`Diagnostic`] naming the file, line and column with
 //! the source line; nothing here panics on any input.
@@ -467,7 +468,14 @@ pub enum BladeSide {
 ///
 /// (z along the rotor axis, x radial through θ = 0). Every stream surface
 /// must have the same J values.
+///
+/// The NASA Rotor 67 file (stream surfaces as four blocks of values, 8 a
+/// line: axial distance, r·θ of the upper surface, the tangential
+/// thickness, radius; in feet) is read too; see [`read_stream_surfaces`].
 pub fn read_blade_table(text: &str, file: &str, side: BladeSide) -> Result<Grid, Diagnostics> {
+    if lines(text).any(|l| l.text.trim().eq_ignore_ascii_case("Axial Distance")) {
+        return read_stream_surfaces(text, file, side);
+    }
     let ctx = Ctx { file };
     let mut surfaces: Vec<(Vec<usize>, Vec<[f64; 3]>, usize)> = Vec::new();
     let mut errors = Vec::new();
@@ -494,6 +502,9 @@ pub fn read_blade_table(text: &str, file: &str, side: BladeSide) -> Result<Grid,
                 &line,
                 format!("{} values; expected `J Z R THETA1 THETA2`", fields.len()),
             ));
+            if errors.len() >= MAX_ERRORS {
+                break;
+            }
             continue;
         }
         let parsed = (|| {
@@ -566,9 +577,217 @@ pub fn read_blade_table(text: &str, file: &str, side: BladeSide) -> Result<Grid,
     Ok(Grid { rows, cols, points })
 }
 
+/// Reads the NASA Rotor 67 geometry file: after `JM NS NB JLE JTE` and
+/// their values, `Surface number k` sections (hub to casing), each with
+/// four blocks — `Axial Distance`, `Radius*Theta Distance` (of the upper
+/// surface), `Delta (Radius*Theta) = Tangential thickness` (subtracted from
+/// the upper surface for the lower one) and `Radius` — of a scale factor
+/// and then JM values, in feet. The blade is J = JLE … JTE of every stream
+/// surface; side 1 is the upper surface, side 2 the lower one, in
+/// millimetres as [`read_blade_table`] writes them:
+///
+/// ```text
+/// θ = (r·θ − [side 2] thickness) / r,   x = r cos θ,   y = r sin θ,   z = axial
+/// ```
+pub fn read_stream_surfaces(text: &str, file: &str, side: BladeSide) -> Result<Grid, Diagnostics> {
+    const FOOT_MM: f64 = 304.8;
+    let ctx = Ctx { file };
+    let fail = |line: usize, source: &str, message: String| -> Diagnostics {
+        let width = source.trim_end().chars().count().max(1);
+        Diagnostic::error(file, line, 1, width, source, message).into()
+    };
+    // [JM, JLE, JTE], from the value line after the last `JM NS NB JLE JTE`
+    // heading before the first surface.
+    let mut sizes: Option<[usize; 3]> = None;
+    let mut heading = false;
+    // Per surface: its header line and its four blocks (scale, values).
+    let mut surfaces: Vec<(usize, [Vec<f64>; 4])> = Vec::new();
+    let mut block: Option<usize> = None;
+    let mut scale = [1.0; 4];
+    for line in lines(text) {
+        let t = line.text.trim();
+        let upper = t.to_ascii_uppercase();
+        if surfaces.is_empty()
+            && upper
+                .split_whitespace()
+                .eq(["JM", "NS", "NB", "JLE", "JTE"])
+        {
+            heading = true;
+            continue;
+        }
+        if heading {
+            heading = false;
+            let v: Vec<usize> = t
+                .split_whitespace()
+                .filter_map(|f| f.parse().ok())
+                .collect();
+            if let [jm, _, _, jle, jte] = v[..] {
+                sizes = Some([jm, jle, jte]);
+            }
+            continue;
+        }
+        if upper.starts_with("SURFACE NUMBER") {
+            surfaces.push((line.number, Default::default()));
+            block = None;
+            continue;
+        }
+        let Some((_, blocks)) = surfaces.last_mut() else {
+            continue;
+        };
+        let which = if upper.starts_with("AXIAL") {
+            Some(0)
+        } else if upper.starts_with("RADIUS*THETA") {
+            Some(1)
+        } else if upper.starts_with("DELTA") {
+            Some(2)
+        } else if upper.starts_with("RADIUS") {
+            Some(3)
+        } else {
+            None
+        };
+        if let Some(k) = which {
+            block = Some(k);
+            scale[k] = f64::NAN; // the next value
+            continue;
+        }
+        let Some(k) = block else {
+            continue;
+        };
+        for field in split_ws(line.text) {
+            let v = ctx
+                .number(&line, field, "a value")
+                .map_err(Diagnostics::from)?;
+            if scale[k].is_nan() {
+                scale[k] = v;
+            } else {
+                blocks[k].push(v * scale[k]);
+            }
+        }
+    }
+    let Some([jm, jle, jte]) = sizes else {
+        return Err(fail(
+            0,
+            "",
+            "no `JM NS NB JLE JTE` values before the first surface".into(),
+        ));
+    };
+    if !(1 <= jle && jle < jte && jte <= jm) {
+        return Err(fail(
+            0,
+            "",
+            format!("JLE {jle} and JTE {jte} do not lie in 1 … JM {jm}"),
+        ));
+    }
+    if surfaces.is_empty() {
+        return Err(fail(0, "", "no `Surface number` section".into()));
+    }
+    let src: Vec<&str> = lines(text).map(|l| l.text).collect();
+    let mut points = Vec::new();
+    for (at, blocks) in &surfaces {
+        if let Some(b) = blocks.iter().position(|b| b.len() != jm) {
+            let name = [
+                "Axial Distance",
+                "Radius*Theta Distance",
+                "Tangential thickness",
+                "Radius",
+            ][b];
+            let header = src.get(at - 1).copied().unwrap_or("");
+            return Err(fail(
+                *at,
+                header,
+                format!(
+                    "`{name}` of this surface has {} values, JM is {jm}",
+                    blocks[b].len()
+                ),
+            ));
+        }
+        let [axial, r_theta, thickness, radius] = blocks;
+        for j in jle - 1..jte {
+            let r = radius[j];
+            if !(r > 0.0) {
+                let header = src.get(at - 1).copied().unwrap_or("");
+                return Err(fail(
+                    *at,
+                    header,
+                    format!("radius {r} at J {} is not positive", j + 1),
+                ));
+            }
+            let arc = match side {
+                BladeSide::Theta1 => r_theta[j],
+                BladeSide::Theta2 => r_theta[j] - thickness[j],
+            };
+            let theta = arc / r;
+            points.push([
+                FOOT_MM * r * theta.cos(),
+                FOOT_MM * r * theta.sin(),
+                FOOT_MM * axial[j],
+            ]);
+        }
+    }
+    Ok(Grid {
+        rows: surfaces.len(),
+        cols: jte - jle + 1,
+        points,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A Rotor 67 style file: JM = 3, the blade J = 2 … 3, two surfaces;
+    /// values by hand (feet → mm, θ = r·θ / r, side 2 less the thickness).
+    #[test]
+    fn stream_surfaces_of_the_rotor_67_file() {
+        let surface = |k: usize, z: [f64; 3], rt: [f64; 3], th: [f64; 3], r: [f64; 3]| {
+            let block = |name: &str, v: [f64; 3]| {
+                format!(" {name}\n  1.000000\n {} {} {}\n", v[0], v[1], v[2])
+            };
+            format!(
+                " Surface number  {k} from hub\n{}{}{}{}",
+                block("Axial Distance", z),
+                block("Radius*Theta Distance", rt),
+                block("Delta (Radius*Theta) = Tangential thickness", th),
+                block("Radius", r)
+            )
+        };
+        let text = format!(
+            " ROTOR 67 GEOMETRY\n   JM   NS   NB  JLE  JTE\n    3    2   22    2    3\n{}{}",
+            surface(
+                1,
+                [-1.0, 0.0, 0.5],
+                [9.0, 0.1, 0.2],
+                [0.0, 0.01, 0.0],
+                [0.5, 0.5, 0.5]
+            ),
+            surface(
+                2,
+                [-1.0, 0.1, 0.6],
+                [9.0, 0.3, 0.4],
+                [0.0, 0.02, 0.0],
+                [0.8, 0.8, 0.8]
+            ),
+        );
+        let g = read_blade_table(&text, "r67.dat", BladeSide::Theta2).unwrap();
+        assert_eq!((g.rows, g.cols), (2, 2));
+        let (r, theta, z) = (0.8 * 304.8, (0.3 - 0.02) / 0.8, 0.1 * 304.8);
+        let want = [r * f64::cos(theta), r * f64::sin(theta), z];
+        let got = g.points[2];
+        assert!(
+            (0..3).all(|i| (got[i] - want[i]).abs() < 1e-9),
+            "{got:?} vs {want:?}"
+        );
+        // A block one value short names its surface.
+        let short = text.replacen(" 0.8 0.8 0.8\n", " 0.8 0.8\n", 1);
+        let e = read_blade_table(&short, "r67.dat", BladeSide::Theta1).unwrap_err();
+        assert_eq!(e.0[0].line, 17, "{e}");
+        assert!(
+            e.0[0]
+                .message
+                .contains("`Radius` of this surface has 2 values, JM is 3"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn csv_with_header_in_any_column_order() {
