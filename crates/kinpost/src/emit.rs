@@ -227,17 +227,7 @@ impl<W: Write> Emitter<W> {
                     hold: last.node.hold,
                     branch: sol.branch,
                 };
-                self.block(
-                    machine,
-                    kin,
-                    &node,
-                    Motion::Feed,
-                    None,
-                    t.line,
-                    t.feed,
-                    t.at,
-                )?;
-                self.planning.inserted_blocks += 1;
+                self.inserted(machine, kin, &node, Motion::Feed, t)?;
             } else {
                 let here = kin.fk(&last.node.joints[..self.n]);
                 last.node.pose = Pose {
@@ -292,8 +282,7 @@ impl<W: Write> Emitter<W> {
                     }
                 }
                 for node in &inserted {
-                    self.block(machine, kin, node, Motion::Feed, None, t.line, t.feed, t.at)?;
-                    self.planning.inserted_blocks += 1;
+                    self.inserted(machine, kin, node, Motion::Feed, t)?;
                 }
                 self.inserted = inserted;
             }
@@ -308,6 +297,21 @@ impl<W: Write> Emitter<W> {
             t.feed,
             t.at,
         )
+    }
+
+    /// A block the post inserts before CL point `t` (it has no CL line of
+    /// its own).
+    fn inserted(
+        &mut self,
+        machine: &Machine,
+        kin: &Kinematics,
+        node: &Node,
+        motion: Motion,
+        t: &Target,
+    ) -> Result<(), PostError> {
+        self.block(machine, kin, node, motion, None, t.line, t.feed, t.at)?;
+        self.planning.inserted_blocks += 1;
+        Ok(())
     }
 
     /// Halves the CL segment `a`–`b` until the contact point at the
@@ -482,17 +486,7 @@ impl<W: Write> Emitter<W> {
             retract_mm: d,
         });
         for node in &nodes {
-            self.block(
-                machine,
-                kin,
-                node,
-                Motion::Rapid,
-                None,
-                t.line,
-                t.feed,
-                t.at,
-            )?;
-            self.planning.inserted_blocks += 1;
+            self.inserted(machine, kin, node, Motion::Rapid, t)?;
         }
         Ok(())
     }
