@@ -260,6 +260,20 @@ pub struct Move {
     pub motion: Motion,
 }
 
+impl From<Move> for Statement {
+    fn from(m: Move) -> Statement {
+        Statement {
+            line: m.line,
+            event: ClEvent::Goto {
+                point: m.point,
+                axis: m.axis,
+                reference: m.reference,
+                motion: m.motion,
+            },
+        }
+    }
+}
+
 /// What [`ClReader::next_move`] found.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Next {

@@ -208,15 +208,7 @@ impl<R: BufRead> ClReader<R> {
     pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
         let mut goto = Move::default();
         Ok(match self.next_move(&mut goto)? {
-            Next::Move => Some(Statement {
-                line: goto.line,
-                event: ClEvent::Goto {
-                    point: goto.point,
-                    axis: goto.axis,
-                    reference: goto.reference,
-                    motion: goto.motion,
-                },
-            }),
+            Next::Move => Some(goto.into()),
             Next::Statement(statement) => Some(statement),
             Next::End => None,
         })
@@ -238,12 +230,7 @@ impl<R: BufRead> ClReader<R> {
         let mut values = [0.0; 9];
         match self.begin_statement(&mut values)? {
             Begin::PlainGoto { count, end } => {
-                let (point, axis, motion) = self.goto_move((5, end), values, count)?;
-                goto.line = self.line;
-                goto.point = point;
-                goto.axis = axis;
-                goto.reference = self.reference;
-                goto.motion = motion;
+                self.plain_move(goto, values, count, end)?;
                 Ok(Next::Move)
             }
             begun => Ok(match self.next_statement_general(begun, values)? {
@@ -264,7 +251,9 @@ impl<R: BufRead> ClReader<R> {
         loop {
             let read = match begun {
                 Begin::PlainGoto { count, end } => {
-                    return self.plain_goto_statement(values, count, end);
+                    let mut goto = Move::default();
+                    self.plain_move(&mut goto, values, count, end)?;
+                    return Ok(Some(goto.into()));
                 }
                 Begin::PlainLine => Read::Statement,
                 Begin::Lines => self.read_lines()?,
@@ -291,27 +280,24 @@ impl<R: BufRead> ClReader<R> {
         }
     }
 
-    /// The statement of a plain `GOTO` line read by `begin_statement`: its
-    /// `count` values and the length of its text.
+    /// The move of a plain `GOTO` line read by `begin_statement` (its
+    /// `count` values and the length of its text), written into `goto`
+    /// field by field.
     #[inline(always)]
-    fn plain_goto_statement(
+    fn plain_move(
         &mut self,
+        goto: &mut Move,
         values: [f64; 9],
         count: usize,
         end: usize,
-    ) -> Result<Option<Statement>, Diagnostic> {
+    ) -> Result<(), Diagnostic> {
         let (point, axis, motion) = self.goto_move((5, end), values, count)?;
-        Ok(Some(Statement {
-            line: self.line,
-            // `self.reference` read straight into the result (the optimizer
-            // copied it around through the stack otherwise).
-            event: ClEvent::Goto {
-                point,
-                axis,
-                reference: self.reference,
-                motion,
-            },
-        }))
+        goto.line = self.line;
+        goto.point = point;
+        goto.axis = axis;
+        goto.reference = self.reference;
+        goto.motion = motion;
+        Ok(())
     }
 
     // ----- lines -----
