@@ -130,7 +130,6 @@ pub(crate) struct Emitter<W: Write> {
     solutions: Vec<Solution>,
     inserted: Vec<Node>,
     pub stats: CheckStats,
-    pub blocks: u64,
     pub planning: Planning,
 }
 
@@ -174,7 +173,6 @@ impl<W: Write> Emitter<W> {
             solutions: Vec::with_capacity(16),
             inserted: Vec::new(),
             stats: CheckStats::default(),
-            blocks: 0,
             planning: Planning::default(),
         }
     }
@@ -623,7 +621,6 @@ impl<W: Write> Emitter<W> {
                 _ => PostError::Io(e),
             })?;
         self.start_unknown = false;
-        self.blocks = self.writer.blocks_written();
         Ok(())
     }
 

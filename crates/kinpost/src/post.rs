@@ -315,6 +315,7 @@ pub fn post<R: BufRead, W: Write>(
         machine_template(machine, dialect, &machine.post.footer),
     )?;
     let tolerance = emitter.settings.tolerance;
+    let blocks = writer.blocks_written();
     writer.finish()?;
 
     if job.cl_points == 0 {
@@ -334,7 +335,7 @@ pub fn post<R: BufRead, W: Write>(
     planning.singular_stretches = setup.path.stretches;
     Ok(Summary {
         cl_points: job.cl_points,
-        blocks: emitter.blocks,
+        blocks,
         warnings,
         max_position_error_mm: emitter.stats.max_position_error_mm,
         max_position_error_line: emitter.stats.worst_line,
