@@ -201,19 +201,21 @@ pub fn gap(
         };
         let step = (fa.point - fb.point).norm();
         g.stepover = g.stepover.max(step);
-        // The clearance to one wheel (`b` or else `a`) of the surface point
-        // a fraction `q` of the way from pass `a` to pass `b` (across, at
-        // the same `s`).
-        let clearance_at = |q: f64, to_b: bool| {
+        // The surface point a fraction `q` of the way from pass `a` to
+        // pass `b` (across, at the same `s`), and its clearance to a wheel.
+        let point_at = |q: f64| {
             let cross = a.cross + (b.cross - a.cross) * q;
-            let x = PassCurve { cross, ..*a }.frame(surface, s)?;
-            let pass = if to_b { b } else { a };
+            PassCurve { cross, ..*a }.frame(surface, s)
+        };
+        let clearance_to = |pass: &PassCurve, x: &PassFrame| {
             let f = foot_point(surface, pass, &x.point, s)?;
             clearance(wheel, &f, &x.point, &x.normal)
         };
         for k in 1..=between {
-            let q = k as f64 / (between + 1) as f64;
-            let (ca, cb) = (clearance_at(q, false), clearance_at(q, true));
+            let Some(x) = point_at(k as f64 / (between + 1) as f64) else {
+                continue;
+            };
+            let (ca, cb) = (clearance_to(a, &x), clearance_to(b, &x));
             let left = match (ca, cb) {
                 (Some(p), Some(q)) => p.min(q),
                 (Some(p), None) | (None, Some(p)) => p,
@@ -242,8 +244,8 @@ pub fn gap(
             let edge = [0.995, 0.98, 0.95].map(|f| f * reach);
             let even = (1..=out).map(|k| reach * k as f64 / out as f64);
             for t in even.chain(edge) {
-                for (q, to_b) in [(-t, false), (t, false), (1.0 - t, true), (1.0 + t, true)] {
-                    if let Some(c) = clearance_at(q, to_b) {
+                for (q, pass) in [(-t, a), (t, a), (1.0 - t, b), (1.0 + t, b)] {
+                    if let Some(c) = point_at(q).and_then(|x| clearance_to(pass, &x)) {
                         g.interference = g.interference.max(-c);
                     }
                 }
