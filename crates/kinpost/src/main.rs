@@ -15,6 +15,7 @@ use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
 mod cmd_surface;
+mod cpu;
 mod sinks;
 
 use sinks::{Sink, deliver, refuse_same_files};
@@ -254,6 +255,14 @@ fn usage(message: impl Into<String>) -> anyhow::Error {
 }
 
 fn main() -> ExitCode {
+    // First: nothing compiled for the build's processor features may run
+    // before it.
+    cpu::require_build_features();
+    cli_main()
+}
+
+#[inline(never)]
+fn cli_main() -> ExitCode {
     let cli = Cli::parse();
     // (Text still buffered is flushed here, where its error can be seen.)
     match run(cli).and_then(|()| Ok(io::stdout().flush()?)) {
