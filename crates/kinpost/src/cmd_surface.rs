@@ -297,7 +297,7 @@ fn fit(args: FitArgs) -> Result<()> {
         Method::Approximation { .. } => "least-squares approximation".to_string(),
     };
     let r = surface.residual().expect("a fitted surface keeps its data");
-    eprintln!(
+    note!(
         "{}: {} × {} points → {rows} × {cols} control points ({kind}, {} parameters); residual at the data points: max {:.3e} mm (row {}, col {}), rms {:.3e} mm",
         args.output_file.display(),
         grid.rows,
@@ -373,7 +373,7 @@ fn eval(args: EvalArgs) -> Result<()> {
         }
     }
     if degenerate > 0 {
-        eprintln!(
+        note!(
             "warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan"
         );
     }
@@ -624,7 +624,7 @@ pub fn path(args: PathArgs) -> Result<()> {
         write_atomically(json, text.as_bytes())
             .with_context(|| format!("cannot write {}", json.display()))?;
     }
-    eprintln!(
+    note!(
         "{} passes along {}, {} CL points, {:.1} mm of feed moves; step-over {:.4}–{:.4} mm; scallop max {:.5} mm{limit}; wheel-edge interference max {:.5} mm; chord error max {:.5} mm (tolerance {})",
         r.passes,
         if options.direction == Direction::U {
@@ -644,13 +644,13 @@ pub fn path(args: PathArgs) -> Result<()> {
     if let Some(rc) = r.concave_feed_radius_min
         && rc < wheel.radius
     {
-        eprintln!(
+        note!(
             "warning: the surface is concave along the feed with radius {rc:.3} mm, less than the wheel radius {} mm: the wheel cuts in there",
             wheel.radius
         );
     }
     if r.interference_max > options.chord_tolerance {
-        eprintln!(
+        note!(
             "warning: the wheel's edge reaches {:.4} mm under the surface between passes (a concave section across the pass): a narrower wheel or passes the other way reduce it",
             r.interference_max
         );

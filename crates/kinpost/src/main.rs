@@ -14,6 +14,16 @@ use kinpost::output::write_atomically;
 use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
+/// `eprintln!` that does not panic when standard error is gone (its reader
+/// closed the pipe): the message is lost, the run goes on and its exit code
+/// stands.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 mod cmd_surface;
 mod cpu;
 mod sinks;
@@ -272,7 +282,7 @@ fn cli_main() -> ExitCode {
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             if e.downcast_ref::<Reported>().is_none() {
-                eprintln!("error: {e:#}");
+                note!("error: {e:#}");
             }
             if e.downcast_ref::<Usage>().is_some() {
                 ExitCode::from(2)
@@ -426,7 +436,7 @@ const STDIN_NAME: &str = "<stdin>";
 
 /// Prints diagnostics and turns them into a [`Reported`] error.
 fn report(d: impl std::fmt::Display) -> anyhow::Error {
-    eprintln!("{d}");
+    note!("{d}");
     anyhow::Error::new(Reported)
 }
 
@@ -614,10 +624,10 @@ fn post(args: PostArgs) -> Result<()> {
     }
     deliver(sinks)?;
     for w in &summary.warnings {
-        eprintln!("{w}\n");
+        note!("{w}\n");
     }
     if !args.quiet {
-        eprintln!("{}", summary.one_line());
+        note!("{}", summary.one_line());
     }
     Ok(())
 }
@@ -717,7 +727,7 @@ fn machine_at_pressure(m: &Machine, pressure: Option<f64>) -> Result<Machine> {
     let p = kinpost::wheel::pressure_axis(m).map_err(|e| anyhow!("{e}"))?;
     if p.clamp(h) != kinpost::machine::Clamp::Inside {
         let [lo, hi] = p.range();
-        eprintln!(
+        note!(
             "warning: {} = {h} is outside the calibration ({lo} .. {hi}): the wheel sits on its stop",
             p.name
         );
@@ -749,7 +759,7 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>, out: &mut impl Wr
             .axis_index(name.trim())
             .ok_or_else(|| anyhow!("machine `{}` has no axis `{name}`", m.name))?;
         if !m.axes[i].accepts(value) {
-            eprintln!("warning: {name}={value} is outside the axis limits");
+            note!("warning: {name}={value} is outside the axis limits");
         }
         set_axis(&mut m, i, value);
         q[i] = value;
@@ -775,7 +785,7 @@ fn set_axis(m: &mut Machine, i: usize, value: f64) {
     match axis.fixed {
         Some(_) if axis.free_with_reference => axis.fixed = None,
         Some(f) if f != value => {
-            eprintln!(
+            note!(
                 "warning: axis {} is fixed at {f} in this machine file; using {value}",
                 axis.name
             );

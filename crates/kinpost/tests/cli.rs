@@ -1012,6 +1012,36 @@ fn a_closed_standard_output_ends_every_command_quietly() {
 }
 
 #[test]
+fn a_closed_standard_error_loses_the_messages_not_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let mpf = dir.path().join("p.mpf");
+    let mpf = mpf.to_str().unwrap();
+    // The flat part posts with two warnings and a summary on standard
+    // error; the missing file is an error message there.
+    for (args, code) in [
+        (
+            &["post", "examples/flat-part.cls", "-m", "mts1600", "-o", mpf][..],
+            0,
+        ),
+        (&["post", "no-such-file.cls", "-m", "mts1600"][..], 1),
+        (&["fk", "-m", "mts1600", "X=459", "A=9999"][..], 0),
+    ] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = kinpost(args)
+            .stdout(Stdio::null())
+            .stderr(writer)
+            .output()
+            .unwrap();
+        assert_exit(&o, code);
+    }
+    // The program was written all the same.
+    let written = std::fs::read_to_string(mpf).unwrap();
+    let o = run(&["post", "examples/flat-part.cls", "-m", "mts1600"]);
+    assert_eq!(written, stdout(&o));
+}
+
+#[test]
 fn a_directory_is_named_as_one() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path().to_str().unwrap();
