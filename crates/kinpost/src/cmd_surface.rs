@@ -6,7 +6,6 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
-use kinpost::output::{AtomicFile, write_atomically};
 use kinpost_surface::grid::{BladeSide, Grid, read_blade_table, read_grid};
 use kinpost_surface::json::{from_json, to_json};
 use kinpost_surface::svg::{Curvature, plot_surface};
@@ -16,6 +15,7 @@ use kinpost_toolpath::plot::plot_path;
 use kinpost_toolpath::{Direction, PathError, PathOptions, Side, Spacing, Wheel, plan};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
+use crate::sinks::{deliver, open_outputs};
 use crate::{report, usage};
 
 #[derive(clap::Subcommand)]
@@ -37,7 +37,7 @@ pub struct FitArgs {
     /// NASA blade table (Rotor 37: Z, R in cm, θ1, θ2 per stream surface;
     /// Rotor 67: blocks of axial distance, r·θ, thickness, radius in feet).
     points: PathBuf,
-    /// Output surface file (JSON).
+    /// Output surface file (JSON), or - for standard output.
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: PathBuf,
     /// End conditions of the interpolation.
@@ -60,7 +60,8 @@ pub struct FitArgs {
     /// reduced grid over the same area.
     #[arg(long, value_name = "I,J")]
     every: Option<String>,
-    /// Also write the grid that was fitted as CSV `row,col,x,y,z`.
+    /// Also write the grid that was fitted as CSV `row,col,x,y,z` (- for
+    /// standard output).
     #[arg(long, value_name = "FILE")]
     write_grid: Option<PathBuf>,
 }
@@ -98,7 +99,7 @@ pub struct EvalArgs {
 pub struct PlotArgs {
     /// Surface file (JSON).
     surface: PathBuf,
-    /// Output SVG file.
+    /// Output SVG file, or - for standard output.
     #[arg(long, value_name = "FILE")]
     svg: PathBuf,
     /// Colour the surface by curvature.
@@ -178,10 +179,12 @@ pub struct PathArgs {
     /// Output CL file, or - for standard output (the default).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: Option<PathBuf>,
-    /// Also draw the passes on the surface as SVG.
+    /// Also draw the passes on the surface as SVG (- for standard output,
+    /// with the CL file in a file).
     #[arg(long, value_name = "FILE")]
     svg: Option<PathBuf>,
-    /// Write the path report (passes, step-over, scallop per gap, …) as JSON.
+    /// Write the path report (passes, step-over, scallop per gap, …) as JSON
+    /// (- for standard output, with the CL file in a file).
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
 }
@@ -242,6 +245,11 @@ pub fn surface(command: SurfaceCommand) -> Result<()> {
 }
 
 fn fit(args: FitArgs) -> Result<()> {
+    let mut outputs = vec![("-o", args.output_file.as_path())];
+    if let Some(path) = &args.write_grid {
+        outputs.push(("--write-grid", path.as_path()));
+    }
+    let mut sinks = open_outputs(&[("points file", args.points.as_path())], &outputs)?;
     let text = read_text(&args.points, "points file")?;
     let name = args.points.to_string_lossy();
     let grid = match args.blade_side {
@@ -285,12 +293,15 @@ fn fit(args: FitArgs) -> Result<()> {
     };
     let surface = Surface::fit(&grid, &options)
         .map_err(|e| anyhow!("{name}: {} × {} grid: {e}", grid.rows, grid.cols))?;
+    sinks[0]
+        .write_all(to_json(&surface).as_bytes())
+        .with_context(|| format!("cannot write {}", args.output_file.display()))?;
     if let Some(path) = &args.write_grid {
-        write_atomically(path, grid_csv(&grid).as_bytes())
+        sinks[1]
+            .write_all(grid_csv(&grid).as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    write_atomically(&args.output_file, to_json(&surface).as_bytes())
-        .with_context(|| format!("cannot write {}", args.output_file.display()))?;
+    deliver(sinks)?;
     let (rows, cols) = surface.net_size();
     let kind = match method {
         Method::Interpolation(e) => format!("interpolation, {} ends", e.name()),
@@ -323,6 +334,10 @@ fn grid_csv(grid: &Grid) -> String {
 }
 
 fn eval(args: EvalArgs) -> Result<()> {
+    let mut sinks = open_outputs(
+        &[("surface file", args.surface.as_path())],
+        &[("-o", args.output_file.as_deref().unwrap_or(Path::new("-")))],
+    )?;
     let surface = load_surface(&args.surface)?;
     let (u0, u1) = surface.u_range();
     let (v0, v1) = surface.v_range();
@@ -377,18 +392,17 @@ fn eval(args: EvalArgs) -> Result<()> {
             "warning: the surface is degenerate (no normal) at {degenerate} of the points: written as nan"
         );
     }
-    match crate::file_path(&args.output_file) {
-        Some(path) => write_atomically(path, out.as_bytes())
-            .with_context(|| format!("cannot write {}", path.display())),
-        None => {
-            let mut o = std::io::stdout().lock();
-            o.write_all(out.as_bytes())?;
-            Ok(o.flush()?)
-        }
-    }
+    sinks[0]
+        .write_all(out.as_bytes())
+        .context("cannot write the evaluation")?;
+    deliver(sinks)
 }
 
 fn plot(args: PlotArgs) -> Result<()> {
+    let mut sinks = open_outputs(
+        &[("surface file", args.surface.as_path())],
+        &[("--svg", args.svg.as_path())],
+    )?;
     let surface = load_surface(&args.surface)?;
     let title = args.title.unwrap_or_else(|| {
         args.surface
@@ -403,8 +417,10 @@ fn plot(args: PlotArgs) -> Result<()> {
         }),
         &title,
     );
-    write_atomically(&args.svg, svg.as_bytes())
-        .with_context(|| format!("cannot write {}", args.svg.display()))
+    sinks[0]
+        .write_all(svg.as_bytes())
+        .with_context(|| format!("cannot write {}", args.svg.display()))?;
+    deliver(sinks)
 }
 
 /// `wheel:radius=R,width=W`.
@@ -478,6 +494,16 @@ fn placement(rotate: &[String], translate: Option<&str>) -> Result<Isometry3<f64
 }
 
 pub fn path(args: PathArgs) -> Result<()> {
+    let mut outputs = vec![(
+        "the CL file (-o)",
+        args.output_file.as_deref().unwrap_or(Path::new("-")),
+    )];
+    for (name, path) in [("--svg", &args.svg), ("--json", &args.json)] {
+        if let Some(path) = path {
+            outputs.push((name, path.as_path()));
+        }
+    }
+    let mut sinks = open_outputs(&[("surface file", args.surface.as_path())], &outputs)?;
     let surface = load_surface(&args.surface)?;
     let wheel = parse_wheel(&args.tool)?;
     let spacing = match (args.stepover, args.scallop) {
@@ -579,29 +605,16 @@ pub fn path(args: PathArgs) -> Result<()> {
         reference: matches!(args.reference, ReferenceArg::Feed),
         comments,
     };
-    match crate::file_path(&args.output_file) {
-        Some(path) => {
-            let mut f = AtomicFile::create(path)
-                .with_context(|| format!("cannot create {}", path.display()))?;
-            write_cl(&toolpath, &options, &cl, &mut f)?;
-            f.commit()
-                .with_context(|| format!("cannot write {}", path.display()))?;
-        }
-        None => {
-            let mut buffer = Vec::new();
-            write_cl(&toolpath, &options, &cl, &mut buffer)?;
-            let mut o = std::io::stdout().lock();
-            o.write_all(&buffer)?;
-            o.flush()?;
-        }
-    }
+    // The sinks in the order opened: the CL file, then the plot and the
+    // report if asked for.
+    let mut next = sinks.iter_mut();
+    let mut sink = || next.next().expect("one sink per output");
+    write_cl(&toolpath, &options, &cl, sink())?;
     if let Some(svg) = &args.svg {
         let title = format!("{}: grinding path", args.surface.display());
-        write_atomically(
-            svg,
-            plot_path(&surface, &toolpath, &options, &title).as_bytes(),
-        )
-        .with_context(|| format!("cannot write {}", svg.display()))?;
+        sink()
+            .write_all(plot_path(&surface, &toolpath, &options, &title).as_bytes())
+            .with_context(|| format!("cannot write {}", svg.display()))?;
     }
     if let Some(json) = &args.json {
         let report = serde_json::json!({
@@ -621,9 +634,11 @@ pub fn path(args: PathArgs) -> Result<()> {
             })).collect::<Vec<_>>(),
         });
         let text = serde_json::to_string_pretty(&report).expect("plain data") + "\n";
-        write_atomically(json, text.as_bytes())
+        sink()
+            .write_all(text.as_bytes())
             .with_context(|| format!("cannot write {}", json.display()))?;
     }
+    deliver(sinks)?;
     note!(
         "{} passes along {}, {} CL points, {:.1} mm of feed moves; step-over {:.4}–{:.4} mm; scallop max {:.5} mm{limit}; wheel-edge interference max {:.5} mm; chord error max {:.5} mm (tolerance {})",
         r.passes,

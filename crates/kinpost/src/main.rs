@@ -10,7 +10,6 @@ use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
 use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
 use kinpost::nc::Dialect;
-use kinpost::output::write_atomically;
 use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
@@ -28,7 +27,7 @@ mod cmd_surface;
 mod cpu;
 mod sinks;
 
-use sinks::{Sink, deliver, refuse_same_files};
+use sinks::{Sink, deliver, open_outputs};
 
 #[derive(Parser)]
 #[command(
@@ -353,7 +352,7 @@ fn run(cli: Cli) -> Result<()> {
             pressure,
             &mut out,
         ),
-        Command::Wheel(args) => wheel(&args, &mut out),
+        Command::Wheel(args) => wheel(&args),
         Command::Surface(c) => cmd_surface::surface(c),
         Command::Path(a) => cmd_surface::path(*a),
     }
@@ -510,7 +509,9 @@ fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
 }
 
 fn post(args: PostArgs) -> Result<()> {
-    check_outputs(&args)?;
+    // Both outputs exist (as temporary files) before the run, so that one
+    // that cannot be created leaves the other unwritten too.
+    let mut sinks = open_post_outputs(&args)?;
     let machine = load_machine(&args.machine)?;
     let dialect_name = args
         .dialect
@@ -599,15 +600,7 @@ fn post(args: PostArgs) -> Result<()> {
         ))
     };
 
-    // Both outputs exist (as temporary files) before the run, so that one
-    // that cannot be created leaves the other unwritten too.
-    let mut program = Sink::open(file_path(&args.output_file))?;
-    let json = args
-        .json
-        .as_ref()
-        .map(|_| Sink::open(file_path(&args.json)))
-        .transpose()?;
-    let result = kinpost::post(input, &machine, &dialect, &mut program, &options);
+    let result = kinpost::post(input, &machine, &dialect, &mut sinks[0], &options);
     if let Some(bar) = &progress {
         bar.finish_and_clear();
     }
@@ -616,11 +609,9 @@ fn post(args: PostArgs) -> Result<()> {
         Err(PostError::Input(d)) => return Err(report(d)),
         Err(e) => return Err(e.into()),
     };
-    let mut sinks = vec![program];
-    if let Some(mut json) = json {
+    if let Some(json) = sinks.get_mut(1) {
         json.write_all(summary.to_json().as_bytes())
             .context("cannot write the JSON summary")?;
-        sinks.push(json);
     }
     deliver(sinks)?;
     for w in &summary.warnings {
@@ -632,23 +623,11 @@ fn post(args: PostArgs) -> Result<()> {
     Ok(())
 }
 
-/// An output's file; none for standard output (`-` or not given).
-fn file_path(path: &Option<PathBuf>) -> Option<&Path> {
-    path.as_deref().filter(|p| *p != Path::new("-"))
-}
-
-/// Refuses the program and the summary both on standard output, and
-/// outputs that would replace an input file (the CL, machine or dialect
+/// The sinks of `kinpost post`: the program (`-o`, standard output unless
+/// given), then the JSON summary (`--json`) if asked for; never both on
+/// standard output, never onto an input file (the CL, machine or dialect
 /// file) or each other.
-fn check_outputs(args: &PostArgs) -> Result<()> {
-    if args.json.is_some()
-        && file_path(&args.json).is_none()
-        && file_path(&args.output_file).is_none()
-    {
-        return Err(usage(
-            "--json - writes the summary to standard output: give the program a file with -o FILE",
-        ));
-    }
+fn open_post_outputs(args: &PostArgs) -> Result<Vec<Sink>> {
     let mut inputs = Vec::new();
     if args.input != "-" {
         inputs.push(("CL file", Path::new(&args.input)));
@@ -661,14 +640,14 @@ fn check_outputs(args: &PostArgs) -> Result<()> {
             inputs.push((what, Path::new(name)));
         }
     }
-    let mut outputs = Vec::new();
-    if let Some(path) = file_path(&args.output_file) {
-        outputs.push(("-o", path));
+    let mut outputs = vec![(
+        "the program (-o)",
+        args.output_file.as_deref().unwrap_or(Path::new("-")),
+    )];
+    if let Some(json) = &args.json {
+        outputs.push(("--json", json.as_path()));
     }
-    if let Some(path) = file_path(&args.json) {
-        outputs.push(("--json", path));
-    }
-    refuse_same_files(&inputs, &outputs)
+    open_outputs(&inputs, &outputs)
 }
 
 /// A progress bar over the bytes of the CL file, on a terminal only (never
@@ -836,7 +815,18 @@ fn ik(
     Ok(())
 }
 
-fn wheel(args: &WheelArgs, out: &mut impl Write) -> Result<()> {
+fn wheel(args: &WheelArgs) -> Result<()> {
+    let mut outputs = vec![("the table", Path::new("-"))];
+    if let Some(svg) = &args.svg {
+        outputs.push(("--svg", svg.as_path()));
+    }
+    let machine_file = Path::new(&args.machine);
+    let inputs: &[(&str, &Path)] = if machine_file.is_file() {
+        &[("machine file", machine_file)]
+    } else {
+        &[]
+    };
+    let mut sinks = open_outputs(inputs, &outputs)?;
     let m = load_machine(&args.machine)?;
     let p = kinpost::wheel::pressure_axis(&m).map_err(|e| anyhow!("{e}"))?;
     let mut pressures = args
@@ -852,13 +842,14 @@ fn wheel(args: &WheelArgs, out: &mut impl Write) -> Result<()> {
     }
     let rows = kinpost::wheel::rows(&m, &pressures).map_err(|e| anyhow!("{e}"))?;
     let table = kinpost::wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?;
-    out.write_all(table.as_bytes())?;
+    sinks[0].write_all(table.as_bytes())?;
     if let Some(path) = &args.svg {
         let svg = kinpost::wheel::svg(&m, &rows).map_err(|e| anyhow!("{e}"))?;
-        write_atomically(path, svg.as_bytes())
+        sinks[1]
+            .write_all(svg.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    Ok(())
+    deliver(sinks)
 }
 
 /// Today's date (UTC) as YYYY-MM-DD, from the civil-from-days algorithm

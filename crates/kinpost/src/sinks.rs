@@ -1,5 +1,6 @@
-//! Where the results of `kinpost post` go: the program and the JSON summary,
-//! each to a file (all or nothing) or to standard output.
+//! Where the results of a command go (`kinpost post`: the program and the
+//! JSON summary; `kinpost path`: the CL file, its plot and report; …), each
+//! to a file (all or nothing) or to standard output (`-`).
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -87,6 +88,35 @@ pub fn deliver(sinks: Vec<Sink>) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
+}
+
+/// The sinks of a command's outputs, in the order given: each is named as
+/// on the command line and goes to its path, or to standard output for `-`.
+/// Refuses (usage errors) two outputs on standard output, and outputs that
+/// name an input or each other (see [`refuse_same_files`]). Every file's
+/// temporary file exists when this returns (see [`Sink::open`]).
+pub fn open_outputs(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<Vec<Sink>> {
+    let stdout = |p: &&Path| *p == Path::new("-");
+    let on_stdout: Vec<&str> = outputs
+        .iter()
+        .filter(|(_, p)| stdout(p))
+        .map(|(name, _)| *name)
+        .collect();
+    if let [first, second, ..] = on_stdout[..] {
+        return Err(usage(format!(
+            "{second} - would write to standard output, where {first} goes: give one of them a file"
+        )));
+    }
+    let files: Vec<(&str, &Path)> = outputs
+        .iter()
+        .copied()
+        .filter(|(_, p)| !stdout(p))
+        .collect();
+    refuse_same_files(inputs, &files)?;
+    outputs
+        .iter()
+        .map(|&(_, p)| Sink::open((!stdout(&p)).then_some(p)))
+        .collect()
 }
 
 /// Refuses (a usage error) an output that names an input or another

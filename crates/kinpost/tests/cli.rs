@@ -387,6 +387,98 @@ fn bad_surface_and_path_option_values_are_usage_errors() {
     assert!(stderr(&o).contains("outside the surface's domain"));
 }
 #[test]
+fn every_command_writes_dash_to_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("points.csv");
+    let mut csv = String::from("row,col,x,y,z\n");
+    for i in 0..4 {
+        for j in 0..4 {
+            csv.push_str(&format!("{i},{j},{},{},{}\n", 10 * j, 10 * i, i * j));
+        }
+    }
+    std::fs::write(&points, csv).unwrap();
+    let points = points.to_str().unwrap();
+    let in_dir = |args: &[&str]| {
+        kinpost(args)
+            .current_dir(dir.path())
+            .output()
+            .expect("run kinpost")
+    };
+    // The surface as JSON on standard output, the grid in a file.
+    let o = in_dir(&["surface", "fit", points, "-o", "-", "--write-grid", "g.csv"]);
+    assert_exit(&o, 0);
+    let surface: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(surface.is_object());
+    std::fs::write(dir.path().join("s.json"), &o.stdout).unwrap();
+    let wheel = "wheel:radius=50,width=2";
+    for (args, starts) in [
+        (&["surface", "plot", "s.json", "--svg", "-"][..], "<svg"),
+        (
+            &["surface", "eval", "s.json", "--uv", "0.5,0.5", "-o", "-"][..],
+            "u,v,",
+        ),
+        (
+            &[
+                "path", "s.json", "--tool", wheel, "-o", "p.cls", "--svg", "-",
+            ][..],
+            "<svg",
+        ),
+        (
+            &[
+                "path", "s.json", "--tool", wheel, "-o", "p.cls", "--json", "-",
+            ][..],
+            "{",
+        ),
+        (&["wheel", "-m", "mts1600", "--svg", "w.svg"][..], ""),
+    ] {
+        let o = in_dir(args);
+        assert_exit(&o, 0);
+        assert!(
+            stdout(&o).trim_start().starts_with(starts),
+            "{args:?}: {}",
+            stdout(&o)
+        );
+    }
+    // Two outputs on standard output, or an output onto an input.
+    for (args, message) in [
+        (
+            &["path", "s.json", "--tool", wheel, "--svg", "-"][..],
+            "--svg - would write to standard output, where the CL file (-o) goes",
+        ),
+        (
+            &[
+                "path", "s.json", "--tool", wheel, "-o", "p.cls", "--svg", "-", "--json", "-",
+            ][..],
+            "--json - would write to standard output, where --svg goes",
+        ),
+        (
+            &["wheel", "-m", "mts1600", "--svg", "-"][..],
+            "--svg - would write to standard output, where the table goes",
+        ),
+        (
+            &[
+                "surface", "eval", "s.json", "--uv", "0.5,0.5", "-o", "s.json",
+            ][..],
+            "is the surface file",
+        ),
+        (
+            &[
+                "path", "s.json", "--tool", wheel, "-o", "p.cls", "--svg", "p.cls",
+            ][..],
+            "are the same file",
+        ),
+    ] {
+        let o = in_dir(args);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(message), "{args:?}: {}", stderr(&o));
+    }
+    assert_eq!(
+        listing(dir.path()),
+        ["g.csv", "p.cls", "points.csv", "s.json", "w.svg"]
+    );
+}
+
+#[test]
 fn machines_and_machine_show() {
     let o = run(&["machines"]);
     assert_exit(&o, 0);
