@@ -21,6 +21,7 @@
 
 pub mod check;
 mod emit;
+mod machine_templates;
 pub mod output;
 mod path;
 mod post;
@@ -34,6 +35,7 @@ pub use kinpost_diag as diag;
 pub use kinpost_machine as machine;
 pub use kinpost_nc as nc;
 pub use kinpost_plan as plan;
+pub use machine_templates::check_machine_templates;
 pub use post::{
     DEFAULT_LINTOL_MM, DEFAULT_RETRACT_MM, DEFAULT_SINGULAR_CONE_DEG, FeedMode, PLANNER_LAG,
     PlannerMode, PostError, PostOptions, axis_specs, post,

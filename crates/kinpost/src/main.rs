@@ -367,7 +367,7 @@ fn machine_check(file: &Path, out: &mut impl Write) -> Result<()> {
             .context("cannot read the machine file from standard input")?;
         (
             STDIN_NAME.to_string(),
-            machine_from_toml(&src, STDIN_NAME).map_err(report)?,
+            machine_from_source(&src, STDIN_NAME)?,
         )
     } else {
         let name = file.to_string_lossy();
@@ -452,13 +452,20 @@ fn load_machine(name: &str) -> Result<Machine> {
     if path.is_file() {
         let src = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read machine file {name}"))?;
-        return machine_from_toml(&src, name).map_err(report);
+        return machine_from_source(&src, name);
     }
     match builtin::load(name) {
         Some(m) => m.map_err(report),
         None if path.is_dir() => Err(anyhow!("machine file {name} is a directory")),
         None => Err(unknown_machine(name)),
     }
+}
+
+/// A machine file's machine, its `[post]` templates checked too.
+fn machine_from_source(src: &str, name: &str) -> Result<Machine> {
+    let machine = machine_from_toml(src, name).map_err(report)?;
+    kinpost::check_machine_templates(src, name).map_err(report)?;
+    Ok(machine)
 }
 
 /// A built-in dialect by name, or a dialect file.

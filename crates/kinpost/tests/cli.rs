@@ -544,6 +544,44 @@ fn machine_check() {
 }
 
 #[test]
+fn machine_file_templates_are_checked_at_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(root().join("crates/machine/machines/mts1600.toml")).unwrap();
+    let bad = src.replace("T{{ tool_number }}", "T{{ tool_numbr }}");
+    assert_ne!(bad, src);
+    let file = dir.path().join("m.toml");
+    std::fs::write(&file, &bad).unwrap();
+    let file = file.to_str().unwrap();
+    let line = bad.lines().position(|l| l.contains("tool_numbr")).unwrap() + 1;
+    let mpf = dir.path().join("p.mpf");
+    for args in [
+        &["machine", "check", file][..],
+        &[
+            "post",
+            "examples/flat-part.cls",
+            "-m",
+            file,
+            "-o",
+            mpf.to_str().unwrap(),
+        ][..],
+    ] {
+        let o = run(args);
+        assert_exit(&o, 1);
+        let e = stderr(&o);
+        assert!(e.contains("unknown variable `tool_numbr`"), "{args:?}: {e}");
+        assert!(e.contains(&format!("{file}:{line}:5")), "{args:?}: {e}");
+    }
+    assert!(!mpf.exists());
+    let o = run_with_stdin(&["machine", "check", "-"], bad.as_bytes());
+    assert_exit(&o, 1);
+    assert!(
+        stderr(&o).contains(&format!("<stdin>:{line}:5")),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn dialects_and_dialect_show() {
     let o = run(&["dialects"]);
     assert_exit(&o, 0);

@@ -10,7 +10,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
-use crate::template;
+use crate::template::{self, TemplateError, template_span_in_toml};
 use crate::writer::{MAX_LEAD, MAX_SUFFIX};
 use crate::{AxisSpec, Motion, ProgramInfo};
 
@@ -818,21 +818,58 @@ fn check_variables(
     source: &str,
     err: &mut dyn FnMut(std::ops::Range<usize>, String),
 ) {
-    let given: Vec<&str> = ProgramInfo::VARIABLES
+    let given = given_variables(kind);
+    for (name, range) in template::unknown_variables(env, kind.key(), t.get_ref(), &given) {
+        err(
+            template_span_in_toml(source, t.span(), t.get_ref(), Some(range)),
+            unknown_variable_message(kind, &name, &given),
+        );
+    }
+}
+
+/// The variables the writer gives template `kind`.
+fn given_variables(kind: TemplateKind) -> Vec<&'static str> {
+    ProgramInfo::VARIABLES
         .iter()
         .chain(kind.variables())
         .copied()
-        .collect();
-    for (name, range) in template::unknown_variables(env, kind.key(), t.get_ref(), &given) {
-        err(
-            template::template_span_in_toml(source, t.span(), t.get_ref(), Some(range)),
-            format!(
-                "template `{}`: unknown variable `{name}`; its variables are {} (a value the \
-                 caller may pass in `extra` is `extra.{name}`, or `{name}` tested with `is defined`)",
-                kind.key(),
-                given.join(", ")
-            ),
-        );
+        .collect()
+}
+
+fn unknown_variable_message(kind: TemplateKind, name: &str, given: &[&str]) -> String {
+    format!(
+        "template `{}`: unknown variable `{name}`; its variables are {} (a value the \
+         caller may pass in `extra` is `extra.{name}`, or `{name}` tested with `is defined`)",
+        kind.key(),
+        given.join(", ")
+    )
+}
+
+/// Checks a template that takes the place of the dialect's template `kind`
+/// (a machine file's `[post] header` or `footer`) as a dialect file's own
+/// are checked at load: its syntax, and that it reads only variables the
+/// writer gives it. The error's range lies in `source`, for the loader to
+/// report at its own place (see [`template_span_in_toml`]).
+pub fn check_template(kind: TemplateKind, source: &str) -> Result<(), TemplateError> {
+    let mut env = template::environment();
+    if let Err(e) = env.add_template_owned(kind.key(), source.to_string()) {
+        return Err(TemplateError {
+            message: format!("template `{}`: {}", kind.key(), template::error_message(&e)),
+            range: e.range(),
+            line: e.line(),
+        });
+    }
+    let given = given_variables(kind);
+    match template::unknown_variables(&env, kind.key(), source, &given)
+        .into_iter()
+        .next()
+    {
+        Some((name, range)) => Err(TemplateError {
+            message: unknown_variable_message(kind, &name, &given),
+            line: Some(source[..range.start].matches('\n').count() + 1),
+            range: Some(range),
+        }),
+        None => Ok(()),
     }
 }
 

@@ -29,13 +29,13 @@ mod writer;
 
 pub use dialect::{
     BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MotionWords, Numbering,
-    TemplateKind, WordFormat,
+    TemplateKind, WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use minijinja::Value;
 pub use number::{MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
-pub use template::{TemplateError, check_template, template_span_in_toml};
+pub use template::{TemplateError, template_span_in_toml};
 pub use writer::{NcWriter, Spindle};
 
 /// One machine axis as the writer and reader need it.

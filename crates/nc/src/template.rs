@@ -225,20 +225,6 @@ impl std::fmt::Display for TemplateError {
 
 impl std::error::Error for TemplateError {}
 
-/// Checks the syntax of a template (e.g. a machine file's header override)
-/// without rendering it, so a loader can report the error at its own span
-/// (see [`template_span_in_toml`]).
-pub fn check_template(source: &str) -> Result<(), TemplateError> {
-    let env = environment();
-    env.template_from_str(source)
-        .map(|_| ())
-        .map_err(|e| TemplateError {
-            message: error_message(&e),
-            range: e.range(),
-            line: e.line(),
-        })
-}
-
 /// Maps a byte range inside a template string to a byte range in the TOML
 /// file that holds it. `value_span` is the span of the TOML string value
 /// (with its quotes, as `toml::Spanned` gives it), `text` the decoded
@@ -328,7 +314,7 @@ mod tests {
 
     #[test]
     fn syntax_error_has_range() {
-        let e = check_template("G01\n{{ foo ").unwrap_err();
+        let e = crate::check_template(crate::TemplateKind::Header, "G01\n{{ foo ").unwrap_err();
         assert!(e.range.is_some(), "{e:?}");
     }
 }

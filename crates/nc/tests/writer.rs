@@ -1,8 +1,8 @@
 use std::collections::BTreeMap;
 
 use kinpost_nc::{
-    AxisSpec, Block, Dialect, Motion, NcError, NcWriter, ProgramInfo, Spindle, check_template,
-    read_program, read_program_full,
+    AxisSpec, Block, Dialect, Motion, NcError, NcWriter, ProgramInfo, Spindle, TemplateKind,
+    check_template, read_program, read_program_full,
 };
 
 /// Machine axes of the MTS1600-500-6NC in chain order (DESIGN §2.1).
@@ -426,9 +426,25 @@ fn template_render_errors_are_reported() {
         .unwrap_err();
     assert!(matches!(e, NcError::Template { .. }), "{e}");
     assert!(e.to_string().contains("undefined"), "{e}");
-    let e = check_template("G01\n{% if x %}").unwrap_err();
+    let e = check_template(TemplateKind::Header, "G01\n{% if x %}").unwrap_err();
     assert!(e.range.is_some());
-    assert!(check_template("T{{ tool_number }}").is_ok());
+    assert_eq!(e.line, Some(2));
+    assert!(check_template(TemplateKind::Header, "T{{ tool_number }}").is_ok());
+    // A variable the header is not given, found without rendering: the
+    // range is its first use.
+    let source = "; {{ program_name }}\nT{{ tool_numbr }}";
+    let e = check_template(TemplateKind::Footer, source).unwrap_err();
+    assert!(e.message.contains("unknown variable `tool_numbr`"), "{e}");
+    assert_eq!(&source[e.range.clone().unwrap()], "tool_numbr");
+    assert_eq!(e.line, Some(2));
+    // Tested with `is defined`: allowed.
+    assert!(
+        check_template(
+            TemplateKind::Footer,
+            "{% if extra is defined %}x{% endif %}"
+        )
+        .is_ok()
+    );
     let mut vars = BTreeMap::new();
     vars.insert("x".to_string(), kinpost_nc::Value::from(2.5));
     assert_eq!(
