@@ -449,7 +449,7 @@ fn unknown_machine(name: &str) -> anyhow::Error {
 /// A built-in machine by name, or a machine file.
 fn load_machine(name: &str) -> Result<Machine> {
     let path = Path::new(name);
-    if path.is_file() {
+    if is_file_to_read(path) {
         let src = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read machine file {name}"))?;
         return machine_from_source(&src, name);
@@ -459,6 +459,12 @@ fn load_machine(name: &str) -> Result<Machine> {
         None if path.is_dir() => Err(anyhow!("machine file {name} is a directory")),
         None => Err(unknown_machine(name)),
     }
+}
+
+/// Whether `path` names something to read as a file: a file, or a named
+/// pipe or device (`-m <(…)` in a shell), not a directory.
+fn is_file_to_read(path: &Path) -> bool {
+    path.metadata().is_ok_and(|m| !m.is_dir())
 }
 
 /// A machine file's machine, its `[post]` templates checked too.
@@ -471,7 +477,7 @@ fn machine_from_source(src: &str, name: &str) -> Result<Machine> {
 /// A built-in dialect by name, or a dialect file.
 fn load_dialect(name: &str) -> Result<Dialect> {
     let path = Path::new(name);
-    if path.is_file() {
+    if is_file_to_read(path) {
         let src = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read dialect file {name}"))?;
         return Dialect::from_toml(&src, name).map_err(report);

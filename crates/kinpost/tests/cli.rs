@@ -543,6 +543,48 @@ fn machine_check() {
     assert!(stdout(&o).is_empty());
 }
 
+/// A machine or dialect file that is a pipe (`-m <(…)` in a shell) is
+/// read like a file.
+#[cfg(target_os = "linux")]
+#[test]
+fn machine_and_dialect_files_may_be_pipes() {
+    let machine = std::fs::read(root().join("crates/machine/machines/mts1600.toml")).unwrap();
+    let cl = example("flat-part.cls");
+    let o = run_with_stdin(
+        &["post", cl.to_str().unwrap(), "-m", "/dev/stdin"],
+        &machine,
+    );
+    assert_exit(&o, 0);
+    assert_eq!(
+        stdout(&o),
+        stdout(&run(&["post", cl.to_str().unwrap(), "-m", "mts1600"]))
+    );
+    let dialect = stdout(&run(&["dialect", "show", "fanuc"]));
+    let o = run_with_stdin(
+        &[
+            "post",
+            cl.to_str().unwrap(),
+            "-m",
+            "mts1600",
+            "-d",
+            "/dev/stdin",
+        ],
+        dialect.as_bytes(),
+    );
+    assert_exit(&o, 0);
+    assert_eq!(
+        stdout(&o),
+        stdout(&run(&[
+            "post",
+            cl.to_str().unwrap(),
+            "-m",
+            "mts1600",
+            "-d",
+            "fanuc"
+        ]))
+    );
+}
+
 #[test]
 fn machine_file_templates_are_checked_at_load() {
     let dir = tempfile::tempdir().unwrap();
