@@ -3,8 +3,6 @@
 //! file is loaded, as a dialect file's templates are, so that a mistake is
 //! reported at its place in the machine file before a post reaches it.
 
-use std::ops::Range;
-
 use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 use kinpost_nc::{TemplateKind, check_template, template_span_in_toml};
 use serde::Deserialize;
@@ -39,8 +37,7 @@ pub fn check_machine_templates(source: &str, file: &str) -> Result<(), Diagnosti
     .filter_map(|(kind, t)| {
         let t = t?;
         let e = check_template(kind, t.get_ref()).err()?;
-        let range = e.range.clone().or_else(|| line_start(t.get_ref(), e.line));
-        let span = template_span_in_toml(source, t.span(), t.get_ref(), range);
+        let span = template_span_in_toml(source, t.span(), t.get_ref(), e.range);
         Some(Diagnostic::at_byte_span(
             Severity::Error,
             file,
@@ -55,17 +52,6 @@ pub fn check_machine_templates(source: &str, file: &str) -> Result<(), Diagnosti
     } else {
         Err(Diagnostics(errors))
     }
-}
-
-/// The byte range of the first character of 1-based line `line` of `text`.
-fn line_start(text: &str, line: Option<usize>) -> Option<Range<usize>> {
-    let line = line?;
-    let start: usize = text
-        .split_inclusive('\n')
-        .take(line.saturating_sub(1))
-        .map(str::len)
-        .sum();
-    (start <= text.len()).then_some(start..start + 1)
 }
 
 #[cfg(test)]

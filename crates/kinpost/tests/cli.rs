@@ -26,6 +26,14 @@ fn run(args: &[&str]) -> Output {
     kinpost(args).output().expect("run kinpost")
 }
 
+/// Runs in directory `dir` (outputs named without a directory go there).
+fn run_in(dir: &Path, args: &[&str]) -> Output {
+    kinpost(args)
+        .current_dir(dir)
+        .output()
+        .expect("run kinpost")
+}
+
 /// Runs with `input` on standard input.
 fn run_with_stdin(args: &[&str], input: &[u8]) -> Output {
     let mut child = kinpost(args)
@@ -336,17 +344,25 @@ fn bad_option_values_are_usage_errors() {
     }
 }
 
-#[test]
-fn bad_surface_and_path_option_values_are_usage_errors() {
-    let dir = tempfile::tempdir().unwrap();
-    let points = dir.path().join("points.csv");
+/// A 4 × 4 grid of points 10 mm apart, `z = bend·i·j`, as
+/// `dir/points.csv`.
+fn grid_points(dir: &Path, bend: f64) -> PathBuf {
+    let points = dir.join("points.csv");
     let mut csv = String::from("row,col,x,y,z\n");
     for i in 0..4 {
         for j in 0..4 {
-            csv.push_str(&format!("{i},{j},{},{},0\n", 10 * j, 10 * i));
+            let z = bend * f64::from(i * j);
+            csv.push_str(&format!("{i},{j},{},{},{z}\n", 10 * j, 10 * i));
         }
     }
     std::fs::write(&points, csv).unwrap();
+    points
+}
+
+#[test]
+fn bad_surface_and_path_option_values_are_usage_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let points = grid_points(dir.path(), 0.0);
     let surface = dir.path().join("s.json");
     let surface = surface.to_str().unwrap();
     let o = run(&["surface", "fit", points.to_str().unwrap(), "-o", surface]);
@@ -386,24 +402,13 @@ fn bad_surface_and_path_option_values_are_usage_errors() {
     assert_exit(&o, 1);
     assert!(stderr(&o).contains("outside the surface's domain"));
 }
+
 #[test]
 fn every_command_writes_dash_to_standard_output() {
     let dir = tempfile::tempdir().unwrap();
-    let points = dir.path().join("points.csv");
-    let mut csv = String::from("row,col,x,y,z\n");
-    for i in 0..4 {
-        for j in 0..4 {
-            csv.push_str(&format!("{i},{j},{},{},{}\n", 10 * j, 10 * i, i * j));
-        }
-    }
-    std::fs::write(&points, csv).unwrap();
+    let points = grid_points(dir.path(), 1.0);
     let points = points.to_str().unwrap();
-    let in_dir = |args: &[&str]| {
-        kinpost(args)
-            .current_dir(dir.path())
-            .output()
-            .expect("run kinpost")
-    };
+    let in_dir = |args: &[&str]| run_in(dir.path(), args);
     // The surface as JSON on standard output, the grid in a file.
     let o = in_dir(&["surface", "fit", points, "-o", "-", "--write-grid", "g.csv"]);
     assert_exit(&o, 0);
@@ -1086,12 +1091,7 @@ fn dash_outputs_are_standard_output() {
     let dir = tempfile::tempdir().unwrap();
     let cl = example("flat-part.cls");
     let cl = cl.to_str().unwrap();
-    let in_dir = |args: &[&str]| {
-        kinpost(args)
-            .current_dir(dir.path())
-            .output()
-            .expect("run kinpost")
-    };
+    let in_dir = |args: &[&str]| run_in(dir.path(), args);
     let o = in_dir(&[
         "post", cl, "-m", "mts1600", "-q", "-o", "-", "--json", "s.json",
     ]);

@@ -855,7 +855,7 @@ pub fn check_template(kind: TemplateKind, source: &str) -> Result<(), TemplateEr
     if let Err(e) = env.add_template_owned(kind.key(), source.to_string()) {
         return Err(TemplateError {
             message: format!("template `{}`: {}", kind.key(), template::error_message(&e)),
-            range: e.range(),
+            range: template::error_range(source, &e),
             line: e.line(),
         });
     }

@@ -262,18 +262,20 @@ pub(crate) fn error_span_in_toml(
     text: &str,
     e: &minijinja::Error,
 ) -> Range<usize> {
-    let range = e.range().or_else(|| {
-        // Only a line: point at its start.
-        e.line().and_then(|l| {
-            let start: usize = text
-                .split_inclusive('\n')
-                .take(l.saturating_sub(1))
-                .map(str::len)
-                .sum();
-            (start <= text.len()).then_some(start..start + 1)
-        })
-    });
-    template_span_in_toml(toml_source, value_span, text, range)
+    template_span_in_toml(toml_source, value_span, text, error_range(text, e))
+}
+
+/// Where error `e` lies in template `text`: its byte range, or when it
+/// gives only a line, the start of that line.
+pub(crate) fn error_range(text: &str, e: &minijinja::Error) -> Option<Range<usize>> {
+    e.range().or_else(|| {
+        let start: usize = text
+            .split_inclusive('\n')
+            .take(e.line()?.saturating_sub(1))
+            .map(str::len)
+            .sum();
+        (start <= text.len()).then_some(start..start + 1)
+    })
 }
 
 #[cfg(test)]
