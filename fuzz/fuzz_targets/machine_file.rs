@@ -1,7 +1,7 @@
 //! Fuzz target: any bytes (as lossy UTF-8) fed to the machine-file loader
 //! must give a machine or located diagnostics, never a panic; a machine that
 //! loads must survive forward kinematics at home and inverse kinematics of
-//! that pose. Run with `cargo +nightly fuzz run machine_file` from the
+//! that pose, and the check of its `[post]` templates. Run with `cargo +nightly fuzz run machine_file` from the
 //! repository root (seed the corpus with `crates/machine/machines/*.toml` and
 //! `crates/machine/tests/malformed/*.toml`).
 
@@ -22,6 +22,13 @@ fuzz_target!(|data: &[u8]| {
             }
         }
         Ok(machine) => {
+            if let Err(diags) = kinpost::check_machine_templates(&text, "fuzz.toml") {
+                let lines = text.split('\n').count();
+                for d in &diags.0 {
+                    assert!(d.line >= 1 && d.line <= lines && d.column >= 1);
+                    let _ = d.to_string();
+                }
+            }
             let kin = Kinematics::new(&machine);
             let home = machine.home_joints();
             let pose = kin.fk(&home);

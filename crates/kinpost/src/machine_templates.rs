@@ -85,6 +85,26 @@ mod tests {
         );
     }
 
+    proptest::proptest! {
+        /// Any template text: no panic, and every error points at a line
+        /// and column of the file.
+        #[test]
+        fn any_template_is_checked_without_a_panic(
+            header in "[ -~\n{}%#]{0,60}",
+            footer in "[ -~{}%]{0,30}",
+        ) {
+            let source = format!(
+                "name = \"m\"\n[post]\nheader = '''\n{header}'''\nfooter = '{footer}'\n"
+            );
+            if let Err(e) = check_machine_templates(&source, "m.toml") {
+                let lines = source.split('\n').count();
+                for d in &e.0 {
+                    proptest::prop_assert!(d.line >= 1 && d.line <= lines && d.column >= 1, "{d}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_built_in_machines_templates_are_right() {
         for name in kinpost_machine::builtin::names() {
