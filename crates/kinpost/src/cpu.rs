@@ -50,6 +50,7 @@ mod x86 {
         (cfg!(target_feature = "sse4.2"), 1, Reg::Ecx, 20),
         (cfg!(target_feature = "movbe"), 1, Reg::Ecx, 22),
         (cfg!(target_feature = "popcnt"), 1, Reg::Ecx, 23),
+        (cfg!(target_feature = "xsave"), 1, Reg::Ecx, 26),
         (cfg!(target_feature = "avx"), 1, Reg::Ecx, 28),
         (cfg!(target_feature = "f16c"), 1, Reg::Ecx, 29),
         (cfg!(target_feature = "bmi1"), 7, Reg::Ebx, 3),
