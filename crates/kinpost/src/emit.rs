@@ -12,6 +12,7 @@ use kinpost_machine::{
     Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
 };
 use kinpost_nc::{Block, Motion, NcWriter};
+use kinpost_plan::STEP_CEILING_DEG;
 use nalgebra::Vector3;
 
 use crate::check::{CheckStats, Tolerance, angle_between, pose_error};
@@ -241,7 +242,9 @@ impl<W: Write> Emitter<W> {
             let linearize = self.settings.lintol > 0.0 && self.settings.tcp.is_none();
             if t.cut && !t.continuous {
                 let last = *last;
-                self.reconfigure(machine, kin, &last, t)?;
+                for node in &self.reconfigure(machine, kin, &last, t)? {
+                    self.inserted(machine, kin, node, Motion::Feed, t)?;
+                }
             } else if linearize
                 && let Some(bound) =
                     chord_settles(kin, &last.node, t.node, last.lever, self.settings.lintol)
@@ -423,14 +426,20 @@ impl<W: Write> Emitter<W> {
     }
 
     /// Retract along the tool axis from the last block, turn the rotary axes
-    /// to the new configuration above the next point, and re-approach.
+    /// to the new configuration above the point before `t` and re-approach
+    /// it, so that the segment to `t` is cut in the new configuration: the
+    /// rapid and approach blocks are written here, and the feed blocks
+    /// that linearize the segment are returned for the caller to write
+    /// before `t`. Where the new configuration cannot reach the point
+    /// before, or not move on from it continuously, the re-approach is onto
+    /// `t` itself and the segment is left uncut (reported).
     fn reconfigure(
         &mut self,
         machine: &Machine,
         kin: &Kinematics,
         last: &Last,
         t: &Target,
-    ) -> Result<(), PostError> {
+    ) -> Result<Vec<Node>, PostError> {
         let (from, to) = (&last.node, t.node);
         if !self.settings.reconfigure {
             return Err((t.at)(format!(
@@ -445,10 +454,12 @@ impl<W: Write> Emitter<W> {
             point: node.pose.point + node.pose.axis * d,
             ..node.pose
         };
-        let up = lift(from);
-        let over = lift(to);
-        let mut nodes = [*from, *to];
-        for (k, (pose, near)) in [(up, from), (over, to)].into_iter().enumerate() {
+        // The point before, in the configuration of `t`.
+        let resumed = self.resume(kin, from, to);
+        let down = resumed.as_ref().map_or(to, |(node, _)| node);
+        let (up, over) = (lift(from), lift(down));
+        let mut nodes = [*from, *down];
+        for (k, (pose, near)) in [(up, from), (over, down)].into_iter().enumerate() {
             let near = Near {
                 joints: &near.joints,
                 hold: near.hold,
@@ -482,11 +493,61 @@ impl<W: Write> Emitter<W> {
             from_deg: a,
             to_deg: b,
             retract_mm: d,
+            uncut_mm: match resumed {
+                Some(_) => 0.0,
+                None => (to.pose.point - from.pose.point).norm(),
+            },
         });
         for node in &nodes {
             self.inserted(machine, kin, node, Motion::Rapid, t)?;
         }
-        Ok(())
+        Ok(match resumed {
+            // The approach onto the point before, then the segment.
+            Some((node, between)) => std::iter::once(node).chain(between).collect(),
+            None => Vec::new(),
+        })
+    }
+
+    /// The point before a reconfiguration (`from`) in the configuration of
+    /// the point after it (`to`), and the nodes that linearize the segment
+    /// between them: `None` when that configuration cannot reach `from`, or
+    /// the segment needs a jump of a rotary axis (beyond the planner's
+    /// ceiling of a continuous step) or does not converge to the straight
+    /// segment.
+    fn resume(&mut self, kin: &Kinematics, from: &Node, to: &Node) -> Option<(Node, Vec<Node>)> {
+        let near = Near {
+            joints: &to.joints,
+            hold: to.hold,
+            branch: Some(to.branch),
+        };
+        let (pose, sol) = solve_near(kin, &from.pose, &near, &self.rotary, &mut self.solutions)?;
+        let node = Node {
+            pose,
+            joints: sol.joints,
+            hold: to.hold,
+            branch: sol.branch,
+        };
+        let step = self
+            .rotary
+            .iter()
+            .map(|&i| (to.joints[i] - node.joints[i]).abs())
+            .fold(0.0, f64::max);
+        if node.branch != to.branch || step > STEP_CEILING_DEG {
+            return None;
+        }
+        let mut between = Vec::new();
+        if self.settings.lintol > 0.0 && self.settings.tcp.is_none() {
+            // (A segment that is then not cut does not count.)
+            let error_before = self.planning.max_linearization_error_mm;
+            if self
+                .linearize(kin, &node, to, f64::INFINITY, 0, &mut between)
+                .is_err()
+            {
+                self.planning.max_linearization_error_mm = error_before;
+                return None;
+            }
+        }
+        Some((node, between))
     }
 
     fn largest_jump(&self, a: &Joints, b: &Joints) -> (usize, f64, f64) {

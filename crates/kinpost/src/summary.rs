@@ -83,6 +83,13 @@ pub struct Reconfiguration {
     pub to_deg: f64,
     /// Retract distance along the tool axis, mm.
     pub retract_mm: f64,
+    /// Length of the CL segment from `previous_line` to `line` that is not
+    /// cut, mm: 0 where the tool re-approaches the previous point in the
+    /// new setting and cuts the segment from there (the usual case); the
+    /// whole segment where the new setting cannot reach the previous point
+    /// or move on from it continuously (the re-approach is then onto
+    /// `line`).
+    pub uncut_mm: f64,
 }
 
 /// A feed block slowed down by an axis's maximum velocity.
@@ -172,6 +179,19 @@ impl Summary {
         }
         if !p.reconfigurations.is_empty() {
             planning += &format!("; {} reconfiguration(s)", p.reconfigurations.len());
+            let uncut: Vec<&Reconfiguration> = p
+                .reconfigurations
+                .iter()
+                .filter(|r| r.uncut_mm > 0.0)
+                .collect();
+            if !uncut.is_empty() {
+                let mm: f64 = uncut.iter().map(|r| r.uncut_mm).sum();
+                planning += &format!(
+                    " ({} leaving {mm:.3} mm of the path uncut, first before CL line {})",
+                    uncut.len(),
+                    uncut[0].line
+                );
+            }
         }
         if p.feed_clamp_count > 0 {
             planning += &format!("; {} feed block(s) clamped", p.feed_clamp_count);

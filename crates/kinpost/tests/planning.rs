@@ -346,15 +346,22 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
     assert_eq!(events.len(), 1, "{events:?}");
     let event = &events[0];
     assert_eq!(event.retract_mm, 50.0);
-    // The blocks before the event's point: the CL point before, the
-    // retract, the turn above the next point, then the point itself.
+    assert_eq!(
+        event.uncut_mm, 0.0,
+        "the segment is cut after the re-approach"
+    );
+    // The blocks from the CL point before the event: the point, the
+    // retract, the turn above that same point, the approach onto it in the
+    // new configuration, then the segment to the event's point, cut.
     let all = rows(&csv, m.axes.len());
+    let b = all.iter().position(|r| r.0 == event.previous_line).unwrap();
     let at = all.iter().position(|r| r.0 == Some(event.line)).unwrap();
-    let before = &all[at - 3];
-    assert_eq!(before.0, event.previous_line);
-    let (retract, over) = (&all[at - 2], &all[at - 1]);
-    assert!(retract.0.is_none() && over.0.is_none());
-    assert_eq!((retract.1.as_str(), over.1.as_str()), ("rapid", "rapid"));
+    let (before, retract, over, again) = (&all[b], &all[b + 1], &all[b + 2], &all[b + 3]);
+    assert!(retract.0.is_none() && over.0.is_none() && again.0.is_none());
+    assert_eq!(
+        (retract.1.as_str(), over.1.as_str(), again.1.as_str()),
+        ("rapid", "rapid", "feed")
+    );
     let p0 = kin.fk(&before.2);
     let p1 = kin.fk(&retract.2);
     let lift = p1.point - p0.point;
@@ -363,10 +370,27 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
         lift.normalize().angle(&p0.axis) < 1e-4,
         "the retract follows the tool axis"
     );
-    let target = kin.fk(&all[at].2);
-    let approach = target.point - kin.fk(&over.2).point;
+    // The same pose in the other configuration.
+    let resumed = kin.fk(&again.2);
+    assert!((resumed.point - p0.point).norm() < 1e-3);
+    assert!(resumed.axis.angle(&p0.axis) < 1e-4);
+    let ic = m.axis_index("C").unwrap();
+    assert!(
+        (again.2[ic] - before.2[ic]).abs() > 90.0,
+        "{again:?} {before:?}"
+    );
+    let approach = resumed.point - kin.fk(&over.2).point;
     assert!((approach.norm() - 50.0).abs() < 1e-3);
-    assert!((-approach).normalize().angle(&target.axis) < 1e-4);
+    assert!((-approach).normalize().angle(&resumed.axis) < 1e-4);
+    // The segment: inserted feed blocks on it, then the event's point.
+    let target = kin.fk(&all[at].2);
+    for r in &all[b + 4..at] {
+        assert!(r.0.is_none() && r.1 == "feed");
+        let p = kin.fk(&r.2).point;
+        let along = (target.point - p0.point).normalize();
+        let off = (p - p0.point) - along * (p - p0.point).dot(&along);
+        assert!(off.norm() <= 0.002 + 1e-6, "{}", off.norm());
+    }
     assert!(summary.max_position_error_mm <= summary.tolerance_mm);
 
     // Forbidden: the error names that CL line.
@@ -377,6 +401,53 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
     let e = post_csv(&m, &cl, &options).unwrap_err().to_string();
     assert!(e.contains(&format!(":{}:", event.line)), "{e}");
     assert!(e.contains("--no-reconfigure"), "{e}");
+}
+
+/// Where neither configuration reaches both ends of a segment (C needs
+/// 190° there, its travel ends at 185°, and the other A branch is outside
+/// A's travel), the re-approach is onto the next point and the segment is
+/// reported as not cut, with its length.
+#[test]
+fn a_segment_no_configuration_can_cut_is_reported_uncut() {
+    let source = builtin::source("trunnion-ac")
+        .unwrap()
+        .replace("limits = [-30, 120]", "limits = [0, 120]")
+        .replace(
+            "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+            "point = [0, 0, 0]\nlimits = [-185, 185]",
+        );
+    let m = machine_from_toml(&source, "short-c-one-branch.toml").unwrap();
+    let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
+    for k in 0..25 {
+        let phi = (20.0 * f64::from(k)).to_radians();
+        let tilt = 25f64.to_radians();
+        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
+        cl.push_str(&goto(
+            &Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0),
+            &axis,
+        ));
+    }
+    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    let events = &summary.planning.reconfigurations;
+    assert_eq!(events.len(), 1, "{events:?}");
+    let event = &events[0];
+    // Two points 20° apart on a circle of 30 mm.
+    let chord = 2.0 * 30.0 * 10f64.to_radians().sin();
+    assert!((event.uncut_mm - chord).abs() < 1e-3, "{event:?}");
+    assert!(
+        summary.one_line().contains("mm of the path uncut"),
+        "{}",
+        summary.one_line()
+    );
+    // The point before, the retract, the turn above the next point, then
+    // the next point itself.
+    let all = rows(&csv, m.axes.len());
+    let at = all.iter().position(|r| r.0 == Some(event.line)).unwrap();
+    assert_eq!(all[at - 3].0, event.previous_line);
+    assert_eq!(
+        (all[at - 2].1.as_str(), all[at - 1].1.as_str()),
+        ("rapid", "rapid")
+    );
 }
 
 #[test]

@@ -26,7 +26,7 @@ const STEP_FLOOR_DEG: f64 = 1.0;
 /// switch there is a jump the linearization cannot follow.
 const SWITCH_APART_DEG: f64 = 0.0;
 /// No rotary axis turns by half a turn or more between two points of a cut.
-const STEP_CEILING_DEG: f64 = 179.0;
+pub const STEP_CEILING_DEG: f64 = 179.0;
 
 /// Most rotary axes the planner's fast path handles (others go through
 /// [`Costs::transition`]).

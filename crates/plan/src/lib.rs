@@ -19,7 +19,7 @@
 mod cost;
 mod trellis;
 
-pub use cost::{Costs, Link};
+pub use cost::{Costs, Link, STEP_CEILING_DEG};
 pub use trellis::{Choice, RECONFIGURE, Trellis};
 
 use kinpost_machine::{Solution, Violation};
