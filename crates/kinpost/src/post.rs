@@ -754,9 +754,9 @@ impl<W: Write> Job<'_, W> {
                     let a = &s.machine.axes[v.axis];
                     let [lo, hi] = a.limits.unwrap_or([f64::NAN, f64::NAN]);
                     format!(
-                        "no solution inside the travel: {} would be {:.4} (limits {lo} .. {hi}) for {}",
+                        "no solution inside the travel: {} would be {} (limits {lo} .. {hi}) for {}",
                         a.name,
-                        v.value,
+                        Mm(v.value),
                         describe(pose)
                     )
                 }
@@ -903,7 +903,40 @@ fn reference_remark(
 pub(crate) fn describe(pose: &Pose) -> String {
     let (p, a) = (pose.point, pose.axis);
     format!(
-        "point ({:.4}, {:.4}, {:.4}) axis ({:.7}, {:.7}, {:.7})",
-        p.x, p.y, p.z, a.x, a.y, a.z
+        "point ({}, {}, {}) axis ({:.7}, {:.7}, {:.7})",
+        Mm(p.x),
+        Mm(p.y),
+        Mm(p.z),
+        a.x,
+        a.y,
+        a.z
     )
+}
+
+/// A length or angle in a message: four decimals, or in exponent notation
+/// where that would print hundreds of digits (`GOTO/1e300,…`).
+pub(crate) struct Mm(pub f64);
+
+impl std::fmt::Display for Mm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.abs() < 1e12 || !self.0.is_finite() {
+            write!(f, "{:.4}", self.0)
+        } else {
+            write!(f, "{:.4e}", self.0)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Mm;
+
+    #[test]
+    fn huge_lengths_are_written_with_an_exponent() {
+        assert_eq!(Mm(12.345_67).to_string(), "12.3457");
+        assert_eq!(Mm(-999_999_999_999.0).to_string(), "-999999999999.0000");
+        assert_eq!(Mm(1e300).to_string(), "1.0000e300");
+        assert_eq!(Mm(-1e12).to_string(), "-1.0000e12");
+        assert_eq!(Mm(f64::NAN).to_string(), "NaN");
+    }
 }
