@@ -7,6 +7,7 @@
 
 use std::io::Write;
 
+use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::angle::SinCosMemo;
 use kinpost_machine::{
     Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
@@ -132,6 +133,9 @@ pub(crate) struct Emitter<W: Write> {
     inserted: Vec<Node>,
     pub stats: CheckStats,
     pub planning: Planning,
+    /// Warnings about what the post could not do as the CL asks (a segment
+    /// left uncut), at their CL lines.
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl<W: Write> Emitter<W> {
@@ -175,6 +179,7 @@ impl<W: Write> Emitter<W> {
             inserted: Vec::new(),
             stats: CheckStats::default(),
             planning: Planning::default(),
+            warnings: Vec::new(),
         }
     }
 
@@ -486,6 +491,21 @@ impl<W: Write> Emitter<W> {
             };
         }
         let (axis, a, b) = self.largest_jump(&from.joints, &to.joints);
+        let uncut_mm = match resumed {
+            Some(_) => 0.0,
+            None => (to.pose.point - from.pose.point).norm(),
+        };
+        if uncut_mm > 0.0
+            && let PostError::Input(mut warning) = (t.at)(format!(
+                "the segment from CL line {} to this point ({uncut_mm:.3} mm) is not cut: no setting \
+                 of the rotary axes inside the travel moves along it continuously, and after the \
+                 retract and reconfiguration ({} {a:.3}° to {b:.3}°) the tool re-approaches this point",
+                last.line, self.names[axis]
+            ))
+        {
+            warning.severity = Severity::Warning;
+            self.warnings.push(*warning);
+        }
         self.planning.reconfigurations.push(Reconfiguration {
             line: t.line,
             previous_line: Some(last.line),
@@ -493,10 +513,7 @@ impl<W: Write> Emitter<W> {
             from_deg: a,
             to_deg: b,
             retract_mm: d,
-            uncut_mm: match resumed {
-                Some(_) => 0.0,
-                None => (to.pose.point - from.pose.point).norm(),
-            },
+            uncut_mm,
         });
         for node in &nodes {
             self.inserted(machine, kin, node, Motion::Rapid, t)?;

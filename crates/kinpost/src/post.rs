@@ -302,7 +302,8 @@ pub fn post<R: BufRead, W: Write>(
         &mut setup.emitter,
         true,
     )?;
-    let emitter = setup.emitter;
+    let mut emitter = setup.emitter;
+    warnings.append(&mut emitter.warnings);
     let mut writer = emitter.writer;
     if emitter.inverse_time_on {
         writer.inverse_time(false)?;

@@ -439,6 +439,17 @@ fn a_segment_no_configuration_can_cut_is_reported_uncut() {
         "{}",
         summary.one_line()
     );
+    // A warning at the point, naming the segment.
+    let [w] = &summary.warnings[..] else {
+        panic!("{:?}", summary.warnings)
+    };
+    assert_eq!(w.line, event.line);
+    let from = format!(
+        "from CL line {} to this point",
+        event.previous_line.unwrap()
+    );
+    assert!(w.message.contains(&from), "{w}");
+    assert!(w.message.contains("is not cut"), "{w}");
     // The point before, the retract, the turn above the next point, then
     // the next point itself.
     let all = rows(&csv, m.axes.len());
