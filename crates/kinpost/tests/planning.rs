@@ -403,6 +403,37 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
     assert!(e.contains("--no-reconfigure"), "{e}");
 }
 
+/// Three turns of the tool axis about the part's Z on a C axis of ±360°:
+/// the cheapest reconfiguration would unwind C by two turns, into a
+/// setting that cannot reach the point before it (C would be 1° past its
+/// travel there), leaving that segment uncut. The planner takes a
+/// reconfiguration the tool can resume from instead: every segment is cut.
+#[test]
+fn the_planner_prefers_a_reconfiguration_that_cuts_every_segment() {
+    let source = builtin::source("trunnion-ac").unwrap().replace(
+        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
+        "point = [0, 0, 0]\nlimits = [-360, 360]",
+    );
+    let m = machine_from_toml(&source, "c-360.toml").unwrap();
+    let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
+    for k in 0..=223 {
+        let phi = (1.0 + 5.0 * f64::from(k)).to_radians();
+        let tilt = 25f64.to_radians();
+        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
+        cl.push_str(&goto(
+            &Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0),
+            &axis,
+        ));
+    }
+    let (_, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    let events = &summary.planning.reconfigurations;
+    assert!(!events.is_empty());
+    for e in events {
+        assert_eq!(e.uncut_mm, 0.0, "{e:?}");
+    }
+    assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+}
+
 /// Where neither configuration reaches both ends of a segment (C needs
 /// 190° there, its travel ends at 185°, and the other A branch is outside
 /// A's travel), the re-approach is onto the next point and the segment is

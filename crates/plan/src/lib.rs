@@ -20,7 +20,7 @@ mod cost;
 mod trellis;
 
 pub use cost::{Costs, Link, STEP_CEILING_DEG};
-pub use trellis::{Choice, RECONFIGURE, Trellis};
+pub use trellis::{Choice, RECONFIGURE, Trellis, UNCUT};
 
 use kinpost_machine::{Solution, Violation};
 

@@ -17,6 +17,14 @@ use crate::cost::{CUT_BRANCH_SWITCH, Costs, CutLimits, CutRule, Link, MAX_ROTARY
 /// reconfiguration is only chosen where no continuous sequence exists.
 pub const RECONFIGURE: f64 = 1e9;
 
+/// Cost added to a candidate that no candidate of the point before reaches
+/// continuously: after the reconfiguration into it, the tool cannot
+/// re-approach the point before in its setting and cut the segment from
+/// there, so the segment would be left uncut. Ten reconfigurations cost
+/// less: another turn of the axes elsewhere is better than a skipped
+/// segment.
+pub const UNCUT: f64 = 10.0 * RECONFIGURE;
+
 /// One candidate configuration of one point and how it is reached.
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -220,6 +228,7 @@ impl Trellis {
             let mut best = (f64::INFINITY, u32::MAX, true);
             match previous {
                 Some(first) => {
+                    let mut reached = false;
                     for (k, p) in self.tips.iter().enumerate() {
                         let k = first + k;
                         let (c, continuous) = self.costs.transition(
@@ -229,11 +238,15 @@ impl Trellis {
                             s.branch,
                             link,
                         );
+                        reached |= continuous;
                         let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
                         // Strictly less: ties keep the earlier candidate.
                         if total < best.0 {
                             best = (total, k as u32, continuous);
                         }
+                    }
+                    if !reached {
+                        best.0 += UNCUT;
                     }
                 }
                 None => {
@@ -244,13 +257,16 @@ impl Trellis {
                     let (c, continuous) = self
                         .costs
                         .transition(&from, branch, &s.joints, s.branch, link);
-                    // The same sum as from a previous layer (the anchor's
-                    // cost is 0 after a decision that is not settled).
-                    best = (
-                        self.anchor_cost + c + if continuous { 0.0 } else { RECONFIGURE },
-                        u32::MAX,
-                        continuous,
-                    );
+                    // The same sum, in the same order, as from a previous
+                    // layer (the anchor's cost is 0 after a decision that is
+                    // not settled), the anchor being the only configuration
+                    // of its point.
+                    let mut total =
+                        self.anchor_cost + c + if continuous { 0.0 } else { RECONFIGURE };
+                    if !continuous {
+                        total += UNCUT;
+                    }
+                    best = (total, u32::MAX, continuous);
                 }
             }
             let mut rotary = [0.0; MAX_ROTARY];
@@ -360,6 +376,7 @@ impl Layer<'_> {
                 v[k] = s.joints[axes[k]];
             }
             let mut best = (f64::INFINITY, u32::MAX, true);
+            let mut reached = false;
             for (k, p) in self.tips.iter().enumerate() {
                 let switch = p.branch != s.branch;
                 let limit = if switch { &limits.switch } else { &limits.same };
@@ -375,11 +392,15 @@ impl Layer<'_> {
                 if switch {
                     c += CUT_BRANCH_SWITCH;
                 }
+                reached |= continuous;
                 let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
                 // Strictly less: ties keep the earlier candidate.
                 if total < best.0 {
                     best = (total, (self.previous + k) as u32, continuous);
                 }
+            }
+            if !reached {
+                best.0 += UNCUT;
             }
             add_node(
                 self.nodes,

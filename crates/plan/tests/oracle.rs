@@ -4,7 +4,7 @@
 //! bit for bit.
 
 use kinpost_machine::{Joints, MAX_AXES, Machine, Prefer, Solution, Violation, Wrap, builtin};
-use kinpost_plan::{Choice, Costs, Link, RECONFIGURE, Trellis};
+use kinpost_plan::{Choice, Costs, Link, RECONFIGURE, Trellis, UNCUT};
 use proptest::prelude::*;
 
 #[derive(Clone, Copy)]
@@ -61,15 +61,22 @@ impl Oracle {
             let mut best = (f64::INFINITY, u32::MAX, true);
             match &previous {
                 Some(range) => {
+                    // A candidate no configuration of the point before
+                    // reaches continuously leaves the segment uncut.
+                    let mut reached = false;
                     for k in range.clone() {
                         let p = &self.nodes[k];
                         let (c, continuous) = self
                             .costs
                             .transition(&p.joints, p.branch, &s.joints, s.branch, link);
+                        reached |= continuous;
                         let total = p.cost + c + if continuous { 0.0 } else { RECONFIGURE };
                         if total < best.0 {
                             best = (total, k as u32, continuous);
                         }
+                    }
+                    if !reached {
+                        best.0 += UNCUT;
                     }
                 }
                 None => {
@@ -80,11 +87,11 @@ impl Oracle {
                     let (c, continuous) = self
                         .costs
                         .transition(&from, branch, &s.joints, s.branch, link);
-                    best = (
-                        c + if continuous { 0.0 } else { RECONFIGURE },
-                        u32::MAX,
-                        continuous,
-                    );
+                    let mut total = c + if continuous { 0.0 } else { RECONFIGURE };
+                    if !continuous {
+                        total += UNCUT;
+                    }
+                    best = (total, u32::MAX, continuous);
                 }
             }
             self.nodes.push(Node {
