@@ -227,11 +227,16 @@ fn trunnion_with_a(limits: &str) -> Machine {
 }
 
 /// The built-in A/C trunnion with C turning by ±100° only.
-fn short_c() -> Machine {
-    let source = builtin::source("trunnion-ac").unwrap().replace(
+/// The built-in `trunnion-ac` as TOML with `line` added to its C axis.
+fn trunnion_ac_with_c(line: &str) -> String {
+    builtin::source("trunnion-ac").unwrap().replace(
         "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-        "point = [0, 0, 0]\nlimits = [-100, 100]",
-    );
+        &format!("point = [0, 0, 0]\n{line}"),
+    )
+}
+
+fn short_c() -> Machine {
+    let source = trunnion_ac_with_c("limits = [-100, 100]");
     let m = machine_from_toml(&source, "short-c.toml").unwrap();
     assert_eq!(
         m.axes[m.axis_index("C").unwrap()].limits,
@@ -246,10 +251,7 @@ fn short_c() -> Machine {
 /// turns it without end.
 #[test]
 fn limits_of_more_than_a_turn_are_kept_unless_the_axis_is_modulo() {
-    let source = builtin::source("trunnion-ac").unwrap().replace(
-        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-        "point = [0, 0, 0]\nlimits = [-370, 370]",
-    );
+    let source = trunnion_ac_with_c("limits = [-370, 370]");
     let mut cl = String::from("FEDRAT/MMPM,800\n");
     for k in 0..=216 {
         let phi = (5.0 * k as f64).to_radians();
@@ -293,10 +295,7 @@ fn limits_of_more_than_a_turn_are_kept_unless_the_axis_is_modulo() {
 /// point were candidates).
 #[test]
 fn an_unwinding_axis_without_limits_unwinds_after_two_turns() {
-    let source = builtin::source("trunnion-ac").unwrap().replace(
-        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-        "point = [0, 0, 0]\nwrap = \"unwind\"",
-    );
+    let source = trunnion_ac_with_c("wrap = \"unwind\"");
     let m = machine_from_toml(&source, "unwind-c.toml").unwrap();
     let ic = m.axis_index("C").unwrap();
     assert_eq!(m.axes[ic].limits, None);
@@ -325,9 +324,16 @@ fn an_unwinding_axis_without_limits_unwinds_after_two_turns() {
 /// Tool axis tilted 25° turning about the part's Z by 270°: more than C's
 /// range on either A branch.
 fn long_turn() -> String {
+    turning(0.0, 5.0, 55)
+}
+
+/// `count` points on a circle of 30 mm at Z 10, from `start_deg` in steps of
+/// `step_deg`, the tool axis tilted 25° towards each point: a tool axis
+/// turning about the part's Z (after a rapid, at 800 mm/min).
+fn turning(start_deg: f64, step_deg: f64, count: u32) -> String {
     let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
-    for k in 0..=54 {
-        let phi = (5.0 * k as f64).to_radians();
+    for k in 0..count {
+        let phi = (start_deg + step_deg * f64::from(k)).to_radians();
         let tilt = 25f64.to_radians();
         let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
         let point = Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0);
@@ -410,21 +416,9 @@ fn a_path_beyond_the_c_range_retracts_and_reconfigures_once() {
 /// reconfiguration the tool can resume from instead: every segment is cut.
 #[test]
 fn the_planner_prefers_a_reconfiguration_that_cuts_every_segment() {
-    let source = builtin::source("trunnion-ac").unwrap().replace(
-        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-        "point = [0, 0, 0]\nlimits = [-360, 360]",
-    );
+    let source = trunnion_ac_with_c("limits = [-360, 360]");
     let m = machine_from_toml(&source, "c-360.toml").unwrap();
-    let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
-    for k in 0..=223 {
-        let phi = (1.0 + 5.0 * f64::from(k)).to_radians();
-        let tilt = 25f64.to_radians();
-        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
-        cl.push_str(&goto(
-            &Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0),
-            &axis,
-        ));
-    }
+    let cl = turning(1.0, 5.0, 224);
     let (_, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
     let events = &summary.planning.reconfigurations;
     assert!(!events.is_empty());
@@ -440,24 +434,10 @@ fn the_planner_prefers_a_reconfiguration_that_cuts_every_segment() {
 /// reported as not cut, with its length.
 #[test]
 fn a_segment_no_configuration_can_cut_is_reported_uncut() {
-    let source = builtin::source("trunnion-ac")
-        .unwrap()
-        .replace("limits = [-30, 120]", "limits = [0, 120]")
-        .replace(
-            "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-            "point = [0, 0, 0]\nlimits = [-185, 185]",
-        );
+    let source = trunnion_ac_with_c("limits = [-185, 185]")
+        .replace("limits = [-30, 120]", "limits = [0, 120]");
     let m = machine_from_toml(&source, "short-c-one-branch.toml").unwrap();
-    let mut cl = String::from("FEDRAT/MMPM,800\nRAPID\n");
-    for k in 0..25 {
-        let phi = (20.0 * f64::from(k)).to_radians();
-        let tilt = 25f64.to_radians();
-        let axis = Vector3::new(tilt.sin() * phi.cos(), tilt.sin() * phi.sin(), tilt.cos());
-        cl.push_str(&goto(
-            &Vector3::new(30.0 * phi.cos(), 30.0 * phi.sin(), 10.0),
-            &axis,
-        ));
-    }
+    let cl = turning(0.0, 20.0, 25);
     let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
     let events = &summary.planning.reconfigurations;
     assert_eq!(events.len(), 1, "{events:?}");
@@ -670,10 +650,7 @@ proptest! {
 #[test]
 fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
     // The trunnion with C limited to 3600°/min; a pass that turns C fast.
-    let source = builtin::source("trunnion-ac").unwrap().replace(
-        "point = [0, 0, 0]          # measured: the table centre (at A = 0)",
-        "point = [0, 0, 0]\nmax_velocity = 3600",
-    );
+    let source = trunnion_ac_with_c("max_velocity = 3600");
     let m = machine_from_toml(&source, "slow-c.toml").unwrap();
     let ic = m.axis_index("C").unwrap();
     let mut cl = String::from("FEDRAT/MMPM,1000\nRAPID\n");
