@@ -43,6 +43,18 @@ pub(crate) struct Node {
     pub branch: u8,
 }
 
+impl Node {
+    /// The node of solution `sol`, which reaches `pose` with `hold` in force.
+    pub fn solved(pose: Pose, sol: &Solution, hold: Option<Hold>) -> Node {
+        Node {
+            pose,
+            joints: sol.joints,
+            hold,
+            branch: sol.branch,
+        }
+    }
+}
+
 /// One CL point as the planner hands it over.
 pub(crate) struct Target<'a> {
     pub node: &'a Node,
@@ -225,12 +237,7 @@ impl<W: Write> Emitter<W> {
                 Motion::Rapid => None,
             };
             if let Some((pose, sol)) = back {
-                let node = Node {
-                    pose,
-                    joints: sol.joints,
-                    hold: last.node.hold,
-                    branch: sol.branch,
-                };
+                let node = Node::solved(pose, &sol, last.node.hold);
                 self.inserted(machine, kin, &node, Motion::Feed, t)?;
             } else {
                 let here = kin.fk(&last.node.joints[..self.n]);
@@ -419,12 +426,7 @@ impl<W: Write> Emitter<W> {
         let Some((pose, sol)) = solved else {
             return Err(SplitError::OutsideTravel);
         };
-        let m = Node {
-            pose,
-            joints: sol.joints,
-            hold,
-            branch: sol.branch,
-        };
+        let m = Node::solved(pose, &sol, hold);
         self.linearize(kin, a, &m, lever, depth + 1, out)?;
         out.push(m);
         self.linearize(kin, &m, b, f64::INFINITY, depth + 1, out)
@@ -483,12 +485,7 @@ impl<W: Write> Emitter<W> {
                     }
                 )));
             };
-            nodes[k] = Node {
-                pose,
-                joints: sol.joints,
-                hold: near.hold,
-                branch: sol.branch,
-            };
+            nodes[k] = Node::solved(pose, &sol, near.hold);
         }
         let (axis, a, b) = self.largest_jump(&from.joints, &to.joints);
         let uncut_mm = match resumed {
@@ -538,12 +535,7 @@ impl<W: Write> Emitter<W> {
             branch: Some(to.branch),
         };
         let (pose, sol) = solve_near(kin, &from.pose, &near, &self.rotary, &mut self.solutions)?;
-        let node = Node {
-            pose,
-            joints: sol.joints,
-            hold: to.hold,
-            branch: sol.branch,
-        };
+        let node = Node::solved(pose, &sol, to.hold);
         let step = self
             .rotary
             .iter()

@@ -549,12 +549,7 @@ impl PathPlan {
             held_values.1 = axis.map_or(0.0, |i| sol.joints[i]);
             guess = sol.joints;
             self.run.push(Decided {
-                node: Node {
-                    pose,
-                    joints: sol.joints,
-                    hold,
-                    branch: sol.branch,
-                },
+                node: Node::solved(pose, &sol, hold),
                 continuous: true,
             });
         }
