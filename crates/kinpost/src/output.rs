@@ -87,13 +87,6 @@ impl Write for AtomicFile {
     }
 }
 
-/// Writes `contents` to `target` all-or-nothing.
-pub fn write_atomically(target: &Path, contents: &[u8]) -> io::Result<()> {
-    let mut f = AtomicFile::create(target)?;
-    f.write_all(contents)?;
-    f.commit()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,11 +132,16 @@ mod tests {
         use std::os::unix::fs::PermissionsExt;
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("new.mpf");
-        write_atomically(&target, b"x").unwrap();
+        let write = |bytes: &[u8]| {
+            let mut f = AtomicFile::create(&target).unwrap();
+            f.write_all(bytes).unwrap();
+            f.commit().unwrap();
+        };
+        write(b"x");
         let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode(&target), 0o644);
         std::fs::set_permissions(&target, std::fs::Permissions::from_mode(0o640)).unwrap();
-        write_atomically(&target, b"y").unwrap();
+        write(b"y");
         assert_eq!(mode(&target), 0o640);
     }
 }
