@@ -969,8 +969,8 @@ fn fk_and_ik_turn_an_axis_free_with_reference() {
     assert_ne!(unlocked, src);
     let free = dir.path().join("free.toml");
     std::fs::write(&free, &unlocked).unwrap();
-    let fk = |m: &str| {
-        let o = run(&[
+    let run_fk = |m: &str| {
+        run(&[
             "fk",
             "-m",
             m,
@@ -980,7 +980,10 @@ fn fk_and_ik_turn_an_axis_free_with_reference() {
             "A=0",
             "B=20",
             "C=90",
-        ]);
+        ])
+    };
+    let fk = |m: &str| {
+        let o = run_fk(m);
         assert_exit(&o, 0);
         assert!(!stderr(&o).contains("fixed"), "{}", stderr(&o));
         stdout(&o)
@@ -1013,17 +1016,7 @@ fn fk_and_ik_turn_an_axis_free_with_reference() {
     // An axis locked for good is locked at the value fk is given.
     let locked = dir.path().join("locked.toml");
     std::fs::write(&locked, src.replace("free_with_reference = true\n", "")).unwrap();
-    let o = run(&[
-        "fk",
-        "-m",
-        locked.to_str().unwrap(),
-        "X=459",
-        "Y=8.807",
-        "Z=361.368",
-        "A=0",
-        "B=20",
-        "C=90",
-    ]);
+    let o = run_fk(locked.to_str().unwrap());
     assert_exit(&o, 0);
     assert!(stderr(&o).contains("using 90"), "{}", stderr(&o));
     assert_eq!(triple(&stdout(&o), "point"), triple(&posed, "point"));
