@@ -10,7 +10,8 @@ use std::io::Write;
 use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::angle::SinCosMemo;
 use kinpost_machine::{
-    Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
+    AXIS_ROUNDING_RAD, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution,
+    lever_over, midpoint_bound,
 };
 use kinpost_nc::{Block, Motion, NcWriter};
 use kinpost_plan::STEP_CEILING_DEG;
@@ -615,6 +616,7 @@ impl<W: Write> Emitter<W> {
         if !self
             .stats
             .record(pose, &reached, line, &self.settings.tolerance)
+            && !self.within_cl_rounding(kin, pose, &reached, line)
             && !self.within_block_bound(machine, kin, pose, &reached)
         {
             let (p, a) = pose_error(pose, &reached);
@@ -763,6 +765,35 @@ impl<W: Write> Emitter<W> {
                 if d2 > 0.0 { d2.sqrt() / time } else { feed }
             }
         }
+    }
+
+    /// A CL tool axis just outside the directions the machine can point (CL
+    /// rounding, see [`AXIS_ROUNDING_RAD`]) is solved at the nearest one it
+    /// can point: the block is right if it is within the tolerance of that
+    /// direction. The axis tolerance in force (and reported) grows by the
+    /// distance, and the block is counted in the summary.
+    fn within_cl_rounding(
+        &mut self,
+        kin: &Kinematics,
+        want: &Pose,
+        got: &Pose,
+        line: usize,
+    ) -> bool {
+        let (gap, nearest) = kin.axis_reach(&want.axis);
+        let t = &mut self.settings.tolerance;
+        if gap == 0.0
+            || gap > AXIS_ROUNDING_RAD
+            || (want.point - got.point).norm() > t.position_mm
+            || angle_between(&nearest, &got.axis) > t.axis_rad
+        {
+            return false;
+        }
+        t.axis_rad = t.axis_rad.max(pose_error(want, got).1);
+        let p = &mut self.planning;
+        p.beyond_reach_blocks += 1;
+        p.max_beyond_reach_rad = p.max_beyond_reach_rad.max(gap);
+        p.first_beyond_reach_line.get_or_insert(line);
+        true
     }
 
     /// With the derived tolerance, a block beyond the machine-wide bound is

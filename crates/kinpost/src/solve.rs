@@ -85,6 +85,11 @@ pub(crate) fn solve_near(
                 .then(travel(a).total_cmp(&travel(b)))
         })
         .copied()?;
+    // An interpolated tool axis just beyond what the machine can point: the
+    // block points the nearest one, and is checked against it.
+    if best.nearest_axis {
+        pose.axis = kin.axis_reach(&pose.axis).1;
+    }
     Some((pose, best))
 }
 

@@ -53,6 +53,15 @@ pub struct Planning {
     /// 1000), and how many there were in all.
     pub feed_clamps: Vec<FeedClamp>,
     pub feed_clamp_count: u64,
+    /// Blocks whose CL tool axis lies just outside the directions the
+    /// machine can point (CL rounding, up to
+    /// [`AXIS_ROUNDING_RAD`](kinpost_machine::AXIS_ROUNDING_RAD)) and that
+    /// the closed-loop check passed only against the nearest direction it
+    /// can point: how many, the largest distance of such a CL axis from
+    /// that direction (rad), and the CL line of the first.
+    pub beyond_reach_blocks: u64,
+    pub max_beyond_reach_rad: f64,
+    pub first_beyond_reach_line: Option<usize>,
 }
 
 /// A run of singular CL points.
@@ -192,6 +201,14 @@ impl Summary {
                     uncut[0].line
                 );
             }
+        }
+        if p.beyond_reach_blocks > 0 {
+            planning += &format!(
+                "; {} block(s) with a CL tool axis up to {:.1e} rad beyond reach (CL rounding), checked against the nearest, first at CL line {}",
+                p.beyond_reach_blocks,
+                p.max_beyond_reach_rad,
+                p.first_beyond_reach_line.unwrap_or(0)
+            );
         }
         if p.feed_clamp_count > 0 {
             planning += &format!("; {} feed block(s) clamped", p.feed_clamp_count);

@@ -43,8 +43,10 @@ use nalgebra::{Matrix3, Vector3};
 use crate::angle::{atan2_deg, sin_cos_deg};
 
 mod chord;
+mod reach;
 mod singular;
 pub use chord::{lever_over, midpoint_bound};
+pub use reach::AXIS_ROUNDING_RAD;
 pub use singular::{Excursion, Folds, Singularity};
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
@@ -73,6 +75,10 @@ pub struct Solution {
     /// A rotary angle was free (tool axis on a rotary axis line) and was
     /// taken from the hint.
     pub singular: bool,
+    /// The requested tool axis lies just beyond the directions the machine
+    /// can point (CL rounding, within [`AXIS_ROUNDING_RAD`]): this solution
+    /// points the nearest one it can ([`Kinematics::axis_reach`]).
+    pub nearest_axis: bool,
     /// The first axis outside its travel, for a branch that has no
     /// equivalent inside the limits.
     pub violation: Option<Violation>,
@@ -736,9 +742,7 @@ impl Kinematics {
         pose: &Pose,
         branches: &mut [Branch<N>; 2],
     ) -> Option<usize> {
-        let (sols, n) = self
-            .sp2
-            .solve_xy(&self.axis_to_sp2.apply(&pose.axis), 1e-10);
+        let (sols, n) = self.sp2.solve_xy(&self.axis_to_sp2.apply(&pose.axis), 0.0);
         for (b, s) in branches.iter_mut().zip(&sols[..n]) {
             let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
             b.angles[0] = SlotAngle::from_xy(x1, y1);
@@ -761,6 +765,7 @@ impl Kinematics {
         for (b, a) in branches.iter_mut().zip(&all) {
             b.angles.copy_from_slice(&a.angles[..N]);
             b.singular = a.singular;
+            b.nearest_axis = a.nearest_axis;
         }
         Ok(count)
     }
@@ -781,7 +786,10 @@ impl Kinematics {
         match self.free_rot.len() {
             0 => {
                 if (self.between[0] * self.a0 - target).norm() > 1e-9 {
-                    return Err(IkError::OrientationUnreachable);
+                    if self.axis_reach(&pose.axis).0 > AXIS_ROUNDING_RAD {
+                        return Err(IkError::OrientationUnreachable);
+                    }
+                    branches[0].nearest_axis = true;
                 }
                 count = 1;
             }
@@ -789,10 +797,15 @@ impl Kinematics {
                 let (i, w) = self.free_rot[0];
                 let u = self.between[1] * self.a0;
                 let v = self.between[0].transpose() * target;
-                if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
-                    return Err(IkError::OrientationUnreachable);
-                }
+                // (Subproblem 1 by projection turns `u` to the nearest
+                // direction of its cone.)
                 let b = &mut branches[0];
+                if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
+                    if self.axis_reach(&pose.axis).0 > AXIS_ROUNDING_RAD {
+                        return Err(IkError::OrientationUnreachable);
+                    }
+                    b.nearest_axis = true;
+                }
                 b.angles[0] = match sp1_xy(&w, &u, &v) {
                     Some((x, y)) => SlotAngle::from_xy(x, y),
                     None => {
@@ -823,12 +836,28 @@ impl Kinematics {
                 } else {
                     (self.sp2_p, self.axis_to_sp2.apply(&pose.axis), None)
                 };
-                let (sols, n) = self.sp2.solve_xy(&q, 1e-10);
+                let (mut sols, mut n) = self.sp2.solve_xy(&q, 0.0);
+                let nearest_axis = n == 0 && full.is_none();
+                if nearest_axis {
+                    // Just beyond a fold (CL rounding): the nearest axis on
+                    // it, where the two branches meet.
+                    let (gap, nearest) = self.axis_reach(&pose.axis);
+                    if gap <= AXIS_ROUNDING_RAD {
+                        (sols, n) = self
+                            .sp2
+                            .solve_xy(&self.axis_to_sp2.apply(&nearest), f64::INFINITY);
+                        // Both branches, as the path on either side has it.
+                        if n == 1 {
+                            (sols[1], n) = (sols[0], 2);
+                        }
+                    }
+                }
                 if n == 0 {
                     return Err(IkError::OrientationUnreachable);
                 }
                 for (k, s) in sols[..n].iter().enumerate() {
                     let b = &mut branches[k];
+                    b.nearest_axis = nearest_axis;
                     let (a1, a2) = match (s.theta1, s.theta2) {
                         (Some((x1, y1)), Some((x2, y2))) => {
                             (SlotAngle::from_xy(x1, y1), SlotAngle::from_xy(x2, y2))
@@ -920,7 +949,7 @@ impl Kinematics {
             *r = slot.range(a.in_degrees(), hint);
         }
         if self.solve_linear(&mut joints, &b.angles, point) {
-            self.push_equivalents::<N>(joints, &ranges, branch, b.singular, out);
+            self.push_equivalents::<N>(joints, &ranges, branch, (b.singular, b.nearest_axis), out);
         }
     }
 
@@ -1045,7 +1074,7 @@ impl Kinematics {
         mut joints: Joints,
         ranges: &[SlotRange; N],
         branch: u8,
-        singular: bool,
+        (singular, nearest_axis): (bool, bool),
         out: &mut Vec<Solution>,
     ) {
         if let Some(slot) = ranges.iter().position(|r| !r.has_equivalent()) {
@@ -1057,6 +1086,7 @@ impl Kinematics {
                 joints,
                 branch,
                 singular,
+                nearest_axis,
                 violation: Some(Violation {
                     axis: self.slots[slot].axis,
                     value: ranges[slot].principal,
@@ -1075,6 +1105,7 @@ impl Kinematics {
                 joints,
                 branch,
                 singular,
+                nearest_axis,
                 violation,
             });
             let pushed = &mut out.last_mut().expect("just pushed").joints;
@@ -1156,6 +1187,7 @@ fn cramer_rows(c: &[V3; 3]) -> Option<[V3; 3]> {
 struct Branch<const N: usize> {
     angles: [SlotAngle; N],
     singular: bool,
+    nearest_axis: bool,
 }
 
 impl<const N: usize> Branch<N> {
@@ -1163,6 +1195,7 @@ impl<const N: usize> Branch<N> {
         Branch {
             angles,
             singular: false,
+            nearest_axis: false,
         }
     }
 }

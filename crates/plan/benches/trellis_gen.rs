@@ -16,6 +16,7 @@ pub fn layers(points: usize, per_point: usize) -> Vec<(Vec<Solution>, Link)> {
             joints,
             branch,
             singular: false,
+            nearest_axis: false,
             violation: None,
         }
     };

@@ -426,6 +426,7 @@ mod tests {
             joints,
             branch,
             singular: false,
+            nearest_axis: false,
             violation: None,
         }
     }

@@ -175,6 +175,7 @@ fn solution() -> impl Strategy<Value = Solution> {
                 joints,
                 branch,
                 singular: false,
+                nearest_axis: false,
                 violation: (!valid).then_some(Violation {
                     axis: 3,
                     value: 999.0,
