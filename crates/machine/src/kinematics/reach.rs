@@ -140,11 +140,7 @@ point = [0, 0, 200]
         )
     }
 
-    /// Head B locked at 15°, table A (X) and C (Z) free: the tool axis makes
-    /// at least 15° with the part's Z (the lower fold), A = 0 on it.
-    fn locked_head() -> Machine {
-        machine(
-            r#"
+    const B_LOCKED_AT_15: &str = r#"
 [[axis]]
 name = "B"
 kind = "rotary"
@@ -152,20 +148,28 @@ side = "tool"
 direction = [0, 1, 0]
 point = [0, 0, 150]
 fixed = 15
+"#;
+    const A_TABLE: &str = r#"
 [[axis]]
 name = "A"
 kind = "rotary"
 side = "workpiece"
 direction = [1, 0, 0]
 point = [0, 0, -50]
+"#;
+    const C_TABLE: &str = r#"
 [[axis]]
 name = "C"
 kind = "rotary"
 side = "workpiece"
 direction = [0, 0, 1]
 point = [0, 0, 0]
-"#,
-        )
+"#;
+
+    /// Head B locked at 15°, table A (X) and C (Z) free: the tool axis makes
+    /// at least 15° with the part's Z (the lower fold), A = 0 on it.
+    fn locked_head() -> Machine {
+        machine(&format!("{B_LOCKED_AT_15}{A_TABLE}{C_TABLE}"))
     }
 
     fn unit(x: f64, y: f64, z: f64) -> Vector3<f64> {
@@ -232,23 +236,7 @@ point = [0, 0, 0]
     #[test]
     fn one_free_axis_takes_the_nearest_direction_on_its_cone() {
         // The locked head above with A locked too: C turns the 15° axis.
-        let m = machine(
-            r#"
-[[axis]]
-name = "B"
-kind = "rotary"
-side = "tool"
-direction = [0, 1, 0]
-point = [0, 0, 150]
-fixed = 15
-[[axis]]
-name = "C"
-kind = "rotary"
-side = "workpiece"
-direction = [0, 0, 1]
-point = [0, 0, 0]
-"#,
-        );
+        let m = machine(&format!("{B_LOCKED_AT_15}{C_TABLE}"));
         let axis = unit(0.0, 0.2588195, 0.9659258);
         let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
         assert!(gap > 1e-8 && gap < 1e-6, "{gap}");
@@ -258,17 +246,7 @@ point = [0, 0, 0]
 
     #[test]
     fn no_free_axis_takes_its_one_direction_within_rounding() {
-        let m = machine(
-            r#"
-[[axis]]
-name = "B"
-kind = "rotary"
-side = "tool"
-direction = [0, 1, 0]
-point = [0, 0, 150]
-fixed = 15
-"#,
-        );
+        let m = machine(B_LOCKED_AT_15);
         let axis = unit(0.2588190, 0.0, 0.9659258);
         let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
         assert_nearest(&m, axis, gap);
