@@ -811,7 +811,7 @@ fn ik(
     let kin = Kinematics::new(&machine_at_pressure(&m, pressure)?);
     let mut sols = Vec::new();
     kin.ik_all_branches(&pose, None, &mut sols)
-        .map_err(|e| anyhow!("no solution: {e}"))?;
+        .map_err(|e| anyhow!("no solution: {}", kin.ik_error_text(e, &pose.axis)))?;
     let names: Vec<String> = m.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
     writeln!(out, "branch {}  status", names.join(""))?;
     for s in &sols {
@@ -820,6 +820,10 @@ fn ik(
             .collect();
         let status = match s.violation {
             None if s.singular => "ok (singular: a free angle kept at 0)".to_string(),
+            None if s.nearest_axis => format!(
+                "ok (the nearest axis the machine can point, {:.1e} rad off: CL rounding)",
+                kin.axis_reach(&pose.axis).0
+            ),
             None => "ok".to_string(),
             Some(v) => format!("outside travel: {}", m.axes[v.axis].name),
         };

@@ -13,8 +13,7 @@ use std::ops::Range;
 use kinpost_diag::Diagnostic;
 use kinpost_machine::angle::{atan2_deg, atan2_rad};
 use kinpost_machine::{
-    AXIS_ROUNDING_RAD, Folds, IkError, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity,
-    Solution, Wrap,
+    Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, Wrap,
 };
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
@@ -240,7 +239,7 @@ impl PathPlan {
         }
         let n = kin.axis_count();
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
-            .map_err(|e| PointError::Ik(ik_message(kin, e, &pose)))?;
+            .map_err(|e| PointError::Ik(kin.ik_error_text(e, &pose.axis)))?;
         let in_cone = pole.is_some_and(|p| p.within(self.cone_rad));
         let singular = in_cone || self.solutions.iter().all(|s| s.singular);
         if singular {
@@ -683,19 +682,6 @@ fn angle_between_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     } else {
         atan2_deg(a.cross(b).norm(), a.dot(b))
     }
-}
-
-/// An inverse-kinematics failure in words; for a tool axis no setting of the
-/// rotary axes gives, how far beyond what the machine can point it lies.
-fn ik_message(kin: &Kinematics, e: IkError, pose: &Pose) -> String {
-    let gap = kin.axis_reach(&pose.axis).0;
-    if e != IkError::OrientationUnreachable || gap == 0.0 {
-        return e.to_string();
-    }
-    format!(
-        "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {AXIS_ROUNDING_RAD:.0e} rad beyond, CL rounding, is taken at the nearest)",
-        gap.to_degrees()
-    )
 }
 
 #[cfg(test)]

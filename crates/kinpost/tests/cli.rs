@@ -1233,3 +1233,31 @@ fn a_directory_is_named_as_one() {
     assert!(stderr(&o).contains("is a directory"), "{}", stderr(&o));
     assert!(listing(dir.path()).is_empty());
 }
+
+/// `ik` of a flat tool axis rounded just below the band of a 45° nutating
+/// head gives the solutions of the nearest axis and says so; 1e-5 rad
+/// below, the error says how far outside the axis lies.
+#[test]
+fn ik_says_when_it_takes_the_nearest_axis_and_how_far_an_unreachable_one_is() {
+    let m = "crates/machine/tests/machines/nutating-45.toml";
+    let near = success(&[
+        "ik",
+        "-m",
+        m,
+        "--point",
+        "50,0,0",
+        "--axis",
+        "1,0,-0.0000001",
+    ]);
+    assert!(
+        near.contains("ok (the nearest axis the machine can point, 1.0e-7 rad off: CL rounding)"),
+        "{near}"
+    );
+    let o = run(&["ik", "-m", m, "--point", "50,0,0", "--axis", "1,0,-0.00001"]);
+    assert_exit(&o, 1);
+    assert!(
+        stderr(&o).contains("no setting of the rotary axes gives this tool axis: it lies 0.0005730° (1.0e-5 rad) beyond the directions the machine can point"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -12,7 +12,7 @@
 
 use nalgebra::Vector3;
 
-use super::{Folds, Kinematics, any_perpendicular};
+use super::{Folds, IkError, Kinematics, any_perpendicular};
 use crate::angle::angle_between;
 
 /// How far outside the directions a machine can point a requested tool axis
@@ -82,6 +82,20 @@ impl Kinematics {
             2 => self.folds().map_or((0.0, *axis), |f| f.nearest(axis)),
             _ => (0.0, *axis),
         }
+    }
+
+    /// An inverse-kinematics failure in words; for a tool axis `axis` no
+    /// setting of the rotary axes gives, how far beyond what the machine can
+    /// point it lies.
+    pub fn ik_error_text(&self, e: IkError, axis: &Vector3<f64>) -> String {
+        let gap = self.axis_reach(axis).0;
+        if e != IkError::OrientationUnreachable || gap == 0.0 {
+            return e.to_string();
+        }
+        format!(
+            "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {AXIS_ROUNDING_RAD:.0e} rad beyond, CL rounding, is taken at the nearest)",
+            gap.to_degrees()
+        )
     }
 }
 
