@@ -770,8 +770,9 @@ impl<W: Write> Emitter<W> {
     /// A CL tool axis just outside the directions the machine can point (CL
     /// rounding, see [`AXIS_ROUNDING_RAD`]) is solved at the nearest one it
     /// can point: the block is right if it is within the tolerance of that
-    /// direction. The axis tolerance in force (and reported) grows by the
-    /// distance, and the block is counted in the summary.
+    /// direction. The axis tolerance in force (and reported) grows to the
+    /// block's error (at most that distance more), and the block is counted
+    /// in the summary.
     fn within_cl_rounding(
         &mut self,
         kin: &Kinematics,

@@ -133,25 +133,15 @@ axis = [0, 0, 1]
         machine_from_toml(&text, "reach.toml").unwrap()
     }
 
-    /// A 45° nutating head: C about Z, B about (0, 1, 1)/√2; it points
-    /// every direction from Z down to the horizontal (the upper fold).
+    /// The test machine with a 45° nutating head (B about (1, 0, 1)/√2, C
+    /// table): it points every direction from Z down to the horizontal
+    /// (the upper fold).
     fn nutating() -> Machine {
-        machine(
-            r#"
-[[axis]]
-name = "C"
-kind = "rotary"
-side = "tool"
-direction = [0, 0, 1]
-point = [0, 0, 0]
-[[axis]]
-name = "B"
-kind = "rotary"
-side = "tool"
-direction = [0, 0.7071067811865476, 0.7071067811865476]
-point = [0, 0, 200]
-"#,
+        machine_from_toml(
+            include_str!("../../tests/machines/nutating-45.toml"),
+            "nutating-45.toml",
         )
+        .unwrap()
     }
 
     const B_LOCKED_AT_15: &str = r#"
