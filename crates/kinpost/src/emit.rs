@@ -10,8 +10,7 @@ use std::io::Write;
 use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::angle::SinCosMemo;
 use kinpost_machine::{
-    AXIS_ROUNDING_RAD, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution,
-    lever_over, midpoint_bound,
+    Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, lever_over, midpoint_bound,
 };
 use kinpost_nc::{Block, Motion, NcWriter};
 use kinpost_plan::STEP_CEILING_DEG;
@@ -768,7 +767,7 @@ impl<W: Write> Emitter<W> {
     }
 
     /// A CL tool axis just outside the directions the machine can point (CL
-    /// rounding, see [`AXIS_ROUNDING_RAD`]) is solved at the nearest one it
+    /// rounding, see [`Kinematics::axis_rounding`]) is solved at the nearest one it
     /// can point: the block is right if it is within the tolerance of that
     /// direction. The axis tolerance in force (and reported) grows to the
     /// block's error (at most that distance more), and the block is counted
@@ -783,7 +782,7 @@ impl<W: Write> Emitter<W> {
         let (gap, nearest) = kin.axis_reach(&want.axis);
         let t = &mut self.settings.tolerance;
         if gap == 0.0
-            || gap > AXIS_ROUNDING_RAD
+            || gap > kin.axis_rounding()
             || (want.point - got.point).norm() > t.position_mm
             || angle_between(&nearest, &got.axis) > t.axis_rad
         {

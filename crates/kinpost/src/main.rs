@@ -8,7 +8,9 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
-use kinpost::machine::{Kinematics, Machine, OutputMode, Pose, builtin, machine_from_toml};
+use kinpost::machine::{
+    Kinematics, MAX_AXIS_ROUNDING_RAD, Machine, OutputMode, Pose, builtin, machine_from_toml,
+};
 use kinpost::nc::Dialect;
 use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
@@ -86,6 +88,12 @@ enum Command {
         /// Pressure of the machine's pressure axis (default: its reference).
         #[arg(long, value_name = "VALUE")]
         pressure: Option<f64>,
+        /// How far outside the directions the machine can point a tool axis
+        /// may lie and be solved at the nearest one, radians: the rounding
+        /// of the CL's tool axes (default 1e-6, 6 decimals or more; 1e-4 for
+        /// 4 decimals; at most 1e-3).
+        #[arg(long, value_name = "RAD", allow_hyphen_values = true)]
+        axis_rounding: Option<f64>,
     },
     /// B-spline surfaces from measured points: fit, evaluate, plot.
     #[command(subcommand)]
@@ -192,6 +200,12 @@ struct PostArgs {
     /// pressure, as the machine maker's post does (for comparison).
     #[arg(long)]
     no_pressure_compensation: bool,
+    /// How far outside the directions the machine can point a tool axis
+    /// may lie and be solved at the nearest one, radians: the rounding
+    /// of the CL's tool axes (default 1e-6, 6 decimals or more; 1e-4 for
+    /// 4 decimals; at most 1e-3).
+    #[arg(long, value_name = "RAD")]
+    axis_rounding: Option<f64>,
     /// Print no summary on standard error.
     #[arg(long, short)]
     quiet: bool,
@@ -344,12 +358,14 @@ fn run(cli: Cli) -> Result<()> {
             axis,
             reference,
             pressure,
+            axis_rounding,
         } => ik(
             &machine,
             &point,
             &axis,
             reference.as_deref(),
             pressure,
+            axis_rounding,
             &mut out,
         ),
         Command::Wheel(args) => wheel(&args),
@@ -569,6 +585,7 @@ fn post(args: PostArgs) -> Result<()> {
             .transpose()?,
         pressure: args.pressure.map(check_pressure_value).transpose()?,
         no_pressure_compensation: args.no_pressure_compensation,
+        axis_rounding_rad: args.axis_rounding.map(check_axis_rounding).transpose()?,
     };
     if !(args.lintol.is_finite() && args.lintol >= 0.0) {
         return Err(usage("--lintol must be a distance of 0 or more (mm)"));
@@ -701,6 +718,16 @@ impl<R: io::Read> io::Read for Progress<R> {
 }
 
 /// A pressure from the command line: a number not below 0.
+fn check_axis_rounding(v: f64) -> Result<f64> {
+    if v.is_finite() && (0.0..=MAX_AXIS_ROUNDING_RAD).contains(&v) {
+        Ok(v)
+    } else {
+        Err(usage(format!(
+            "--axis-rounding must be an angle from 0 to {MAX_AXIS_ROUNDING_RAD:e} rad (the rounding of a CL tool axis; 1e-4 for 4 decimals)"
+        )))
+    }
+}
+
 fn check_pressure_value(v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
@@ -793,8 +820,10 @@ fn ik(
     axis: &str,
     reference: Option<&str>,
     pressure: Option<f64>,
+    axis_rounding: Option<f64>,
     out: &mut impl Write,
 ) -> Result<()> {
+    let axis_rounding = axis_rounding.map(check_axis_rounding).transpose()?;
     let m = load_machine(machine)?;
     let pose = Pose {
         point: Vector3::from(parse_vector(point, "point")?),
@@ -808,7 +837,10 @@ fn ik(
     } else {
         m
     };
-    let kin = Kinematics::new(&machine_at_pressure(&m, pressure)?);
+    let mut kin = Kinematics::new(&machine_at_pressure(&m, pressure)?);
+    if let Some(rad) = axis_rounding {
+        kin.set_axis_rounding(rad);
+    }
     let mut sols = Vec::new();
     kin.ik_all_branches(&pose, None, &mut sols)
         .map_err(|e| anyhow!("no solution: {}", kin.ik_error_text(e, &pose.axis)))?;

@@ -63,6 +63,13 @@ pub struct PostOptions {
     /// Write the pressure words but solve every block at the reference
     /// pressure, as the machine maker's post does (for comparison).
     pub no_pressure_compensation: bool,
+    /// How far outside the directions the machine can point a CL tool axis
+    /// may lie and be solved at the nearest one, radians (default
+    /// [`AXIS_ROUNDING_RAD`](kinpost_machine::AXIS_ROUNDING_RAD), the
+    /// rounding of 6 decimals; at most
+    /// [`MAX_AXIS_ROUNDING_RAD`](kinpost_machine::MAX_AXIS_ROUNDING_RAD)):
+    /// for a CL that writes its tool axes with fewer decimals.
+    pub axis_rounding_rad: Option<f64>,
 }
 
 /// Default linearization tolerance, mm.
@@ -594,7 +601,10 @@ impl<W: Write> Job<'_, W> {
                     a.limits = None;
                 }
             }
-            let kin = Kinematics::new(&planned);
+            let mut kin = Kinematics::new(&planned);
+            if let Some(rad) = self.options.axis_rounding_rad {
+                kin.set_axis_rounding(rad);
+            }
             let cone = self
                 .options
                 .singular_cone_deg

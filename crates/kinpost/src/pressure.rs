@@ -76,7 +76,11 @@ impl Wheel {
         }
         let new = match self.cache.iter().position(|(k, _)| *k == key(&offset)) {
             Some(i) => self.cache.remove(i).1,
-            None => Kinematics::new(&self.machine.at_pressure(written)),
+            None => {
+                let mut new = Kinematics::new(&self.machine.at_pressure(written));
+                new.set_axis_rounding(kin.axis_rounding());
+                new
+            }
         };
         let old = std::mem::replace(kin, new);
         self.cache.push((key(&self.offset), old));

@@ -55,7 +55,7 @@ pub struct Planning {
     pub feed_clamp_count: u64,
     /// Blocks whose CL tool axis lies just outside the directions the
     /// machine can point (CL rounding, up to
-    /// [`AXIS_ROUNDING_RAD`](kinpost_machine::AXIS_ROUNDING_RAD)) and that
+    /// [`PostOptions::axis_rounding_rad`](crate::PostOptions::axis_rounding_rad)) and that
     /// the closed-loop check passed only against the nearest direction it
     /// can point: how many, the largest distance of such a CL axis from
     /// that direction (rad), and the CL line of the first.

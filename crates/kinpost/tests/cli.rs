@@ -1256,8 +1256,41 @@ fn ik_says_when_it_takes_the_nearest_axis_and_how_far_an_unreachable_one_is() {
     let o = run(&["ik", "-m", m, "--point", "50,0,0", "--axis", "1,0,-0.00001"]);
     assert_exit(&o, 1);
     assert!(
-        stderr(&o).contains("no setting of the rotary axes gives this tool axis: it lies 0.0005730° (1.0e-5 rad) beyond the directions the machine can point"),
+        stderr(&o).contains("no setting of the rotary axes gives this tool axis: it lies 0.0005730° (1.0e-5 rad) beyond the directions the machine can point (an axis up to 1.0e-6 rad beyond, CL rounding, is taken at the nearest; if the CL rounds its tool axes that coarsely, --axis-rounding 1.0e-5 takes it at the nearest)"),
         "{}",
         stderr(&o)
     );
+    // With that axis rounding it is taken at the nearest axis, in `ik` as
+    // in `post`.
+    let args = ["ik", "-m", m, "--point", "50,0,0", "--axis", "1,0,-0.00001"];
+    let coarse = success(&[&args[..], &["--axis-rounding", "1.0e-5"]].concat());
+    assert!(
+        coarse.contains("ok (the nearest axis the machine can point, 1.0e-5 rad off: CL rounding)"),
+        "{coarse}"
+    );
+    let cl = "FEDRAT/MMPM,1000\nGOTO/50,0,0,1,0,-0.00001\nGOTO/40,10,0,1,0,0\n";
+    let post = |extra: &[&str]| {
+        run_with_stdin(
+            &[&["post", "-", "-m", m][..], extra].concat(),
+            cl.as_bytes(),
+        )
+    };
+    assert_exit(&post(&[]), 1);
+    let o = post(&["--axis-rounding", "1e-4", "--dialect", "csv"]);
+    assert_exit(&o, 0);
+    assert!(
+        stderr(&o).contains("1 block(s) with a CL tool axis up to 1.0e-5 rad beyond reach"),
+        "{}",
+        stderr(&o)
+    );
+    // More than any rounding: a usage error.
+    for bad in ["0.01", "-1e-6", "nan"] {
+        let o = run(&[&args[..], &["--axis-rounding", bad]].concat());
+        assert_exit(&o, 2);
+        assert!(
+            stderr(&o).contains("--axis-rounding must be an angle from 0 to 1e-3 rad"),
+            "{}",
+            stderr(&o)
+        );
+    }
 }

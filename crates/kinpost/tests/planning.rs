@@ -965,48 +965,86 @@ fn a_feed_per_revolution_follows_the_spindle_speed() {
 /// some of them just below the horizontal, beyond the band: each is solved
 /// at the nearest axis on the edge, the closed-loop check counts the
 /// distance as the CL's own, and the summary says so. 1e-5 below is beyond
-/// any rounding: an error that says how far.
+/// the rounding of 6 decimals: an error that says how far, and what axis
+/// rounding would take it.
 #[test]
 fn a_flat_tool_axis_rounded_below_the_band_posts_at_the_edge() {
-    let path = format!(
-        "{}/../machine/tests/machines/nutating-45.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
-    let flat = |below: &str| {
-        let mut cl = String::from("FEDRAT/MMPM,1000\n");
-        for k in 0..=10 {
-            let phi = (9.0 * f64::from(k)).to_radians();
-            let z = if k % 2 == 1 { below } else { "0.0000000" };
-            cl += &format!(
-                "GOTO/{:.4},{:.4},0.0000,{:.7},{:.7},{z}\n",
-                50.0 * phi.cos(),
-                50.0 * phi.sin(),
-                phi.cos(),
-                phi.sin()
-            );
-        }
-        cl
-    };
-    let (csv, summary) = post_csv(&m, &flat("-0.0000001"), &PostOptions::default()).unwrap();
+    let m = nutating_45();
+    let (csv, summary) = post_csv(&m, &flat_path("-0.0000001"), &PostOptions::default()).unwrap();
     let p = &summary.planning;
     assert!(p.beyond_reach_blocks >= 1, "{p:?}");
     assert!((p.max_beyond_reach_rad - 1e-7).abs() < 1e-9, "{p:?}");
     assert_eq!(p.first_beyond_reach_line, Some(3));
     assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
     assert!(summary.tolerance_rad < 1.1e-7, "{}", summary.tolerance_rad);
-    // Every block points the tool flat (or above) and reaches its point.
-    let kin = Kinematics::new(&m);
-    for (_, _, q) in rows(&csv, m.axes.len()) {
+    assert_flat_blocks(&m, &csv);
+    let e = post_csv(&m, &flat_path("-0.0000100"), &PostOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no setting of the rotary axes gives this tool axis: it lies 0.0005730° (1.0e-5 rad) beyond the directions the machine can point (an axis up to 1.0e-6 rad beyond, CL rounding, is taken at the nearest; if the CL rounds its tool axes that coarsely, --axis-rounding 1.1e-5 takes it at the nearest)"),
+        "{e}"
+    );
+}
+
+/// `--axis-rounding` for a CL that writes fewer decimals: the point 1e-5
+/// below the fold posts at the edge, checked against it; 2e-4 below is
+/// still beyond.
+#[test]
+fn a_cl_that_rounds_its_tool_axes_more_coarsely_posts_with_its_axis_rounding() {
+    // 1e-5 rad below the fold, as rounding to 5 decimals can put it.
+    let m = nutating_45();
+    let options = PostOptions {
+        axis_rounding_rad: Some(1e-4),
+        ..PostOptions::default()
+    };
+    let (csv, summary) = post_csv(&m, &flat_path("-0.0000100"), &options).unwrap();
+    let p = &summary.planning;
+    assert!(p.beyond_reach_blocks >= 1, "{p:?}");
+    assert!((p.max_beyond_reach_rad - 1e-5).abs() < 1e-9, "{p:?}");
+    assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
+    assert!(summary.tolerance_rad < 1.1e-5, "{}", summary.tolerance_rad);
+    assert_flat_blocks(&m, &csv);
+    // The setting is a bound: farther out is still an error.
+    let e = post_csv(&m, &flat_path("-0.0002000"), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("(2.0e-4 rad) beyond"), "{e}");
+    assert!(e.contains("an axis up to 1.0e-4 rad beyond"), "{e}");
+}
+
+fn nutating_45() -> Machine {
+    let path = format!(
+        "{}/../machine/tests/machines/nutating-45.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap()
+}
+
+/// A quarter circle of points with the tool lying flat on the 45° nutating
+/// head's lower edge, every second tool axis written `below` the horizontal.
+fn flat_path(below: &str) -> String {
+    let mut cl = String::from("FEDRAT/MMPM,1000\n");
+    for k in 0..=10 {
+        let phi = (9.0 * f64::from(k)).to_radians();
+        let z = if k % 2 == 1 { below } else { "0.0000000" };
+        cl += &format!(
+            "GOTO/{:.4},{:.4},0.0000,{:.7},{:.7},{z}\n",
+            50.0 * phi.cos(),
+            50.0 * phi.sin(),
+            phi.cos(),
+            phi.sin()
+        );
+    }
+    cl
+}
+
+/// Every block points the tool flat (or above) and reaches its point.
+fn assert_flat_blocks(m: &Machine, csv: &str) {
+    let kin = Kinematics::new(m);
+    for (_, _, q) in rows(csv, m.axes.len()) {
         let pose = kin.fk(&q);
         assert!(pose.axis.z > -1e-8, "{pose:?}");
         assert!(pose.point.z.abs() < 1e-3, "{pose:?}");
     }
-    let e = post_csv(&m, &flat("-0.0000100"), &PostOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("no setting of the rotary axes gives this tool axis: it lies 0.0005730° (1.0e-5 rad) beyond the directions the machine can point"),
-        "{e}"
-    );
 }

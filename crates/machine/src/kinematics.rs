@@ -46,7 +46,7 @@ mod chord;
 mod reach;
 mod singular;
 pub use chord::{lever_over, midpoint_bound};
-pub use reach::AXIS_ROUNDING_RAD;
+pub use reach::{AXIS_ROUNDING_RAD, MAX_AXIS_ROUNDING_RAD};
 pub use singular::{Excursion, Folds, Singularity};
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};
@@ -76,7 +76,7 @@ pub struct Solution {
     /// taken from the hint.
     pub singular: bool,
     /// The requested tool axis lies just beyond the directions the machine
-    /// can point (CL rounding, within [`AXIS_ROUNDING_RAD`]): this solution
+    /// can point (CL rounding, within [`Kinematics::axis_rounding`]): this solution
     /// points the nearest one it can ([`Kinematics::axis_reach`]).
     pub nearest_axis: bool,
     /// The first axis outside its travel, for a branch that has no
@@ -352,6 +352,10 @@ pub struct Kinematics {
     sp2_p: Vector3<f64>,
     sp2: Sp2,
     c0t: Matrix3<f64>,
+    /// How far outside the directions the machine can point a CL tool axis
+    /// may lie and still be solved at the nearest one (see
+    /// [`Kinematics::set_axis_rounding`]).
+    axis_rounding: f64,
 }
 
 #[inline]
@@ -572,6 +576,7 @@ impl Kinematics {
             free_rot,
             between,
             free_lin,
+            axis_rounding: AXIS_ROUNDING_RAD,
         }
     }
 
@@ -786,7 +791,7 @@ impl Kinematics {
         match self.free_rot.len() {
             0 => {
                 if (self.between[0] * self.a0 - target).norm() > 1e-9 {
-                    if self.axis_reach(&pose.axis).0 > AXIS_ROUNDING_RAD {
+                    if self.axis_reach(&pose.axis).0 > self.axis_rounding {
                         return Err(IkError::OrientationUnreachable);
                     }
                     branches[0].nearest_axis = true;
@@ -801,7 +806,7 @@ impl Kinematics {
                 // direction of its cone.)
                 let b = &mut branches[0];
                 if (w.dot(&u) - w.dot(&v)).abs() > 1e-9 {
-                    if self.axis_reach(&pose.axis).0 > AXIS_ROUNDING_RAD {
+                    if self.axis_reach(&pose.axis).0 > self.axis_rounding {
                         return Err(IkError::OrientationUnreachable);
                     }
                     b.nearest_axis = true;
@@ -842,7 +847,7 @@ impl Kinematics {
                     // Just beyond a fold (CL rounding): the nearest axis on
                     // it, where the two branches meet.
                     let (gap, nearest) = self.axis_reach(&pose.axis);
-                    if gap <= AXIS_ROUNDING_RAD {
+                    if gap <= self.axis_rounding {
                         (sols, n) = self
                             .sp2
                             .solve_xy(&self.axis_to_sp2.apply(&nearest), f64::INFINITY);

@@ -24,8 +24,8 @@ pub mod subproblems;
 
 pub use file::machine_from_toml;
 pub use kinematics::{
-    AXIS_ROUNDING_RAD, Excursion, Folds, IkError, Joints, Kinematics, Singularity, Solution,
-    Violation, lever_over, midpoint_bound, wrap180,
+    AXIS_ROUNDING_RAD, Excursion, Folds, IkError, Joints, Kinematics, MAX_AXIS_ROUNDING_RAD,
+    Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,
 };
 pub use model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,

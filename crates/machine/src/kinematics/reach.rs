@@ -6,9 +6,11 @@
 //! head, the one axis a head locked at 15° gives a 4-axis table, the rim of
 //! the hole a C axis out of square leaves around its pole), that rounding
 //! puts some of its axes just outside. Such an axis, up to
-//! [`AXIS_ROUNDING_RAD`] outside, is solved at the nearest direction the
-//! machine can point, and the closed-loop check counts the distance between
-//! the two as the CL's own error. Farther out, the axis is unreachable.
+//! [`Kinematics::axis_rounding`] outside ([`AXIS_ROUNDING_RAD`] unless set
+//! for a CL that rounds more coarsely), is solved at the nearest direction
+//! the machine can point, and the closed-loop check counts the distance
+//! between the two as the CL's own error. Farther out, the axis is
+//! unreachable.
 
 use nalgebra::Vector3;
 
@@ -21,6 +23,11 @@ use crate::angle::angle_between;
 /// the sixth decimal on each component moves a unit vector by up to 8.7e-7
 /// rad).
 pub const AXIS_ROUNDING_RAD: f64 = 1e-6;
+
+/// The largest axis rounding [`Kinematics::set_axis_rounding`] takes,
+/// radians: the rounding of tool axes written with 3 decimals (8.7e-4 rad).
+/// Farther out, a tool axis is not the rounding of one the machine can point.
+pub const MAX_AXIS_ROUNDING_RAD: f64 = 1e-3;
 
 /// `a` (unit) turned in its plane with `d` (unit) to make the angle `t`
 /// with `d`; for `a` along `±d`, any such direction.
@@ -84,16 +91,48 @@ impl Kinematics {
         }
     }
 
+    /// How far outside the directions the machine can point a tool axis may
+    /// lie and still be solved, at the nearest one it can point, radians:
+    /// the rounding of the CL's tool axes ([`AXIS_ROUNDING_RAD`] unless set).
+    pub fn axis_rounding(&self) -> f64 {
+        self.axis_rounding
+    }
+
+    /// Sets [`Kinematics::axis_rounding`] for a CL that writes its tool axes
+    /// with fewer decimals (half a unit of the last decimal on each component
+    /// moves a unit vector by up to `0.87·10^-d` rad: 8.7e-5 rad for 4
+    /// decimals). Clamped to `0..=`[`MAX_AXIS_ROUNDING_RAD`] (NaN: the
+    /// default).
+    pub fn set_axis_rounding(&mut self, rad: f64) {
+        self.axis_rounding = if rad.is_nan() {
+            AXIS_ROUNDING_RAD
+        } else {
+            rad.clamp(0.0, MAX_AXIS_ROUNDING_RAD)
+        };
+    }
+
     /// An inverse-kinematics failure in words; for a tool axis `axis` no
     /// setting of the rotary axes gives, how far beyond what the machine can
-    /// point it lies.
+    /// point it lies, and, when that could be the rounding of a CL that
+    /// writes fewer decimals, the axis rounding that would take it.
     pub fn ik_error_text(&self, e: IkError, axis: &Vector3<f64>) -> String {
         let gap = self.axis_reach(axis).0;
         if e != IkError::OrientationUnreachable || gap == 0.0 {
             return e.to_string();
         }
+        let rounding = self.axis_rounding;
+        let hint = if gap <= MAX_AXIS_ROUNDING_RAD {
+            // Two significant digits, rounded up: that value takes it.
+            let scale = 10f64.powi(gap.log10().floor() as i32 - 1);
+            let suggest = ((gap / scale).ceil() * scale).min(MAX_AXIS_ROUNDING_RAD);
+            format!(
+                "; if the CL rounds its tool axes that coarsely, --axis-rounding {suggest:.1e} takes it at the nearest"
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {AXIS_ROUNDING_RAD:.0e} rad beyond, CL rounding, is taken at the nearest)",
+            "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {rounding:.1e} rad beyond, CL rounding, is taken at the nearest{hint})",
             gap.to_degrees()
         )
     }
@@ -180,8 +219,7 @@ point = [0, 0, 0]
         Vector3::new(x, y, z).normalize()
     }
 
-    fn solve(m: &Machine, axis: Vector3<f64>) -> Result<Vec<crate::Solution>, crate::IkError> {
-        let kin = Kinematics::new(m);
+    fn solve(kin: &Kinematics, axis: Vector3<f64>) -> Result<Vec<crate::Solution>, crate::IkError> {
         let mut out = Vec::new();
         let pose = Pose {
             point: Vector3::new(10.0, 20.0, 30.0),
@@ -193,15 +231,14 @@ point = [0, 0, 0]
 
     /// Every solution reaches the point exactly and the nearest axis the
     /// machine can point, which lies `gap` from `axis`.
-    fn assert_nearest(m: &Machine, axis: Vector3<f64>, gap: f64) {
-        let kin = Kinematics::new(m);
+    fn assert_nearest(kin: &Kinematics, axis: Vector3<f64>, gap: f64) {
         let (got_gap, nearest) = kin.axis_reach(&axis);
         assert!((got_gap - gap).abs() < 1e-12, "gap {got_gap} vs {gap}");
         assert!((angle_between(&nearest, &axis) - gap).abs() < 1e-12);
-        let sols = solve(m, axis).unwrap();
+        let sols = solve(kin, axis).unwrap();
         assert!(!sols.is_empty());
         for s in &sols {
-            let pose = kin.fk(&s.joints[..m.axes.len()]);
+            let pose = kin.fk(&s.joints[..kin.axis_count()]);
             assert!((pose.point - Vector3::new(10.0, 20.0, 30.0)).norm() < 1e-9);
             assert!(angle_between(&pose.axis, &nearest) < 1e-9, "{s:?}");
         }
@@ -210,7 +247,11 @@ point = [0, 0, 0]
     #[test]
     fn a_flat_tool_rounded_below_the_horizontal_is_solved_flat() {
         // (0, -1, -0.0000001) as a CL writes it: 1e-7 rad below the fold.
-        assert_nearest(&nutating(), unit(0.0, -1.0, -0.0000001), 1e-7);
+        assert_nearest(
+            &Kinematics::new(&nutating()),
+            unit(0.0, -1.0, -0.0000001),
+            1e-7,
+        );
         // Exactly flat and above it: inside.
         assert_eq!(
             Kinematics::new(&nutating())
@@ -220,7 +261,7 @@ point = [0, 0, 0]
         );
         // 2e-6 rad below: beyond CL rounding, unreachable.
         assert_eq!(
-            solve(&nutating(), unit(0.0, -1.0, -2e-6)).unwrap_err(),
+            solve(&Kinematics::new(&nutating()), unit(0.0, -1.0, -2e-6)).unwrap_err(),
             crate::IkError::OrientationUnreachable
         );
     }
@@ -230,11 +271,38 @@ point = [0, 0, 0]
         let axis = unit(-0.2588190, 0.0, 0.9659258);
         let gap = 15f64.to_radians() - angle_between(&Vector3::z(), &axis);
         assert!(gap > 1e-8 && gap < 1e-7, "{gap}");
-        assert_nearest(&locked_head(), axis, gap);
+        assert_nearest(&Kinematics::new(&locked_head()), axis, gap);
         assert_eq!(
-            solve(&locked_head(), unit(-0.2588, 0.0, 0.9659)).unwrap_err(),
+            solve(&Kinematics::new(&locked_head()), unit(-0.2588, 0.0, 0.9659)).unwrap_err(),
             crate::IkError::OrientationUnreachable
         );
+    }
+
+    #[test]
+    fn four_decimals_need_their_axis_rounding() {
+        // 15° written with 4 decimals lies 1.17e-5 rad inside the fold
+        // (15° − atan2(0.2588, 0.9659) = 0.000671°).
+        let axis = unit(-0.2588, 0.0, 0.9659);
+        let gap = 15f64.to_radians() - angle_between(&Vector3::z(), &axis);
+        assert!(gap > 1e-5 && gap < 2e-5, "{gap}");
+        let mut kin = Kinematics::new(&locked_head());
+        assert_eq!(kin.axis_rounding(), AXIS_ROUNDING_RAD);
+        let e = solve(&kin, axis).unwrap_err();
+        assert_eq!(
+            kin.ik_error_text(e, &axis),
+            "no setting of the rotary axes gives this tool axis: it lies 0.0006711° (1.2e-5 rad) beyond the directions the machine can point (an axis up to 1.0e-6 rad beyond, CL rounding, is taken at the nearest; if the CL rounds its tool axes that coarsely, --axis-rounding 1.2e-5 takes it at the nearest)"
+        );
+        kin.set_axis_rounding(1.2e-5);
+        assert_nearest(&kin, axis, gap);
+        // Clamped to what rounding can be; NaN is the default.
+        kin.set_axis_rounding(1.0);
+        assert_eq!(kin.axis_rounding(), MAX_AXIS_ROUNDING_RAD);
+        kin.set_axis_rounding(f64::NAN);
+        assert_eq!(kin.axis_rounding(), AXIS_ROUNDING_RAD);
+        // Beyond what any rounding can be: no hint.
+        let far = unit(-0.2, 0.0, 0.98);
+        let text = kin.ik_error_text(solve(&kin, far).unwrap_err(), &far);
+        assert!(!text.contains("--axis-rounding"), "{text}");
     }
 
     #[test]
@@ -244,8 +312,8 @@ point = [0, 0, 0]
         let axis = unit(0.0, 0.2588195, 0.9659258);
         let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
         assert!(gap > 1e-8 && gap < 1e-6, "{gap}");
-        assert_nearest(&m, axis, gap);
-        assert!(solve(&m, unit(0.0, 0.26, 0.9659258)).is_err());
+        assert_nearest(&Kinematics::new(&m), axis, gap);
+        assert!(solve(&Kinematics::new(&m), unit(0.0, 0.26, 0.9659258)).is_err());
     }
 
     #[test]
@@ -253,7 +321,7 @@ point = [0, 0, 0]
         let m = machine(B_LOCKED_AT_15);
         let axis = unit(0.2588190, 0.0, 0.9659258);
         let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
-        assert_nearest(&m, axis, gap);
-        assert!(solve(&m, unit(0.2588, 0.0, 0.9659)).is_err());
+        assert_nearest(&Kinematics::new(&m), axis, gap);
+        assert!(solve(&Kinematics::new(&m), unit(0.2588, 0.0, 0.9659)).is_err());
     }
 }
