@@ -23,6 +23,11 @@ const UNIT_TOLERANCE: f64 = 1e-6;
 /// axis that turns without end has no `limits`.
 const MAX_ROTARY_TRAVEL: f64 = 3600.0;
 
+/// The largest coordinate of a point in a machine file, mm. A double keeps
+/// about 1e-10 mm at a kilometre; at 1e15 mm it keeps 0.1 mm, and a chain
+/// through such a point solves to wrong positions.
+const MAX_COORDINATE_MM: f64 = 1e6;
+
 #[derive(Deserialize)]
 struct RawMachine {
     name: Option<Spanned<String>>,
@@ -195,13 +200,25 @@ impl Checker<'_> {
         Some(raw / n)
     }
 
-    /// A point, or an error at `v`'s span when a coordinate is not finite.
+    /// A point, or an error at `v`'s span when a coordinate is not finite
+    /// or farther out than [`MAX_COORDINATE_MM`].
     fn point(&mut self, v: &Spanned<Nums<3>>, what: &str) -> Vector3<f64> {
         let p = Vector3::from(v.get_ref().0);
         if p.iter().any(|x| !x.is_finite()) {
             self.error(
                 v.span(),
                 format!("{what} must be three finite numbers (mm)"),
+            );
+            return Vector3::zeros();
+        }
+        if p.amax() > MAX_COORDINATE_MM {
+            self.error(
+                v.span(),
+                format!(
+                    "{what} has a coordinate of {:e} mm: a machine's points lie within {MAX_COORDINATE_MM:e} mm (a kilometre); \
+                     farther out, the arithmetic loses the precision of a position",
+                    p.amax()
+                ),
             );
             return Vector3::zeros();
         }
