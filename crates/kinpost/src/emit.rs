@@ -23,6 +23,12 @@ use crate::summary::{FeedClamp, Planning, Reconfiguration};
 
 /// Deepest halving of one CL segment by the linearization (2^16 blocks).
 const MAX_DEPTH: u32 = 16;
+/// Most equal pieces a CL segment is cut into at once by the linearization
+/// (each may still be halved).
+const MAX_PIECES: f64 = 4096.0;
+/// How many more pieces than the midpoint's deviation says are cut at once,
+/// so that a segment of even curvature needs no halving after.
+const PIECES_MARGIN: f64 = 1.05;
 /// What the chord bound adds for the ends of a joint motion not being
 /// exactly on their CL points (the inverse kinematics is exact to 1e-9 mm).
 const CHORD_SLACK_MM: f64 = 1e-6;
@@ -143,6 +149,8 @@ pub(crate) struct Emitter<W: Write> {
     sin_cos: SinCosMemo,
     solutions: Vec<Solution>,
     inserted: Vec<Node>,
+    /// The equal pieces a long CL segment is first cut into (scratch).
+    pieces: Vec<Node>,
     pub stats: CheckStats,
     pub planning: Planning,
     /// Warnings about what the post could not do as the CL asks (a segment
@@ -189,6 +197,7 @@ impl<W: Write> Emitter<W> {
             sin_cos: SinCosMemo::default(),
             solutions: Vec::with_capacity(16),
             inserted: Vec::new(),
+            pieces: Vec::new(),
             stats: CheckStats::default(),
             planning: Planning::default(),
             warnings: Vec::new(),
@@ -349,7 +358,7 @@ impl<W: Write> Emitter<W> {
     }
 
     /// [`Emitter::linearize`] for a segment the chord bound did not settle:
-    /// the midpoint's forward kinematics decides, and the halves recurse.
+    /// the midpoint's forward kinematics decides, and the pieces recurse.
     fn split(
         &mut self,
         kin: &Kinematics,
@@ -360,13 +369,11 @@ impl<W: Write> Emitter<W> {
         out: &mut Vec<Node>,
     ) -> Result<(), SplitError> {
         let n = self.n;
-        let mut mid = a.joints;
-        for (m, v) in mid.iter_mut().zip(&b.joints).take(n) {
-            *m = 0.5 * (*m + v);
-        }
+        let mid = joints_at(a, b, 0.5, n);
         let reached = kin.fk(&mid[..n]).point;
         let deviation = distance_to_segment(&reached, &a.pose.point, &b.pose.point);
-        if deviation <= self.settings.lintol {
+        let lintol = self.settings.lintol;
+        if deviation <= lintol {
             let p = &mut self.planning;
             p.max_linearization_error_mm = p.max_linearization_error_mm.max(deviation);
             return Ok(());
@@ -391,34 +398,114 @@ impl<W: Write> Emitter<W> {
                 SplitError::NoConvergence
             });
         }
-        let pose = interpolate(&a.pose, &b.pose, 0.5);
+        // The deviation of a piece shrinks like the square of its length: a
+        // CL segment that strays too far for two halves (a long move with a
+        // large turn) is cut at once into as many equal pieces as that says
+        // it needs, instead of being halved down to a power of two of them.
+        // Each piece is then checked like any segment, and halved where it
+        // still strays. (Not where the interpolated tool axis leaves the
+        // directions the machine can point: the pieces might step over that
+        // excursion, which halving names.)
+        let pieces = ((deviation / lintol).sqrt() * PIECES_MARGIN).ceil();
+        if depth == 0
+            && deviation > 4.0 * lintol
+            && kin
+                .folds()
+                .is_none_or(|f| f.arc_outside(&a.pose.axis, &b.pose.axis).is_none())
+        {
+            let pieces = pieces.min(MAX_PIECES);
+            let mut nodes = std::mem::take(&mut self.pieces);
+            nodes.clear();
+            for k in 1..pieces as u32 {
+                match self.node_at(kin, a, b, f64::from(k) / pieces) {
+                    Ok((m, false)) => nodes.push(m),
+                    // An interpolated tool axis the machine cannot point, or
+                    // a node it cannot reach: halving decides, as it does
+                    // for shorter segments (see `node_at`).
+                    _ => break,
+                }
+            }
+            let all = nodes.len() + 1 == pieces as usize;
+            let result = if all {
+                self.linearize_through(kin, a, &nodes, b, lever, depth, out)
+            } else {
+                Ok(())
+            };
+            self.pieces = nodes;
+            if all {
+                return result;
+            }
+        }
+        let (m, _) = self.node_at(kin, a, b, 0.5)?;
+        self.linearize_through(kin, a, &[m], b, lever, depth, out)
+    }
+
+    /// Linearizes `a`–`nodes[0]`–…–`b` (the nodes inserted between `a` and
+    /// `b`, in order), pushing the nodes with those between them.
+    #[allow(clippy::too_many_arguments)]
+    fn linearize_through(
+        &mut self,
+        kin: &Kinematics,
+        a: &Node,
+        nodes: &[Node],
+        b: &Node,
+        lever: f64,
+        depth: u32,
+        out: &mut Vec<Node>,
+    ) -> Result<(), SplitError> {
+        let (mut from, mut from_lever) = (a, lever);
+        for m in nodes {
+            self.linearize(kin, from, m, from_lever, depth + 1, out)?;
+            out.push(*m);
+            (from, from_lever) = (m, f64::INFINITY);
+        }
+        self.linearize(kin, from, b, from_lever, depth + 1, out)
+    }
+
+    /// The node the linearization inserts at `t` (0..1) between `a` and `b`:
+    /// the CL pose interpolated there, solved nearest the joint-space
+    /// interpolation; `true` with it where the machine cannot point the
+    /// interpolated tool axis and the node keeps the joint-space one. (Where
+    /// that excursion is more than rounding, halving does not converge, and
+    /// the error names it.)
+    fn node_at(
+        &mut self,
+        kin: &Kinematics,
+        a: &Node,
+        b: &Node,
+        t: f64,
+    ) -> Result<(Node, bool), SplitError> {
+        let guess = joints_at(a, b, t, self.n);
+        let pose = interpolate(&a.pose, &b.pose, t);
         // Inside the singular cone the singular angle moves linearly in
         // joint space (held between the ends) instead of swinging.
         let hold = self.settings.singularity.and_then(|s| {
             let held = a.hold.is_some() || b.hold.is_some();
             (held || s.distance(&pose.axis) < self.settings.cone_rad).then_some(Hold {
                 axis: s.axis,
-                value: mid[s.axis],
+                value: guess[s.axis],
             })
         });
-        // Both ends on one branch: the midpoint too. Near a fold the
-        // branches lie close, and the joint-space midpoint may be nearer the
+        // Both ends on one branch: the node too. Near a fold the branches
+        // lie close, and the joint-space interpolation may be nearer the
         // other one: a switch there would never converge. (Ends on two
         // branches: the nearest.)
         let branch = (a.branch == b.branch).then_some(a.branch);
         let near = Near {
-            joints: &mid,
+            joints: &guess,
             hold,
             branch,
         };
+        let mut natural = false;
         let solved =
             solve_near(kin, &pose, &near, &self.rotary, &mut self.solutions).or_else(|| {
                 // The machine cannot point the interpolated tool axis (two
                 // rotary axes at an angle other than 90° reach a band of
-                // directions only): keep the axis of the rotary midpoint and
-                // put the contact point on the segment.
+                // directions only): keep the axis of the joint-space
+                // interpolation and put the contact point on the segment.
+                natural = true;
                 let natural = Pose {
-                    axis: kin.fk(&mid[..self.n]).axis,
+                    axis: kin.fk(&guess[..self.n]).axis,
                     ..pose
                 };
                 solve_near(kin, &natural, &near, &self.rotary, &mut self.solutions)
@@ -426,10 +513,7 @@ impl<W: Write> Emitter<W> {
         let Some((pose, sol)) = solved else {
             return Err(SplitError::OutsideTravel);
         };
-        let m = Node::solved(pose, &sol, hold);
-        self.linearize(kin, a, &m, lever, depth + 1, out)?;
-        out.push(m);
-        self.linearize(kin, &m, b, f64::INFINITY, depth + 1, out)
+        Ok((Node::solved(pose, &sol, hold), natural))
     }
 
     /// Retract along the tool axis from the last block, turn the rotary axes
@@ -835,6 +919,16 @@ fn chord_settles(kin: &Kinematics, a: &Node, b: &Node, lever: f64, lintol: f64) 
 }
 
 /// Distance from `p` to the segment `a`–`b`.
+/// The joints at `t` (0..1) of the straight joint motion from `a` to `b`
+/// (at 0.5 the exact midpoint).
+fn joints_at(a: &Node, b: &Node, t: f64, n: usize) -> Joints {
+    let mut q = a.joints;
+    for (q, v) in q.iter_mut().zip(&b.joints).take(n) {
+        *q = (1.0 - t) * *q + t * v;
+    }
+    q
+}
+
 pub(crate) fn distance_to_segment(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     let ab = b - a;
     let l2 = ab.norm_squared();

@@ -1048,3 +1048,51 @@ fn assert_flat_blocks(m: &Machine, csv: &str) {
         assert!(pose.point.z.abs() < 1e-3, "{pose:?}");
     }
 }
+
+/// A long feed move with a large turn (50 mm while B tilts 40°, the return
+/// move of the benchmark's path) strays about 5 mm from its chord in joint
+/// space: it is cut at once into the equal pieces that deviation says it
+/// needs (it shrinks like the square of the piece length), not halved down
+/// to 64, and every piece stays within the linearization tolerance.
+#[test]
+fn a_long_turning_move_is_cut_into_the_pieces_it_needs() {
+    let m = builtin::load("mts1600").unwrap().unwrap();
+    let cl = "FEDRAT/MMPM,2000\n\
+              GOTO/-400.0000,60.0000,5.0000,-0.3420201,0.0000000,0.9396926\n\
+              GOTO/-350.0000,60.0000,7.0000,0.3420201,0.0000000,0.9396926\n";
+    let (csv, summary) = post_csv(&m, cl, &PostOptions::default()).unwrap();
+    let kin = Kinematics::new(&m);
+    let rows = rows(&csv, m.axes.len());
+    let (a, b) = (
+        Vector3::new(-400.0, 60.0, 5.0),
+        Vector3::new(-350.0, 60.0, 7.0),
+    );
+    let off_chord = |q0: &[f64], q1: &[f64]| {
+        let mid: Vec<f64> = q0.iter().zip(q1).map(|(x, y)| 0.5 * (x + y)).collect();
+        let p = kin.fk(&mid).point;
+        let t = ((p - a).dot(&(b - a)) / (b - a).norm_squared()).clamp(0.0, 1.0);
+        (p - (a + (b - a) * t)).norm()
+    };
+    let whole = off_chord(&rows[0].2, &rows[rows.len() - 1].2);
+    assert!(whole > 4.0 && whole < 6.0, "{whole}");
+    let needed = (whole / kinpost::DEFAULT_LINTOL_MM).sqrt();
+    let pieces = rows.len() - 1;
+    assert_eq!(summary.planning.inserted_blocks as usize, pieces - 1);
+    assert!(
+        (pieces as f64) < 1.1 * needed + 1.0,
+        "{pieces} pieces where {needed:.1} are needed"
+    );
+    for w in rows.windows(2) {
+        let d = off_chord(&w[0].2, &w[1].2);
+        assert!(d <= kinpost::DEFAULT_LINTOL_MM, "{d}");
+    }
+    // Equal pieces along the CL segment.
+    let points: Vec<_> = rows.iter().map(|r| kin.fk(&r.2).point).collect();
+    for w in points.windows(2) {
+        let step = (w[1] - w[0]).norm();
+        assert!(
+            (step - (b - a).norm() / pieces as f64).abs() < 1e-3,
+            "{step}"
+        );
+    }
+}
