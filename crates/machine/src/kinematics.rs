@@ -842,11 +842,14 @@ impl Kinematics {
                     (self.sp2_p, self.axis_to_sp2.apply(&pose.axis), None)
                 };
                 let (mut sols, mut n) = self.sp2.solve_xy(&q, 0.0);
-                let nearest_axis = n == 0 && full.is_none();
-                if nearest_axis {
+                let mut nearest_axis = false;
+                if n == 0 && full.is_none() {
                     // Just beyond a fold (CL rounding): the nearest axis on
-                    // it, where the two branches meet.
+                    // it, where the two branches meet. (On it, by the
+                    // measure of `axis_reach`, subproblem 2's own rounding
+                    // missed it: the axis itself.)
                     let (gap, nearest) = self.axis_reach(&pose.axis);
+                    nearest_axis = gap > 0.0;
                     if gap <= self.axis_rounding {
                         (sols, n) = self
                             .sp2

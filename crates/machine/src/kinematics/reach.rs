@@ -306,6 +306,30 @@ point = [0, 0, 0]
     }
 
     #[test]
+    fn an_axis_on_the_rim_of_the_hole_is_not_beyond_it() {
+        // A C table out of square by 0.01° in XZ on an A table: it cannot
+        // point within 0.01° of its own direction, and Z lies on that rim
+        // (at A = 0, C = 0). Subproblem 2 misses it by rounding; the axis
+        // is solved as it is, not flagged as taken at a nearest one.
+        let tilt = 0.01f64.to_radians();
+        let m = machine(&format!(
+            "{A_TABLE}[[axis]]\nname = \"C\"\nkind = \"rotary\"\nside = \"workpiece\"\n\
+             direction = [{}, 0, {}]\npoint = [0, 0, 0]\n",
+            tilt.sin(),
+            tilt.cos()
+        ));
+        let kin = Kinematics::new(&m);
+        assert_eq!(kin.axis_reach(&Vector3::z()).0, 0.0);
+        let sols = solve(&kin, Vector3::z()).unwrap();
+        assert!(!sols.is_empty());
+        for s in &sols {
+            assert!(!s.nearest_axis, "{s:?}");
+            let pose = kin.fk(&s.joints[..kin.axis_count()]);
+            assert!(angle_between(&pose.axis, &Vector3::z()) < 1e-12, "{s:?}");
+        }
+    }
+
+    #[test]
     fn one_free_axis_takes_the_nearest_direction_on_its_cone() {
         // The locked head above with A locked too: C turns the 15° axis.
         let m = machine(&format!("{B_LOCKED_AT_15}{C_TABLE}"));
