@@ -971,13 +971,7 @@ fn a_feed_per_revolution_follows_the_spindle_speed() {
 fn a_flat_tool_axis_rounded_below_the_band_posts_at_the_edge() {
     let m = nutating_45();
     let (csv, summary) = post_csv(&m, &flat_path("-0.0000001"), &PostOptions::default()).unwrap();
-    let p = &summary.planning;
-    assert!(p.beyond_reach_blocks >= 1, "{p:?}");
-    assert!((p.max_beyond_reach_rad - 1e-7).abs() < 1e-9, "{p:?}");
-    assert_eq!(p.first_beyond_reach_line, Some(3));
-    assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
-    assert!(summary.tolerance_rad < 1.1e-7, "{}", summary.tolerance_rad);
-    assert_flat_blocks(&m, &csv);
+    assert_posted_at_the_edge(&m, &csv, &summary, 1e-7);
     let e = post_csv(&m, &flat_path("-0.0000100"), &PostOptions::default())
         .unwrap_err()
         .to_string();
@@ -999,12 +993,7 @@ fn a_cl_that_rounds_its_tool_axes_more_coarsely_posts_with_its_axis_rounding() {
         ..PostOptions::default()
     };
     let (csv, summary) = post_csv(&m, &flat_path("-0.0000100"), &options).unwrap();
-    let p = &summary.planning;
-    assert!(p.beyond_reach_blocks >= 1, "{p:?}");
-    assert!((p.max_beyond_reach_rad - 1e-5).abs() < 1e-9, "{p:?}");
-    assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
-    assert!(summary.tolerance_rad < 1.1e-5, "{}", summary.tolerance_rad);
-    assert_flat_blocks(&m, &csv);
+    assert_posted_at_the_edge(&m, &csv, &summary, 1e-5);
     // The setting is a bound: farther out is still an error.
     let e = post_csv(&m, &flat_path("-0.0002000"), &options)
         .unwrap_err()
@@ -1039,8 +1028,20 @@ fn flat_path(below: &str) -> String {
     cl
 }
 
-/// Every block points the tool flat (or above) and reaches its point.
-fn assert_flat_blocks(m: &Machine, csv: &str) {
+/// `flat_path` posted with its axes `gap` below the fold taken at the edge:
+/// counted from CL line 3 on, checked against the edge, and every block
+/// points the tool flat (or above) and reaches its point.
+fn assert_posted_at_the_edge(m: &Machine, csv: &str, summary: &Summary, gap: f64) {
+    let p = &summary.planning;
+    assert!(p.beyond_reach_blocks >= 1, "{p:?}");
+    assert!((p.max_beyond_reach_rad - gap).abs() < 1e-9, "{p:?}");
+    assert_eq!(p.first_beyond_reach_line, Some(3));
+    assert!(summary.max_axis_error_rad <= summary.tolerance_rad);
+    assert!(
+        summary.tolerance_rad < 1.1 * gap,
+        "{}",
+        summary.tolerance_rad
+    );
     let kin = Kinematics::new(m);
     for (_, _, q) in rows(csv, m.axes.len()) {
         let pose = kin.fk(&q);
