@@ -151,6 +151,9 @@ pub(crate) struct Emitter<W: Write> {
     inserted: Vec<Node>,
     /// The equal pieces a long CL segment is first cut into (scratch).
     pieces: Vec<Node>,
+    /// The CL line of the point being written (the end of the segment the
+    /// linearization works on).
+    segment_line: usize,
     pub stats: CheckStats,
     pub planning: Planning,
     /// Warnings about what the post could not do as the CL asks (a segment
@@ -198,6 +201,7 @@ impl<W: Write> Emitter<W> {
             solutions: Vec::with_capacity(16),
             inserted: Vec::new(),
             pieces: Vec::new(),
+            segment_line: 0,
             stats: CheckStats::default(),
             planning: Planning::default(),
             warnings: Vec::new(),
@@ -221,6 +225,7 @@ impl<W: Write> Emitter<W> {
         t: &Target,
     ) -> Result<(), PostError> {
         self.pressure = t.pressure;
+        self.segment_line = t.line;
         if let Some(last) = &mut self.last
             && last.pressure.to_bits() != t.pressure.to_bits()
         {
@@ -416,17 +421,22 @@ impl<W: Write> Emitter<W> {
             let pieces = pieces.min(MAX_PIECES);
             let mut nodes = std::mem::take(&mut self.pieces);
             nodes.clear();
+            let mut off: f64 = 0.0;
             for k in 1..pieces as u32 {
                 match self.node_at(kin, a, b, f64::from(k) / pieces) {
-                    Ok((m, false)) => nodes.push(m),
+                    Ok((m, false, m_off)) => {
+                        nodes.push(m);
+                        off = off.max(m_off);
+                    }
                     // An interpolated tool axis the machine cannot point, or
                     // a node it cannot reach: halving decides, as it does
-                    // for shorter segments (see `node_at`).
+                    // for shorter segments.
                     _ => break,
                 }
             }
             let all = nodes.len() + 1 == pieces as usize;
             let result = if all {
+                self.axis_off(off);
                 self.linearize_through(kin, a, &nodes, b, lever, depth, out)
             } else {
                 Ok(())
@@ -436,7 +446,8 @@ impl<W: Write> Emitter<W> {
                 return result;
             }
         }
-        let (m, _) = self.node_at(kin, a, b, 0.5)?;
+        let (m, _, off) = self.node_at(kin, a, b, 0.5)?;
+        self.axis_off(off);
         self.linearize_through(kin, a, &[m], b, lever, depth, out)
     }
 
@@ -465,16 +476,16 @@ impl<W: Write> Emitter<W> {
     /// The node the linearization inserts at `t` (0..1) between `a` and `b`:
     /// the CL pose interpolated there, solved nearest the joint-space
     /// interpolation; `true` with it where the machine cannot point the
-    /// interpolated tool axis and the node keeps the joint-space one. (Where
-    /// that excursion is more than rounding, halving does not converge, and
-    /// the error names it.)
+    /// interpolated tool axis and the node keeps the joint-space one; and
+    /// the angle between the node's tool axis and the interpolated one,
+    /// radians (not 0 where an angle is held or the axis is beyond reach).
     fn node_at(
         &mut self,
         kin: &Kinematics,
         a: &Node,
         b: &Node,
         t: f64,
-    ) -> Result<(Node, bool), SplitError> {
+    ) -> Result<(Node, bool, f64), SplitError> {
         let guess = joints_at(a, b, t, self.n);
         let pose = interpolate(&a.pose, &b.pose, t);
         // Inside the singular cone the singular angle moves linearly in
@@ -510,10 +521,23 @@ impl<W: Write> Emitter<W> {
                 };
                 solve_near(kin, &natural, &near, &self.rotary, &mut self.solutions)
             });
-        let Some((pose, sol)) = solved else {
+        let Some((solved, sol)) = solved else {
             return Err(SplitError::OutsideTravel);
         };
-        Ok((Node::solved(pose, &sol, hold), natural))
+        let off = angle_between(&solved.axis, &pose.axis);
+        Ok((Node::solved(solved, &sol, hold), natural, off))
+    }
+
+    /// Counts an inserted node whose tool axis lies `off_rad` from the CL's
+    /// interpolated one (held near the pole, or at the edge of what the
+    /// machine can point).
+    fn axis_off(&mut self, off_rad: f64) {
+        let p = &mut self.planning;
+        let deg = off_rad.to_degrees();
+        if deg > p.max_inserted_axis_deviation_deg {
+            p.max_inserted_axis_deviation_deg = deg;
+            p.max_inserted_axis_deviation_line = Some(self.segment_line);
+        }
     }
 
     /// Retract along the tool axis from the last block, turn the rotary axes

@@ -40,6 +40,14 @@ fn slerp(a: &Vector3<f64>, b: &Vector3<f64>, t: f64) -> Vector3<f64> {
     }
 }
 
+/// How far a solution's held angle may lie from the value held, degrees.
+/// The tool axis solved is one the machine points with that value, so the
+/// solution has it up to rounding; where that axis lies on a fold (the two
+/// branches meet there, as beside the small hole of a C axis out of
+/// square), the angle is found through a square root of a near-zero term,
+/// and lies up to about 1e-4° off.
+const HELD_SLACK_DEG: f64 = 1e-3;
+
 /// Where to solve a pose near: a configuration, the singular angle held
 /// there if any, and the branch to keep if any.
 pub(crate) struct Near<'a> {
@@ -74,7 +82,8 @@ pub(crate) fn solve_near(
     kin.ik(&pose, Some(&hint[..n]), scratch).ok()?;
     let travel =
         |s: &Solution| -> f64 { rotary.iter().map(|&i| (s.joints[i] - hint[i]).abs()).sum() };
-    let held = |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value).abs() < 1e-6);
+    let held =
+        |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value).abs() < HELD_SLACK_DEG);
     let other = |s: &Solution| near.branch.is_some_and(|b| b != s.branch);
     let best = scratch
         .iter()

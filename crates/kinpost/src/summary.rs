@@ -45,6 +45,12 @@ pub struct Planning {
     /// where the midpoint was computed, the chain's chord bound (plus 1e-6 mm)
     /// where that bound alone showed the block within the tolerance.
     pub max_linearization_error_mm: f64,
+    /// Largest angle between the tool axis of an inserted linearization
+    /// block and the CL's interpolated one, degrees (where an angle is held
+    /// near the pole, or the interpolated axis passes where the machine
+    /// cannot point), and the CL line of the segment.
+    pub max_inserted_axis_deviation_deg: f64,
+    pub max_inserted_axis_deviation_line: Option<usize>,
     /// Largest change of one rotary axis between two consecutive feed
     /// blocks, degrees, and the CL line of the block.
     pub max_rotary_step_deg: f64,
@@ -171,6 +177,13 @@ impl Summary {
             planning += &format!(
                 "; {} inserted block(s), linearization max {:.4} mm",
                 p.inserted_blocks, p.max_linearization_error_mm
+            );
+        }
+        if p.max_inserted_axis_deviation_deg >= 1e-4 {
+            planning += &format!(
+                "; an inserted block's tool axis up to {:.4}° off the CL's interpolation (before CL line {})",
+                p.max_inserted_axis_deviation_deg,
+                p.max_inserted_axis_deviation_line.unwrap_or(0)
             );
         }
         if !p.singular_stretches.is_empty() {

@@ -868,32 +868,50 @@ fn a_path_skirting_the_folds_is_linearized() {
 /// axis (a fold, not a pole, bounds the band there). cone-crossing.cls
 /// tilts it 1° at azimuth 0°, then at 170°: the great circle between
 /// passes the C axis at atan(tan 1°·cos 85°) and enters that cone. The
-/// error names the cone and the depth instead of a linearization that
-/// does not converge.
+/// machine passes the cone at its rim: the contact point stays within the
+/// linearization tolerance, and the summary says how far the tool axis of
+/// the inserted blocks lies from the interpolated one (the cone's depth).
 #[test]
-fn a_segment_through_a_cone_the_machine_cannot_point_is_named() {
+fn a_segment_through_a_cone_the_machine_cannot_point_passes_at_its_rim() {
     let dir = format!("{}/tests/folds", env!("CARGO_MANIFEST_DIR"));
     let path = format!("{dir}/nutating-off.toml");
     let m = machine_from_toml(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
     let cl = std::fs::read_to_string(format!("{dir}/cone-crossing.cls")).unwrap();
-    let e = post_csv(&m, &cl, &PostOptions::default())
-        .unwrap_err()
-        .to_string();
     let nearest = (1f64.to_radians().tan() * 85f64.to_radians().cos())
         .atan()
         .to_degrees();
-    let want = format!(
-        "the tool axis interpolated between CL line 7 and this point, point (3.0000, 0.0000, 0.0000) axis (-0.0171873, 0.0030306, 0.9998477), passes {:.4}° into the cone of directions within 0.2000° of (0.0000000, 0.0000000, 1.0000000) that the machine cannot point",
-        0.2 - nearest
-    );
-    assert!(e.contains(&want), "{e}\nwanted: {want}");
-    // Written as joint moves, the segment posts.
+    for cone in [None, Some(0.0)] {
+        let options = PostOptions {
+            singular_cone_deg: cone,
+            ..Default::default()
+        };
+        let (csv, summary) = post_csv(&m, &cl, &options).unwrap();
+        let p = &summary.planning;
+        assert!(
+            (p.max_inserted_axis_deviation_deg - (0.2 - nearest)).abs() < 1e-4,
+            "{cone:?}: {p:?}"
+        );
+        assert_eq!(p.max_inserted_axis_deviation_line, Some(8));
+        assert!(p.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
+        assert!(summary.one_line().contains(&format!(
+            "an inserted block's tool axis up to {:.4}° off the CL's interpolation (before CL line 8)",
+            0.2 - nearest
+        )));
+        // Every block points where the machine can: 0.2° or more from Z.
+        let kin = Kinematics::new(&m);
+        for (_, _, q) in rows(&csv, m.axes.len()) {
+            let a = kin.fk(&q).axis;
+            assert!(a.z.acos().to_degrees() > 0.2 - 1e-6, "{a:?}");
+        }
+    }
+    // Written as joint moves, the segment posts without inserted blocks.
     let options = PostOptions {
         lintol_mm: Some(0.0),
         ..Default::default()
     };
-    let (csv, _) = post_csv(&m, &cl, &options).unwrap();
+    let (csv, summary) = post_csv(&m, &cl, &options).unwrap();
     assert_eq!(rows(&csv, m.axes.len()).len(), 6);
+    assert_eq!(summary.planning.max_inserted_axis_deviation_deg, 0.0);
 }
 
 /// Posts a CL file of `tests/folds` on a machine there with the defaults:
