@@ -159,6 +159,20 @@ mod tests {
     }
 
     #[test]
+    fn a_head_no_linear_axis_follows_keeps_its_pivot_as_lever() {
+        // head-head-bc: X Y Z carry the C fork, which carries the B spindle
+        // with its line 250 mm above the tool tip; the linear travel does
+        // not move the tool tip away from either line.
+        let m = kinpost_machine::builtin::load("head-head-bc")
+            .unwrap()
+            .unwrap();
+        assert!((m.largest_pivot_distance() - 250.0).abs() < 1e-9);
+        let t = Tolerance::from_resolution(&m, |_| 0.001);
+        let want = 3.0 * 0.0005 + 2.0 * 0.0005f64.to_radians() * 250.0 + 1e-9;
+        assert!((t.position_mm - want).abs() < 1e-15, "{}", t.position_mm);
+    }
+
+    #[test]
     fn stats_keep_exact_maxima() {
         let pose = |x: f64, ax: f64| Pose {
             point: Vector3::new(x, 0.0, 0.0),

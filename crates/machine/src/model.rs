@@ -228,10 +228,14 @@ impl Machine {
         self.axes.iter().map(|a| a.fixed.unwrap_or(0.0)).collect()
     }
 
-    /// Largest distance between the home tool point and a rotary axis line,
-    /// plus the diagonal of the linear travel box (1 m per linear axis where
-    /// the travel is not given): an upper bound of the lever through which an
-    /// angle error moves the tool point.
+    /// An upper bound of the lever through which an angle error moves the
+    /// tool point: the largest distance between the home tool point and a
+    /// rotary axis line, plus, for an axis with linear axes between it and
+    /// the tool in the chain (a table axis, or a head axis the ram carries
+    /// further), the diagonal of the linear travel box (1 m per linear axis
+    /// where the travel is not given). The linear axes move the tool point
+    /// away from a table axis; a head axis that no linear axis follows keeps
+    /// its distance.
     pub fn largest_pivot_distance(&self) -> f64 {
         let travel: f64 = self
             .axes
@@ -243,12 +247,33 @@ impl Machine {
             })
             .sum::<f64>()
             .sqrt();
-        let lever = self
-            .axes
+        // Between axis `i` and the tool: on the tool side, the axes of that
+        // side listed after it; on the workpiece side, those listed before
+        // it (they carry it) and every axis of the tool side.
+        let linear_inside = |i: usize| {
+            let side = self.axes[i].side;
+            self.axes.iter().enumerate().any(|(j, a)| {
+                !a.is_rotary()
+                    && match (side, a.side) {
+                        (Side::Tool, Side::Tool) => j > i,
+                        (Side::Tool, Side::Workpiece) => false,
+                        (Side::Workpiece, Side::Workpiece) => j < i,
+                        (Side::Workpiece, Side::Tool) => true,
+                    }
+            })
+        };
+        self.axes
             .iter()
-            .filter(|a| a.is_rotary())
-            .map(|a| (self.tool.point - a.point).cross(&a.direction).norm())
-            .fold(0.0, f64::max);
-        lever + travel
+            .enumerate()
+            .filter(|(_, a)| a.is_rotary())
+            .map(|(i, a)| {
+                let home = (self.tool.point - a.point).cross(&a.direction).norm();
+                if linear_inside(i) {
+                    home + travel
+                } else {
+                    home
+                }
+            })
+            .fold(0.0, f64::max)
     }
 }
