@@ -592,16 +592,10 @@ impl<W: Write> Job<'_, W> {
                     self.dialect.name()
                 )));
             }
-            // A modulo axis reaches every angle: its limits only bound the
-            // counter, so the kinematics sees it without them and takes the
-            // turn nearest the previous point.
-            let mut planned = machine.clone();
-            for a in &mut planned.axes {
-                if a.is_endless() {
-                    a.limits = None;
-                }
-            }
-            let mut kin = Kinematics::new(&planned);
+            // (A modulo axis reaches every angle: the kinematics sees it
+            // without limits, `Axis::travel`, and takes the turn nearest the
+            // previous point.)
+            let mut kin = Kinematics::new(&machine);
             if let Some(rad) = self.options.axis_rounding_rad {
                 kin.set_axis_rounding(rad);
             }
@@ -614,9 +608,9 @@ impl<W: Write> Job<'_, W> {
                 PlannerMode::Global => PLANNER_LAG,
                 PlannerMode::Nearest => 1,
             };
-            let costs = Costs::new(&planned, cone, kin.singularity().map(|s| s.axis));
+            let costs = Costs::new(&machine, cone, kin.singularity().map(|s| s.axis));
             let path = PathPlan::new(
-                &planned,
+                &machine,
                 &kin,
                 Trellis::new(costs, lag),
                 cone,
@@ -642,7 +636,7 @@ impl<W: Write> Job<'_, W> {
                 emitter: Emitter::new(&machine, writer, settings),
                 kin,
                 path,
-                wheel: Wheel::new(&planned, !self.options.no_pressure_compensation),
+                wheel: Wheel::new(&machine, !self.options.no_pressure_compensation),
                 machine,
                 six_axis,
             });

@@ -1294,3 +1294,37 @@ fn ik_says_when_it_takes_the_nearest_axis_and_how_far_an_unreachable_one_is() {
         );
     }
 }
+
+/// A modulo axis reaches every angle: `fk` and `ik` do not hold it to its
+/// limits (which bound the counter), as `post` does not.
+#[test]
+fn fk_and_ik_do_not_hold_a_modulo_axis_to_its_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let show = stdout(&run(&["machine", "show", "head-head-bc"]));
+    let machine = show.replace(
+        "limits = [-360, 360]\n# Endless",
+        "limits = [0, 1]\n# Endless",
+    );
+    assert_ne!(machine, show, "head-head-bc's C is modulo with limits ±360");
+    let path = dir.path().join("modulo-c.toml");
+    std::fs::write(&path, machine).unwrap();
+    let m = path.to_str().unwrap();
+    let fk = run(&["fk", "-m", m, "C=90", "B=30"]);
+    assert_exit(&fk, 0);
+    assert!(
+        !stderr(&fk).contains("outside the axis limits"),
+        "{}",
+        stderr(&fk)
+    );
+    let ik = success(&[
+        "ik",
+        "-m",
+        m,
+        "--point",
+        "10,20,30",
+        "--axis",
+        "0,0.5,0.8660254",
+    ]);
+    assert!(!ik.contains("outside"), "{ik}");
+    assert!(ik.lines().skip(1).all(|l| l.ends_with("ok")), "{ik}");
+}

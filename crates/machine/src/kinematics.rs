@@ -400,7 +400,7 @@ impl Kinematics {
         for (i, a) in machine.axes.iter().enumerate() {
             fixed[i] = a.fixed.unwrap_or(0.0);
             is_fixed[i] = a.fixed.is_some();
-            limits[i] = a.limits;
+            limits[i] = a.travel();
             rotary[i] = a.is_rotary();
         }
         // The chain outermost first: W0⁻¹, the workpiece axes inverted from

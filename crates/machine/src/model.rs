@@ -103,10 +103,17 @@ impl Axis {
         }
     }
 
-    /// Whether `value` lies inside the travel (with a tolerance of 1e-9 for
-    /// values computed exactly at a limit).
+    /// The travel the machine holds the axis to: its limits, except for a
+    /// modulo axis, which reaches every angle (its limits bound the counter,
+    /// not the machine).
+    pub fn travel(&self) -> Option<[f64; 2]> {
+        if self.is_endless() { None } else { self.limits }
+    }
+
+    /// Whether `value` lies inside the travel ([`Axis::travel`], with a
+    /// tolerance of 1e-9 for values computed exactly at a limit).
     pub fn accepts(&self, value: f64) -> bool {
-        match self.limits {
+        match self.travel() {
             None => value.is_finite(),
             Some([lo, hi]) => value >= lo - 1e-9 && value <= hi + 1e-9,
         }

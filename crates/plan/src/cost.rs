@@ -166,12 +166,7 @@ impl Costs {
             .filter(free)
             .filter_map(|i| {
                 let a = &machine.axes[i];
-                let [lo, hi] = a.limits?;
-                // A modulo axis reaches every angle: its limits bound the
-                // counter, not the machine.
-                if a.is_rotary() && a.wrap == Wrap::Modulo {
-                    return None;
-                }
+                let [lo, hi] = a.travel()?;
                 let margin = ((hi - lo) * 0.05).min(if a.is_rotary() { 5.0 } else { 10.0 });
                 (margin > 0.0).then_some(Limited {
                     index: i,
