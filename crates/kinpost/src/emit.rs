@@ -32,6 +32,11 @@ const PIECES_MARGIN: f64 = 1.05;
 /// What the chord bound adds for the ends of a joint motion not being
 /// exactly on their CL points (the inverse kinematics is exact to 1e-9 mm).
 const CHORD_SLACK_MM: f64 = 1e-6;
+/// A block whose tool point moves less than this, mm, only turns.
+const PURE_TURN_MM: f64 = 1e-3;
+/// A rotary axis without a maximum velocity that a feed block turns faster
+/// than this, degrees per minute (100 turns a minute), is warned about once.
+const FAST_TURN_DEG_PER_MIN: f64 = 36_000.0;
 /// At most this many feed clamps are listed (all are counted).
 const MAX_CLAMPS_LISTED: usize = 1000;
 
@@ -123,10 +128,11 @@ pub(crate) struct Emitter<W: Write> {
     /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
     /// measures it: one unit of the last decimal of every free axis.
     rounding_travel: (f64, f64),
-    /// One unit of the last written decimal of the free linear axes (the
-    /// finest of them, at most 1 µm), mm: a shorter move of the tool point
-    /// only turns.
-    tip_resolution: f64,
+    /// Rotary axes without a maximum velocity already warned about for
+    /// turning implausibly fast in a feed block, and the block just found
+    /// (axis, degrees per minute, degrees, minutes).
+    fast_warned: Vec<usize>,
+    fast_turn: Option<(usize, f64, f64, f64)>,
     /// Axes with a maximum velocity (index, units per minute).
     vmax: Vec<(usize, f64)>,
     names: Vec<String>,
@@ -171,15 +177,11 @@ impl<W: Write> Emitter<W> {
                 .sum::<f64>()
         };
         let rounding_travel = (free(true).to_radians(), free(false));
-        let tip_resolution = (0..axes.len())
-            .filter(|&i| axes[i].is_free() && !axes[i].is_rotary())
-            .map(|i| settings.resolution[i])
-            .fold(f64::INFINITY, f64::min)
-            .min(1e-3);
         Emitter {
             writer,
             rounding_travel,
-            tip_resolution,
+            fast_warned: Vec::new(),
+            fast_turn: None,
             settings,
             n: axes.len(),
             rotary: machine.free_rotary_axes().collect(),
@@ -755,6 +757,18 @@ impl<W: Write> Emitter<W> {
                     self.writer.inverse_time(self.inverse_time_on)?;
                 }
                 let word = self.feed_word(f, node, &values, line);
+                if let Some((i, speed, turned, time)) = self.fast_turn.take()
+                    && let PostError::Input(mut warning) = at(format!(
+                        "this feed block turns {} by {turned:.3}° in {:.1e} s ({speed:.0}°/min): \
+                         the machine file gives {} no max_velocity to hold it to",
+                        self.names[i],
+                        time * 60.0,
+                        self.names[i]
+                    ))
+                {
+                    warning.severity = Severity::Warning;
+                    self.warnings.push(*warning);
+                }
                 if word < 1.0 && self.writer.feed_rounds_to_zero(word) {
                     return Err(at(format!(
                         "the feed word {word} rounds to 0 with the dialect's feed decimals (CL feed rate {f} mm/min): \
@@ -824,17 +838,12 @@ impl<W: Write> Emitter<W> {
             .iter()
             .map(|&i| (node.joints[i] - last.node.joints[i]).abs())
             .fold(0.0, f64::max);
-        // A tool point that moves less than the last written decimal of
-        // the linear axes does not move as far as the program can say: the
-        // block only turns, and takes its largest rotary change in degrees
-        // over the feed rate taken as degrees per minute. (Its length
-        // instead would make the block an instant: F without bound where F
-        // is the block time.)
-        let distance = if length >= self.tip_resolution {
-            length
-        } else {
-            turn
-        };
+        // A tool point that moves less than 1 µm (for every dialect alike)
+        // does not move: the block only turns, and takes its largest rotary
+        // change in degrees over the feed rate taken as degrees per minute.
+        // (Its length instead would make the block an instant: F without
+        // bound where F is the block time.)
+        let distance = if length >= PURE_TURN_MM { length } else { turn };
         if distance <= 1e-9 || feed <= 0.0 {
             return feed;
         }
@@ -858,6 +867,23 @@ impl<W: Write> Emitter<W> {
                     programmed_min: programmed,
                     written_min: time,
                 });
+            }
+        }
+        if self.settings.feed_mode != FeedMode::Tip {
+            // The block time is what the program says: a rotary axis with no
+            // maximum velocity to hold it to may be asked to turn faster
+            // than any machine does (a reorientation about the tool point
+            // while it hardly moves).
+            for &i in &self.rotary {
+                let turned = (values[i] - last.values[i]).abs();
+                let speed = turned / time;
+                if speed > FAST_TURN_DEG_PER_MIN
+                    && !self.vmax.iter().any(|&(j, _)| j == i)
+                    && !self.fast_warned.contains(&i)
+                {
+                    self.fast_warned.push(i);
+                    self.fast_turn = Some((i, speed, turned, time));
+                }
             }
         }
         match self.settings.feed_mode {

@@ -1115,3 +1115,66 @@ fn a_long_turning_move_is_cut_into_the_pieces_it_needs() {
         );
     }
 }
+
+/// Inverse-time block times do not depend on the dialect's decimals: a
+/// block whose tool point moves less than 1 µm only turns, and takes its
+/// rotary change at the feed rate read as degrees per minute, in the csv
+/// (6 decimals) as in fanuc (3). A feed block that turns a rotary axis
+/// without `max_velocity` faster than 100 turns a minute is warned about.
+#[test]
+fn inverse_time_feed_words_are_the_same_in_every_dialect() {
+    let m = builtin::load("mts1600").unwrap().unwrap();
+    // The tool point moves 0.5 µm a point while the axis tilts 1° a point.
+    let mut cl = String::from("FEDRAT/MMPM,1000\n");
+    for k in 0..6 {
+        let b = f64::from(k).to_radians();
+        cl += &format!(
+            "GOTO/{:.7},60.0000000,5.0000000,{:.7},0.0000000,{:.7}\n",
+            -400.0 + 0.0005 * f64::from(k),
+            b.sin(),
+            b.cos()
+        );
+    }
+    let options = PostOptions {
+        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        lintol_mm: Some(0.0),
+        ..Default::default()
+    };
+    let (csv, summary) = post_csv(&m, &cl, &options).unwrap();
+    assert!(summary.warnings.is_empty(), "{:?}", summary.warnings);
+    let feeds: Vec<f64> = csv
+        .lines()
+        .skip(3) // header, the first block (per minute), its first move
+        .map(|r| r.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(feeds.len(), 4);
+    for f in &feeds {
+        // 1° at 1000°/min: 1/1000 min.
+        assert!((f - 1000.0).abs() < 1.0, "{feeds:?}");
+    }
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let mut out = Vec::new();
+    post(cl.as_bytes(), &m, &dialect, &mut out, &options).unwrap();
+    let fanuc = String::from_utf8(out).unwrap();
+    assert_eq!(fanuc.matches("F1000.").count(), 4, "{fanuc}");
+
+    // 0.05 mm while B tilts 30°: by the tool path, B would turn at
+    // 600,000°/min.
+    let fast = "FEDRAT/MMPM,1000\n\
+                GOTO/-400.0000,60.0000,5.0000,0.0000000,0.0000000,1.0000000\n\
+                GOTO/-399.9500,60.0000,5.0000,0.5000000,0.0000000,0.8660254\n";
+    let options = PostOptions {
+        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        ..Default::default()
+    };
+    let (_, summary) = post_csv(&m, fast, &options).unwrap();
+    assert_eq!(summary.warnings.len(), 1, "{:?}", summary.warnings);
+    let w = &summary.warnings[0];
+    assert_eq!(w.line, 3);
+    assert!(
+        w.message
+            .contains("(600000°/min): the machine file gives B no max_velocity to hold it to"),
+        "{}",
+        w.message
+    );
+}
