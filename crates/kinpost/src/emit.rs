@@ -125,6 +125,8 @@ pub(crate) struct Emitter<W: Write> {
     rotary: Vec<usize>,
     /// Free linear axes.
     linear: Vec<usize>,
+    /// Free rotary axes with `wrap = "unwind"`.
+    unwind: Vec<usize>,
     /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
     /// measures it: one unit of the last decimal of every free axis.
     rounding_travel: (f64, f64),
@@ -185,6 +187,7 @@ impl<W: Write> Emitter<W> {
             settings,
             n: axes.len(),
             rotary: machine.free_rotary_axes().collect(),
+            unwind: machine.unwinding_axes().collect(),
             linear: (0..axes.len())
                 .filter(|&i| axes[i].is_free() && !axes[i].is_rotary())
                 .collect(),
@@ -314,6 +317,22 @@ impl<W: Write> Emitter<W> {
                     self.inserted(machine, kin, node, Motion::Feed, t)?;
                 }
                 self.inserted = inserted;
+            }
+        }
+        if t.motion == Motion::Rapid
+            && let Some(last) = &self.last
+        {
+            // An axis that unwinds at the start of a segment does so where
+            // the rapid ends, not while the tool leaves the cut: the rapid
+            // keeps the turn it has, and a block of its own then unwinds
+            // the whole turns (the same pose).
+            let mut kept = *t.node;
+            for &i in &self.unwind {
+                let turns = ((last.node.joints[i] - kept.joints[i]) / 360.0).round();
+                kept.joints[i] += 360.0 * turns;
+            }
+            if kept.joints != t.node.joints && kept.joints != last.node.joints {
+                self.inserted(machine, kin, &kept, Motion::Rapid, t)?;
             }
         }
         self.block(

@@ -12,9 +12,7 @@ use std::ops::Range;
 
 use kinpost_diag::Diagnostic;
 use kinpost_machine::angle::{atan2_deg, atan2_rad};
-use kinpost_machine::{
-    Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution, Wrap,
-};
+use kinpost_machine::{Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
 use kinpost_nc::Motion;
 use kinpost_plan::{Choice, Link, Trellis, rejection};
 use nalgebra::Vector3;
@@ -132,10 +130,7 @@ impl PathPlan {
             singularity: kin.singularity(),
             cone_rad: cone_deg.to_radians(),
             rotary: machine.free_rotary_axes().collect(),
-            unwind: machine
-                .free_rotary_axes()
-                .filter(|&i| axes[i].wrap == Wrap::Unwind)
-                .collect(),
+            unwind: machine.unwinding_axes().collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
             file: file.to_string(),
             points: Vec::new(),

@@ -292,7 +292,8 @@ fn limits_of_more_than_a_turn_are_kept_unless_the_axis_is_modulo() {
 /// A C axis without limits that unwinds (`wrap = "unwind"`) is back at
 /// the turn nearest zero at the start of the next segment, however far the
 /// last cut turned it (before: only the turns within 210° of the last
-/// point were candidates).
+/// point were candidates). It unwinds where the rapid ends, in a block of
+/// its own: the rapid that leaves the cut keeps its turn.
 #[test]
 fn an_unwinding_axis_without_limits_unwinds_after_two_turns() {
     let source = trunnion_ac_with_c("wrap = \"unwind\"");
@@ -311,14 +312,35 @@ fn an_unwinding_axis_without_limits_unwinds_after_two_turns() {
     for k in 0..=144 {
         cl.push_str(&at((5.0 * k as f64).to_radians()));
     }
+    // Retract 50 mm along Z.
     cl.push_str("RAPID\n");
-    cl.push_str(&at(0.0));
+    cl.push_str(&goto(
+        &Vector3::new(40.0, 0.0, 50.0),
+        &Vector3::new(tilt.sin(), 0.0, tilt.cos()),
+    ));
     let (csv, _) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
     let all = rows(&csv, m.axes.len());
     let turned = all.iter().map(|r| r.2[ic].abs()).fold(0.0, f64::max);
     assert!(turned > 600.0, "the cut turns C twice: {turned}°");
-    let last = all.last().unwrap().2[ic];
-    assert!(last.abs() <= 180.0, "C {last}° after the rapid");
+    let [.., cut, retract, unwound] = &all[..] else {
+        panic!("{csv}")
+    };
+    assert_eq!(retract.1, "rapid");
+    assert_eq!(retract.0, None, "the retract is a block of the post's");
+    assert!(
+        (retract.2[ic] - cut.2[ic]).abs() < 1e-6,
+        "{retract:?} after {cut:?}"
+    );
+    assert_eq!(unwound.0, Some(146 + 2));
+    assert!(
+        unwound.2[ic].abs() <= 180.0,
+        "C {}° after the rapid",
+        unwound.2[ic]
+    );
+    let kin = Kinematics::new(&m);
+    let (a, b) = (kin.fk(&retract.2), kin.fk(&unwound.2));
+    assert!((a.point - b.point).norm() < 1e-6 && (a.axis - b.axis).norm() < 1e-9);
+    assert!((a.point.z - 50.0).abs() < 1e-6, "{a:?}");
 }
 
 /// Tool axis tilted 25° turning about the part's Z by 270°: more than C's

@@ -207,6 +207,13 @@ impl Machine {
         (0..self.axes.len()).filter(|&i| self.axes[i].is_rotary() && self.axes[i].is_free())
     }
 
+    /// Indices of the free rotary axes with `wrap = "unwind"` (back to the
+    /// turn nearest zero at the start of every segment).
+    pub fn unwinding_axes(&self) -> impl Iterator<Item = usize> + '_ {
+        self.free_rotary_axes()
+            .filter(|&i| self.axes[i].wrap == Wrap::Unwind)
+    }
+
     /// Number of free (not `fixed`) rotary axes.
     pub fn free_rotary_count(&self) -> usize {
         self.free_rotary_axes().count()
