@@ -786,12 +786,24 @@ fn fk(machine: &str, values: &[String], pressure: Option<f64>, out: &mut impl Wr
     let pose = Kinematics::new(&machine_at_pressure(&m, pressure)?).fk(&q);
     let p = pose.point;
     let a = pose.axis;
-    writeln!(out, "point     {:.6} {:.6} {:.6}", p.x, p.y, p.z)?;
-    writeln!(out, "axis      {:.9} {:.9} {:.9}", a.x, a.y, a.z)?;
+    let v =
+        |v: &Vector3<f64>, d: usize| v.iter().map(|&x| fixed(x, d)).collect::<Vec<_>>().join(" ");
+    writeln!(out, "point     {}", v(&p, 6))?;
+    writeln!(out, "axis      {}", v(&a, 9))?;
     if let Some(r) = pose.reference {
-        writeln!(out, "reference {:.9} {:.9} {:.9}", r.x, r.y, r.z)?;
+        writeln!(out, "reference {}", v(&r, 9))?;
     }
     Ok(())
+}
+
+/// `value` with `decimals` decimals, without the sign of a value that
+/// rounds to zero ("0.000000", not "-0.000000").
+fn fixed(value: f64, decimals: usize) -> String {
+    let s = format!("{value:.decimals$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+        _ => s,
+    }
 }
 
 /// Puts axis `i` of the machine `fk` turns at `value`. The kinematics
@@ -848,7 +860,7 @@ fn ik(
     writeln!(out, "branch {}  status", names.join(""))?;
     for s in &sols {
         let values: Vec<String> = (0..m.axes.len())
-            .map(|i| format!("{:>12.6}", s.joints[i]))
+            .map(|i| format!("{:>12}", fixed(s.joints[i], 6)))
             .collect();
         let status = match s.violation {
             None if s.singular => "ok (singular: a free angle kept at 0)".to_string(),

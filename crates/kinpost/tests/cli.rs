@@ -1328,3 +1328,25 @@ fn fk_and_ik_do_not_hold_a_modulo_axis_to_its_limits() {
     assert!(!ik.contains("outside"), "{ik}");
     assert!(ik.lines().skip(1).all(|l| l.ends_with("ok")), "{ik}");
 }
+
+/// `fk` and `ik` print a value that rounds to zero without a sign.
+#[test]
+fn fk_and_ik_print_no_negative_zero() {
+    // At C = 90° the tool axis is (−6e-17, 0, 1).
+    let fk = success(&["fk", "-m", "head-head-bc", "C=90", "B=0"]);
+    assert!(
+        fk.contains("axis      0.000000000 0.000000000 1.000000000"),
+        "{fk}"
+    );
+    assert!(!fk.contains("-0.0"), "{fk}");
+    let ik = success(&[
+        "ik",
+        "-m",
+        "mts1600",
+        "--point",
+        "-400,60,5",
+        "--axis",
+        "0,0,1",
+    ]);
+    assert!(!ik.contains("-0.000000"), "{ik}");
+}
