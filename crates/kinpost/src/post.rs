@@ -466,7 +466,14 @@ fn statement<R: BufRead, W: Write>(
             };
             job.emit(Output::Spindle(state), reader)?
         }
-        ClEvent::SpindleOff => job.emit(Output::Spindle(Spindle::Off), reader)?,
+        ClEvent::SpindleOff => {
+            // No speed now: a feed per revolution gives no feed rate.
+            job.rpm = None;
+            if job.feed_per_rev.is_some() {
+                job.feed = None;
+            }
+            job.emit(Output::Spindle(Spindle::Off), reader)?
+        }
         ClEvent::Coolant { on, mode } => job.emit(Output::Coolant(on.then_some(mode)), reader)?,
         ClEvent::Insert(text) => job.emit(Output::Insert(text), reader)?,
         ClEvent::EndOfPath => job.break_segment(),
@@ -729,9 +736,12 @@ impl<W: Write> Job<'_, W> {
             }));
         }
         if motion == Motion::Feed && self.feed.is_none() {
-            return Err(at(
-                "feed move before any FEDRAT: the controller has no feed rate for it".into(),
-            ));
+            return Err(at(if self.feed_per_rev.is_some() {
+                "feed move at a feed per revolution with the spindle off (SPINDL/OFF): give SPINDL/rpm before it"
+                    .into()
+            } else {
+                "feed move before any FEDRAT: the controller has no feed rate for it".into()
+            }));
         }
         let nc_motion = match motion {
             Motion::Rapid => kinpost_nc::Motion::Rapid,

@@ -998,6 +998,24 @@ fn a_feed_per_revolution_follows_the_spindle_speed() {
         e.contains("a feed per revolution needs the spindle speed: give SPINDL/rpm before it"),
         "{e}"
     );
+    // The spindle stopped: no speed for a feed per revolution, until the
+    // next SPINDL gives one.
+    let stopped = "SPINDL/RPM,2000,CLW\nFEDRAT/MMPR,0.1\nGOTO/0,0,50,0,0,1\nSPINDL/OFF\n";
+    let e = post_csv(&m, &format!("{stopped}GOTO/0,0,40\n"), &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("feed move at a feed per revolution with the spindle off (SPINDL/OFF): give SPINDL/rpm before it"),
+        "{e}"
+    );
+    assert!(e.contains(":5:"), "{e}");
+    let (csv, _) = post_csv(
+        &m,
+        &format!("{stopped}SPINDL/RPM,1000,CLW\nGOTO/0,0,40\n"),
+        &options,
+    )
+    .unwrap();
+    assert!(csv.trim_end().ends_with(",100.000000"), "{csv}");
 }
 
 /// A CL file writes tool axes with 7 decimals. Along the edge of the band a
