@@ -430,8 +430,8 @@ impl<W: Write> Emitter<W> {
         // it needs, instead of being halved down to a power of two of them.
         // Each piece is then checked like any segment, and halved where it
         // still strays. (Not where the interpolated tool axis leaves the
-        // directions the machine can point: the pieces might step over that
-        // excursion, which halving names.)
+        // directions the machine can point: the deviation is uneven along
+        // such a segment, and halving puts its nodes where it is.)
         let pieces = ((deviation / lintol).sqrt() * PIECES_MARGIN).ceil();
         if depth == 0
             && deviation > 4.0 * lintol
