@@ -717,7 +717,8 @@ impl<R: io::Read> io::Read for Progress<R> {
     }
 }
 
-/// A pressure from the command line: a number not below 0.
+/// An axis rounding from the command line: an angle from 0 to
+/// [`MAX_AXIS_ROUNDING_RAD`].
 fn check_axis_rounding(v: f64) -> Result<f64> {
     if v.is_finite() && (0.0..=MAX_AXIS_ROUNDING_RAD).contains(&v) {
         Ok(v)
@@ -728,6 +729,7 @@ fn check_axis_rounding(v: f64) -> Result<f64> {
     }
 }
 
+/// A pressure from the command line: a number not below 0.
 fn check_pressure_value(v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
