@@ -215,6 +215,12 @@ point = [0, 0, 0]
         machine(&format!("{B_LOCKED_AT_15}{A_TABLE}{C_TABLE}"))
     }
 
+    /// How far short of 15° from Z the direction `axis` lies, radians (the
+    /// tilt of the head locked at 15°).
+    fn off_15_degrees(axis: &Vector3<f64>) -> f64 {
+        15f64.to_radians() - angle_between(&Vector3::z(), axis)
+    }
+
     fn unit(x: f64, y: f64, z: f64) -> Vector3<f64> {
         Vector3::new(x, y, z).normalize()
     }
@@ -269,7 +275,7 @@ point = [0, 0, 0]
     #[test]
     fn fifteen_degrees_rounded_to_seven_decimals_is_solved_at_fifteen() {
         let axis = unit(-0.2588190, 0.0, 0.9659258);
-        let gap = 15f64.to_radians() - angle_between(&Vector3::z(), &axis);
+        let gap = off_15_degrees(&axis);
         assert!(gap > 1e-8 && gap < 1e-7, "{gap}");
         assert_nearest(&Kinematics::new(&locked_head()), axis, gap);
         assert_eq!(
@@ -283,7 +289,7 @@ point = [0, 0, 0]
         // 15° written with 4 decimals lies 1.17e-5 rad inside the fold
         // (15° − atan2(0.2588, 0.9659) = 0.000671°).
         let axis = unit(-0.2588, 0.0, 0.9659);
-        let gap = 15f64.to_radians() - angle_between(&Vector3::z(), &axis);
+        let gap = off_15_degrees(&axis);
         assert!(gap > 1e-5 && gap < 2e-5, "{gap}");
         let mut kin = Kinematics::new(&locked_head());
         assert_eq!(kin.axis_rounding(), AXIS_ROUNDING_RAD);
@@ -334,7 +340,7 @@ point = [0, 0, 0]
         // The locked head above with A locked too: C turns the 15° axis.
         let m = machine(&format!("{B_LOCKED_AT_15}{C_TABLE}"));
         let axis = unit(0.0, 0.2588195, 0.9659258);
-        let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
+        let gap = off_15_degrees(&axis).abs();
         assert!(gap > 1e-8 && gap < 1e-6, "{gap}");
         assert_nearest(&Kinematics::new(&m), axis, gap);
         assert!(solve(&Kinematics::new(&m), unit(0.0, 0.26, 0.9659258)).is_err());
@@ -344,7 +350,7 @@ point = [0, 0, 0]
     fn no_free_axis_takes_its_one_direction_within_rounding() {
         let m = machine(B_LOCKED_AT_15);
         let axis = unit(0.2588190, 0.0, 0.9659258);
-        let gap = (15f64.to_radians() - angle_between(&Vector3::z(), &axis)).abs();
+        let gap = off_15_degrees(&axis).abs();
         assert_nearest(&Kinematics::new(&m), axis, gap);
         assert!(solve(&Kinematics::new(&m), unit(0.2588, 0.0, 0.9659)).is_err());
     }
