@@ -470,11 +470,9 @@ impl<W: Write> NcWriter<W> {
         self.vars.insert("tool".into(), Value::from(name));
         self.vars.insert("tool_name".into(), Value::from(name));
         self.command(TemplateKind::ToolChange, Vec::new())?;
-        // The change moves the axes to where the machine changes tools: the
-        // next block states every axis again.
-        for w in &mut self.words {
-            w.known = false;
-        }
+        // The change moves the axes to where the machine changes tools, and
+        // its cycle may leave another motion mode and feed in force.
+        self.forget_modal_state();
         if tcp {
             self.tcp(true)?;
         }
@@ -681,7 +679,22 @@ impl<W: Write> NcWriter<W> {
         self.buf.clear();
         self.buf.extend_from_slice(text.as_bytes());
         self.buf.extend_from_slice(&self.eol);
-        Ok(self.out.write_all(&self.buf)?)
+        self.out.write_all(&self.buf)?;
+        // Its code may move the axes or switch motion mode and feed (a
+        // `G0 Z100` left the next feed block at rapid).
+        self.forget_modal_state();
+        Ok(())
+    }
+
+    /// After code the writer did not write itself (a tool change, an
+    /// `INSERT`): the next motion block states its motion word, every axis
+    /// word and its feed word again.
+    fn forget_modal_state(&mut self) {
+        for w in &mut self.words {
+            w.known = false;
+        }
+        self.motion_state = None;
+        self.last_feed = None;
     }
 
     /// The next block number, with prefix and separator, into `out`.

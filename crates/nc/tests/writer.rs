@@ -856,7 +856,7 @@ fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
 }
 
 #[test]
-fn after_a_tool_change_every_axis_is_written_again() {
+fn after_a_tool_change_the_motion_word_and_every_axis_are_written_again() {
     let dialect = Dialect::builtin("fanuc").unwrap();
     let axes = mts_axes();
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
@@ -879,7 +879,38 @@ fn after_a_tool_change_every_axis_is_written_again() {
     let out = text(w);
     assert_eq!(
         out,
-        "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nX459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
+        "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nG00 X459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
+    );
+}
+
+#[test]
+fn after_an_insert_the_next_block_states_motion_axes_and_feed() {
+    // The INSERT's code may switch to rapid and move: a feed block that
+    // relied on G01 and F being in force would run at rapid.
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
+    let block = |w: &mut NcWriter<Vec<u8>>, z: f64| {
+        let mut q = p;
+        q[3] = z;
+        w.block(&Block {
+            cl_line: None,
+            motion: Motion::Feed,
+            axes: &q,
+            feed: Some(500.0),
+        })
+        .unwrap();
+    };
+    block(&mut w, 380.0);
+    block(&mut w, 400.0);
+    w.insert("G00 Z450.").unwrap();
+    block(&mut w, 410.0);
+    block(&mut w, 420.0);
+    assert_eq!(
+        text(w),
+        "G01 X459.000 Y8.500 Z380.000 A-90.000 B10.250 F500.\nZ400.000\nG00 Z450.\n\
+         G01 X459.000 Y8.500 Z410.000 A-90.000 B10.250 F500.\nZ420.000\n"
     );
 }
 
