@@ -125,3 +125,24 @@ fn inverse_time_needs_a_dialect_that_can_switch() {
     .to_string();
     assert!(err.contains("no `inverse_time_on` template"), "{err}");
 }
+
+#[test]
+fn a_heidenhain_speed_change_under_tcpm_resets_it_around_its_tool_call() {
+    // The TNC refuses a TOOL CALL while FUNCTION TCPM is active.
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,500\nGOTO/0,0,10\nSPINDL/4000,RPM,CLW\nGOTO/10,0,10\n";
+    let nc = run("trunnion-ac", "heidenhain", OutputMode::Tcp, cl).unwrap();
+    let lines: Vec<&str> = nc
+        .lines()
+        .map(|l| l.split_once(' ').map_or(l, |(_, rest)| rest))
+        .collect();
+    let call = lines
+        .iter()
+        .position(|l| l.starts_with("TOOL CALL") && l.contains("S4000"))
+        .unwrap_or_else(|| panic!("no speed change\n{nc}"));
+    assert_eq!(lines[call - 1], "FUNCTION RESET TCPM", "\n{nc}");
+    assert_eq!(lines[call + 1], "M3", "\n{nc}");
+    assert!(lines[call + 2].starts_with("FUNCTION TCPM"), "\n{nc}");
+    // In joint output there is no TCPM to reset.
+    let joint = run("trunnion-ac", "heidenhain", OutputMode::Joint, cl).unwrap();
+    assert!(!joint.contains("TCPM"), "{joint}");
+}

@@ -164,7 +164,7 @@ pub struct ProgramInfo {
 impl ProgramInfo {
     /// The names every template gets from [`ProgramInfo::template_vars`]
     /// (each extra key too, but those depend on the caller).
-    pub const VARIABLES: [&'static str; 9] = [
+    pub const VARIABLES: [&'static str; 10] = [
         "program_name",
         "date",
         "machine",
@@ -174,11 +174,13 @@ impl ProgramInfo {
         "dialect",
         "axes",
         "extra",
+        "tcp",
     ];
 
     /// The template variables: `program_name`, `date`, `machine`, `tool`,
-    /// `tool_number`, `cl_file`, `dialect`, `axes` (list of names), `extra`
-    /// and every extra key.
+    /// `tool_number`, `cl_file`, `dialect`, `axes` (list of names), `extra`,
+    /// `tcp` (false here: the writer sets it while tool-centre-point
+    /// control is on) and every extra key.
     pub fn template_vars(&self, dialect: &str, axes: &[AxisSpec]) -> BTreeMap<String, Value> {
         let mut vars: BTreeMap<String, Value> = self
             .extra
@@ -195,6 +197,7 @@ impl ProgramInfo {
         put("tool_number", Value::from(self.tool_number));
         put("cl_file", Value::from(self.cl_file.as_str()));
         put("dialect", Value::from(dialect));
+        put("tcp", Value::from(false));
         put(
             "axes",
             Value::from(

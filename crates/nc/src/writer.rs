@@ -426,6 +426,7 @@ impl<W: Write> NcWriter<W> {
         override_template: Option<&str>,
     ) -> Result<(), NcError> {
         self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
+        self.vars.insert("tcp".into(), Value::from(self.tcp_on));
         if self.kind == DialectKind::Csv {
             self.csv_header()?;
             return Ok(());
@@ -446,6 +447,7 @@ impl<W: Write> NcWriter<W> {
         override_template: Option<&str>,
     ) -> Result<(), NcError> {
         self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
+        self.vars.insert("tcp".into(), Value::from(self.tcp_on));
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
@@ -515,6 +517,7 @@ impl<W: Write> NcWriter<W> {
     /// Tool-centre-point control on or off (templates `tcp_on`, `tcp_off`).
     pub fn tcp(&mut self, on: bool) -> Result<(), NcError> {
         self.tcp_on = on;
+        self.vars.insert("tcp".into(), Value::from(on));
         let kind = if on {
             TemplateKind::TcpOn
         } else {
