@@ -218,7 +218,9 @@ pub enum ClEvent {
     Coolant {
         /// False for `COOLNT/OFF`.
         on: bool,
-        /// The first word, upper case (`"ON"` for a bare `COOLNT`).
+        /// The first word other than `ON` and `OFF`, upper case (`"MIST"`
+        /// for `COOLNT/ON,MIST`); else the first word (`"ON"` for a bare
+        /// `COOLNT`).
         mode: String,
     },
     /// `INSERT/text`: the text after the first `/`, verbatim (trailing

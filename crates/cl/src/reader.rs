@@ -1172,9 +1172,16 @@ impl<R: BufRead> ClReader<R> {
             });
         };
         let on = !self.fields.iter().any(|&f| self.is(f, "OFF"));
+        // The mode is the first word that is not ON: `COOLNT/ON,MIST` is
+        // mist, as `COOLNT/MIST` is.
+        let mode = self
+            .fields
+            .iter()
+            .find(|&&f| !self.is(f, "ON") && !self.is(f, "OFF"))
+            .map_or(first, |&f| f);
         Ok(ClEvent::Coolant {
             on,
-            mode: self.field(first).to_ascii_uppercase(),
+            mode: self.field(mode).to_ascii_uppercase(),
         })
     }
 

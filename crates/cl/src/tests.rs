@@ -296,7 +296,7 @@ fn comments() {
 fn tools_spindle_coolant() {
     assert_eq!(
         events(
-            "LOAD/TOOL,1\nSELECT/ tool , 5.\nSPINDL/12000,RPM,CLW\nSPINDL/RPM,500,CCLW\nSPINDL/OFF\nSPINDL/ON\nCOOLNT/FLOOD\nCOOLNT/mist\nCOOLNT/OFF\nCOOLNT\n"
+            "LOAD/TOOL,1\nSELECT/ tool , 5.\nSPINDL/12000,RPM,CLW\nSPINDL/RPM,500,CCLW\nSPINDL/OFF\nSPINDL/ON\nCOOLNT/FLOOD\nCOOLNT/mist\nCOOLNT/OFF\nCOOLNT\nCOOLNT/ON,THRU\nCOOLNT/ON\n"
         ),
         vec![
             ClEvent::LoadTool { number: 1 },
@@ -325,6 +325,14 @@ fn tools_spindle_coolant() {
             ClEvent::Coolant {
                 on: false,
                 mode: "OFF".into()
+            },
+            ClEvent::Coolant {
+                on: true,
+                mode: "ON".into()
+            },
+            ClEvent::Coolant {
+                on: true,
+                mode: "THRU".into()
             },
             ClEvent::Coolant {
                 on: true,

@@ -70,3 +70,38 @@ fn insert_longer_than_the_controller_reads_names_the_cl_line() {
     assert!(d.message.contains("INSERT"), "{d}");
     assert!(d.message.contains("max_line_length of 253"), "{d}");
 }
+
+/// A coolant mode the dialect has no code for (through-spindle, air) is an
+/// error at its CL line in every built-in word dialect, not flood coolant;
+/// `COOLNT/ON,MIST` is mist.
+#[test]
+fn a_coolant_mode_without_a_code_stops_the_post_at_its_line() {
+    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nCOOLNT/AIR\nFEDRAT/300\nGOTO/0,0,10\n";
+    for name in ["sinumerik", "fanuc", "heidenhain", "linuxcnc"] {
+        let dialect = Dialect::builtin(name).unwrap();
+        let d = post_error(&dialect, cl);
+        assert_eq!((d.line, d.column), (3, 1), "{name}: {d:?}");
+        assert!(
+            d.message
+                .contains("coolant mode `air` has no code in this dialect"),
+            "{name}: {}",
+            d.message
+        );
+        let machine = builtin::load("trunnion-ac").unwrap().unwrap();
+        let mut out = Vec::new();
+        let mist = cl.replace("COOLNT/AIR", "COOLNT/ON,MIST");
+        post(
+            mist.as_bytes(),
+            &machine,
+            &dialect,
+            &mut out,
+            &PostOptions::default(),
+        )
+        .unwrap();
+        let nc = String::from_utf8(out).unwrap();
+        assert!(
+            nc.lines().any(|l| l.ends_with("M07") || l.ends_with("M7")),
+            "{name}\n{nc}"
+        );
+    }
+}

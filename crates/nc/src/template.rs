@@ -25,7 +25,18 @@ pub(crate) fn environment() -> Environment<'static> {
     env.add_filter("num", num);
     env.add_filter("name", name);
     env.add_filter("ascii", ascii);
+    env.add_function("fail", fail);
     env
+}
+
+/// `{{ fail("message") }}`: the template refuses its input with that
+/// message (a coolant mode the machine has no code for), and the post stops
+/// with it at the CL statement.
+fn fail(message: String) -> Result<Value, minijinja::Error> {
+    Err(minijinja::Error::new(
+        minijinja::ErrorKind::InvalidOperation,
+        message,
+    ))
 }
 
 /// `{{ text | ascii }}`: text for a controller that reads ASCII only (a
