@@ -572,7 +572,15 @@ impl<W: Write> Job<'_, W> {
                 ..derived
             };
             let out = self.out.take().expect("the output is taken once, here");
+            let feed_mode = self
+                .options
+                .feed_mode
+                .or(self.dialect.default_feed_mode().and_then(FeedMode::parse))
+                .unwrap_or_default();
             let mut writer = NcWriter::new(self.dialect, &axes, out);
+            if feed_mode == FeedMode::InverseTime {
+                writer.add_feed_mode_column();
+            }
             writer.header(
                 &self.info,
                 machine_template(self.machine, self.dialect, &self.machine.post.header),
@@ -583,11 +591,6 @@ impl<W: Write> Job<'_, W> {
             if tcp.is_some() {
                 writer.tcp(true)?;
             }
-            let feed_mode = self
-                .options
-                .feed_mode
-                .or(self.dialect.default_feed_mode().and_then(FeedMode::parse))
-                .unwrap_or_default();
             // (Inverse time is switched on by the emitter, at the first feed
             // block whose start is known.)
             if feed_mode == FeedMode::InverseTime

@@ -706,7 +706,7 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
     let feed_col = |csv: &str| -> Vec<f64> {
         csv.lines()
             .skip(1)
-            .map(|r| r.rsplit(',').next().unwrap().parse().unwrap_or(f64::NAN))
+            .map(|r| feed_field(csv, r).parse().unwrap_or(f64::NAN))
             .collect()
     };
     let f = feed_col(&csv);
@@ -776,7 +776,7 @@ fn a_block_that_turns_while_the_tool_point_barely_moves_takes_the_turning_time()
     ] {
         let csv = post_trunnion(cl, "csv", mode).unwrap();
         let last = csv.lines().last().unwrap();
-        let f: f64 = last.rsplit(',').next().unwrap().parse().unwrap();
+        let f: f64 = feed_field(&csv, last).parse().unwrap();
         assert!((f - want).abs() < 1e-5, "{mode:?}: {last}");
     }
 }
@@ -809,6 +809,44 @@ fn inverse_time_starts_where_the_start_is_known() {
         ],
         "{nc}"
     );
+}
+
+#[test]
+fn csv_says_which_feeds_are_inverse_time() {
+    // The same program in CSV: its feed column holds per-minute feeds where
+    // the start is unknown and inverse-time feeds elsewhere; a last column
+    // says which.
+    let cl = "FEDRAT/MMPM,100\nGOTO/0,0,50,0,0,1\nGOTO/0,0,10\nLOAD/TOOL,2\nGOTO/10,0,10\nGOTO/20,0,10\n";
+    let csv = post_trunnion(cl, "csv", kinpost::FeedMode::InverseTime).unwrap();
+    let rows: Vec<(&str, &str)> = csv
+        .lines()
+        .map(|l| {
+            let fields: Vec<&str> = l.split(',').collect();
+            (fields[fields.len() - 2], fields[fields.len() - 1])
+        })
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            ("feed", "feed_mode"),
+            ("100.000000", "per-minute"),
+            ("2.500000", "inverse-time"),
+            ("100.000000", "per-minute"),
+            ("10.000000", "inverse-time"),
+        ],
+        "{csv}"
+    );
+    // Read back as the CSV dialect reads it.
+    let m = kinpost::machine::builtin::load("trunnion-ac")
+        .unwrap()
+        .unwrap();
+    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let axes = kinpost::axis_specs(&m);
+    let program = kinpost::nc::read_program(&dialect, &axes, "job.csv", &csv).unwrap();
+    assert_eq!(program.len(), 4);
+    // Feed per minute: no such column.
+    let tip = post_trunnion(cl, "csv", kinpost::FeedMode::Tip).unwrap();
+    assert!(tip.starts_with("line,motion,X,Y,Z,A,C,feed\n"), "{tip}");
 }
 
 #[test]
@@ -1185,7 +1223,7 @@ fn inverse_time_feed_words_are_the_same_in_every_dialect() {
     let feeds: Vec<f64> = csv
         .lines()
         .skip(3) // header, the first block (per minute), its first move
-        .map(|r| r.rsplit(',').next().unwrap().parse().unwrap())
+        .map(|r| feed_field(&csv, r).parse().unwrap())
         .collect();
     assert_eq!(feeds.len(), 4);
     for f in &feeds {
@@ -1217,4 +1255,12 @@ fn inverse_time_feed_words_are_the_same_in_every_dialect() {
         "{}",
         w.message
     );
+}
+
+/// The `feed` field of a CSV row (found by the header: programs with
+/// inverse-time feeds have a `feed_mode` column after it).
+fn feed_field<'a>(csv: &str, row: &'a str) -> &'a str {
+    let header = csv.lines().next().unwrap();
+    let k = header.split(',').position(|c| c == "feed").unwrap();
+    row.split(',').nth(k).unwrap()
 }

@@ -380,6 +380,9 @@ fn read_csv(
         Motion,
         Axis(usize),
         Feed,
+        /// What the feed is (`per-minute`, `inverse-time`); read for its
+        /// syntax only.
+        FeedMode,
     }
     let mut columns: Option<Vec<Col>> = None;
     let column_of = |line: &str, field_index: usize| -> usize {
@@ -404,6 +407,7 @@ fn read_csv(
                     "line" => Col::Line,
                     "motion" => Col::Motion,
                     "feed" => Col::Feed,
+                    "feed_mode" => Col::FeedMode,
                     _ => match axes.iter().position(|a| a.name == name) {
                         Some(i) => Col::Axis(i),
                         None => {
@@ -478,6 +482,13 @@ fn read_csv(
                 Col::Feed => {
                     if !v.is_empty() {
                         block.feed = Some(csv_number(v).ok_or_else(|| bad("feed"))?);
+                    }
+                }
+                Col::FeedMode => {
+                    if !matches!(v, "" | "per-minute" | "inverse-time") {
+                        return Err(bad(
+                            "feed mode (expected `per-minute`, `inverse-time` or nothing)",
+                        ));
                     }
                 }
             }

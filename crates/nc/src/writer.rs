@@ -250,6 +250,11 @@ pub struct NcWriter<W: Write> {
     vars: BTreeMap<String, Value>,
     blocks: u64,
     csv_header_done: bool,
+    /// CSV: a last column `feed_mode` says what each feed row's feed is.
+    feed_mode_column: bool,
+    /// Inverse-time feed is on (between `inverse_time(true)` and
+    /// `inverse_time(false)`).
+    inverse_time_on: bool,
     /// Tool-centre-point control is on: a tool change turns it off first
     /// and on again for the new tool (its length).
     tcp_on: bool,
@@ -331,6 +336,9 @@ impl<W: Write> NcWriter<W> {
             + dialect.block.after_axes.len()
             + dialect.feed.rapid.len()
             + dialect.block.line_end.len()
+            // (and a CSV `feed_mode` field)
+            + sep.len()
+            + 16
             + 64;
         let vars = ProgramInfo::default().template_vars(&dialect.name, axes);
         NcWriter {
@@ -369,6 +377,8 @@ impl<W: Write> NcWriter<W> {
             vars,
             blocks: 0,
             csv_header_done: false,
+            feed_mode_column: false,
+            inverse_time_on: false,
             tcp_on: false,
         }
     }
@@ -526,11 +536,22 @@ impl<W: Write> NcWriter<W> {
         self.command(kind, Vec::new())
     }
 
+    /// CSV output of a program whose feed words change meaning (inverse
+    /// time, with the blocks from an unknown start per minute): a last
+    /// column `feed_mode` says, on every feed row, `inverse-time` or
+    /// `per-minute` (empty on rapid rows). Call before the header; nothing
+    /// for an NC dialect, whose `inverse_time_on`/`inverse_time_off` lines
+    /// say it.
+    pub fn add_feed_mode_column(&mut self) {
+        self.feed_mode_column = self.kind == DialectKind::Csv;
+    }
+
     /// Inverse-time feed on or off (templates `inverse_time_on`,
     /// `inverse_time_off`). While on, every feed block carries its feed word
     /// (inverse time is not modal): the caller passes 1 / block time in
     /// minutes as the block's feed.
     pub fn inverse_time(&mut self, on: bool) -> Result<(), NcError> {
+        self.inverse_time_on = on;
         let kind = if on {
             TemplateKind::InverseTimeOn
         } else {
@@ -1049,6 +1070,10 @@ impl<W: Write> NcWriter<W> {
         }
         self.buf.extend_from_slice(&self.sep);
         self.buf.extend_from_slice(b"feed");
+        if self.feed_mode_column {
+            self.buf.extend_from_slice(&self.sep);
+            self.buf.extend_from_slice(b"feed_mode");
+        }
         self.buf.extend_from_slice(&self.eol);
         self.out.write_all(&self.buf)
     }
@@ -1091,6 +1116,18 @@ impl<W: Write> NcWriter<W> {
                 Err(e) => return Err(self.bad_value(usize::MAX, f, e)),
             };
             len = put_word(&mut self.line.bytes, len, &self.feed, n, true);
+        }
+        if self.feed_mode_column {
+            len = put_text(&mut self.line.bytes, len, &self.sep);
+            if block.motion == Motion::Feed && block.feed.is_some() {
+                let mode: &[u8] = if self.inverse_time_on {
+                    b"inverse-time"
+                } else {
+                    b"per-minute"
+                };
+                self.line.bytes[len..len + mode.len()].copy_from_slice(mode);
+                len += mode.len();
+            }
         }
         len = put_text(&mut self.line.bytes, len, &self.eol);
         self.line.len = len;

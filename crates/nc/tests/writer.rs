@@ -717,6 +717,13 @@ fn csv_reader_errors_name_line_and_column() {
     assert_eq!((e.line, e.column), (1, 15));
     let e = read_program(&d, &axes, "p.csv", "line,motion,X,Y,feed\n1,fed,1,2,\n").unwrap_err();
     assert_eq!((e.line, e.column), (2, 3));
+    let head = "line,motion,X,Y,feed,feed_mode\n";
+    let ok = format!("{head}1,feed,1,2,5,inverse-time\n2,feed,1,3,100,per-minute\n3,rapid,1,4,,\n");
+    assert_eq!(read_program(&d, &axes, "p.csv", &ok).unwrap().len(), 3);
+    let bad = format!("{head}1,feed,1,2,5,inverse\n");
+    let e = read_program(&d, &axes, "p.csv", &bad).unwrap_err();
+    assert_eq!((e.line, e.column), (2, 14));
+    assert!(e.message.contains("feed mode"), "{}", e.message);
 }
 
 #[test]
