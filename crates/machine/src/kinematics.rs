@@ -957,7 +957,26 @@ impl Kinematics {
             *r = slot.range(a.in_degrees(), hint);
         }
         if self.solve_linear(&mut joints, &b.angles, point) {
-            self.push_equivalents::<N>(joints, &ranges, branch, (b.singular, b.nearest_axis), out);
+            self.push_equivalents::<N>(&joints, &ranges, branch, (b.singular, b.nearest_axis), out);
+        }
+    }
+
+    /// `to` with the free linear values of `from`, copied one by one: they
+    /// were just written one by one, and a wider load of them (a copy of the
+    /// whole array) would wait for those stores to retire.
+    #[inline(always)]
+    fn copy_linear(&self, from: &Joints, to: &mut Joints) {
+        match &self.linear_solve {
+            LinearSolve::Constant { axes, .. } => {
+                for &i in axes {
+                    to[i] = from[i];
+                }
+            }
+            LinearSolve::General => {
+                for &i in &self.free_lin {
+                    to[i] = from[i];
+                }
+            }
         }
     }
 
@@ -975,14 +994,25 @@ impl Kinematics {
         // values of locked axes are read from `self.fixed`, which `q`
         // starts as: `q` was just written, and reading it back in other
         // pieces than it was written in stalls the processor.)
-        let mut y = *target;
-        for step in &self.steps[..self.split] {
-            match step {
-                // Locked linear axes only: the split is at the first free one.
-                Step::Linear { axis, dir, .. } => y -= dir * self.fixed[*axis],
-                Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
+        // One rotary axis outside (a table) is read from `target` itself: a
+        // copy of it, stored in other pieces than the turn reads, stalls the
+        // processor.
+        let y = match &self.steps[..self.split] {
+            [] => *target,
+            [Step::Rotary(t)] => t.unmove_point(&turned(angles, t), target),
+            steps => {
+                let mut y = *target;
+                for step in steps {
+                    match step {
+                        // Locked linear axes only: the split is at the first
+                        // free one.
+                        Step::Linear { axis, dir, .. } => y -= dir * self.fixed[*axis],
+                        Step::Rotary(t) => y = t.unmove_point(&turned(angles, t), &y),
+                    }
+                }
+                y
             }
-        }
+        };
         let LinearSolve::Constant { rows, axes, .. } = &self.linear_solve else {
             return self.solve_linear_general(q, angles, &y);
         };
@@ -1079,19 +1109,19 @@ impl Kinematics {
     #[inline(always)]
     fn push_equivalents<const N: usize>(
         &self,
-        mut joints: Joints,
+        joints: &Joints,
         ranges: &[SlotRange; N],
         branch: u8,
         (singular, nearest_axis): (bool, bool),
         out: &mut Vec<Solution>,
     ) {
+        // Each solution is pushed with the locked values (`self.fixed`,
+        // written long ago), then its linear and rotary values are written
+        // in place (see `copy_linear`).
         if let Some(slot) = ranges.iter().position(|r| !r.has_equivalent()) {
             // No equivalent inside the limits: report the principal value.
-            for (s, r) in self.slots.iter().zip(ranges) {
-                joints[s.axis] = r.raw;
-            }
             out.push(Solution {
-                joints,
+                joints: self.fixed,
                 branch,
                 singular,
                 nearest_axis,
@@ -1100,23 +1130,27 @@ impl Kinematics {
                     value: ranges[slot].principal,
                 }),
             });
+            let pushed = &mut out.last_mut().expect("just pushed").joints;
+            self.copy_linear(joints, pushed);
+            for (s, r) in self.slots.iter().zip(ranges) {
+                pushed[s.axis] = r.raw;
+            }
             return;
         }
         // Linear axes: their values do not change between equivalents. A
         // branch outside the linear travel is given once.
-        let violation = self.linear_violation(&joints);
+        let violation = self.linear_violation(joints);
         let mut turn: [f64; N] = ranges.map(|r| r.first);
         loop {
-            // Pushed, then its rotary values written in place (not into
-            // `joints` and copied whole right after: see `solve_branch`).
             out.push(Solution {
-                joints,
+                joints: self.fixed,
                 branch,
                 singular,
                 nearest_axis,
                 violation,
             });
             let pushed = &mut out.last_mut().expect("just pushed").joints;
+            self.copy_linear(joints, pushed);
             for k in 0..N {
                 pushed[self.slots[k].axis] = ranges[k].principal + 360.0 * turn[k];
             }
