@@ -164,27 +164,22 @@ const SIGN: [f64; 256] = {
     sign
 };
 
-/// The length of the chunk [`plain_quotient`] reads: a sign, eight digits,
+/// The length of the chunk [`plain_number`] reads: a sign, eight digits,
 /// a point and the byte after the number.
 pub(crate) const PLAIN_CHUNK: usize = 11;
-
-/// A number as the quotient of its signed digits and a power of ten: `m /
-/// d` is its value, correctly rounded (Clinger's fast path, exact operands).
-/// The division is left to the caller so that those of several numbers go
-/// into the same instructions (`divpd`: two at a time).
-#[derive(Clone, Copy)]
-pub(crate) struct Quotient(pub f64, pub f64);
 
 /// [`scan_number`] for the shape CL files are made of: `[-+]?d*[.d*]` with
 /// at most 7 digits before the point and at most 8 digits in all, read a
 /// word at a time from a fixed-size chunk (so that no load needs a bounds
-/// check). Returns the number as a [`Quotient`] and its length, which is at
-/// most 10: `chunk[len]` is the byte after it. The caller must check that
-/// this byte is a separator, neither a digit (more digits), nor `.`, `e` or
-/// `E`: then the quotient is what [`scan_number`] gives. `None` for any
-/// other shape.
+/// check). Returns the number and its length, which is at most 10:
+/// `chunk[len]` is the byte after it. The caller must check that this byte
+/// is a separator, neither a digit (more digits), nor `.`, `e` or `E`: then
+/// the number is what [`scan_number`] gives. `None` for any other shape.
+///
+/// The number is the quotient of its signed digits and a power of ten,
+/// correctly rounded (Clinger's fast path, exact operands).
 #[inline(always)]
-pub(crate) fn plain_quotient(chunk: &[u8; PLAIN_CHUNK]) -> Option<(Quotient, usize)> {
+pub(crate) fn plain_number(chunk: &[u8; PLAIN_CHUNK]) -> Option<(f64, usize)> {
     let sign = chunk[0];
     let s = usize::from(sign == b'-' || sign == b'+');
     let word = load_word(chunk, s);
@@ -221,7 +216,7 @@ pub(crate) fn plain_quotient(chunk: &[u8; PLAIN_CHUNK]) -> Option<(Quotient, usi
     // as `str::parse` has it), without a branch on it, which is
     // unpredictable.
     let m = (mantissa as i64) as f64 * SIGN[usize::from(sign)];
-    Some((Quotient(m, POW10[(n - whole) & 15]), len))
+    Some((m / POW10[(n - whole) & 15], len))
 }
 
 /// The eight bytes at `chunk[i..]` (`i` is 0, 1 or 2), little-endian.
@@ -232,13 +227,13 @@ fn load_word(chunk: &[u8; PLAIN_CHUNK], i: usize) -> u64 {
     u64::from_le_bytes(word)
 }
 
-/// [`plain_quotient`] on `b[start..]`, divided: the value and the index just after the
+/// [`plain_number`] on `b[start..]`: the value and the index just after the
 /// number. `None` also if `b` has fewer than [`PLAIN_CHUNK`] bytes from
 /// `start` (pad the buffer).
 #[cfg(test)]
 fn scan_plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
-    let (Quotient(m, d), len) = plain_quotient(b.get(start..)?.first_chunk()?)?;
-    Some((m / d, start + len))
+    let (v, len) = plain_number(b.get(start..)?.first_chunk()?)?;
+    Some((v, start + len))
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@ use std::io::BufRead;
 
 use kinpost_diag::{Diagnostic, Severity};
 
-use crate::number::{PLAIN_CHUNK, Quotient, parse_number, plain_quotient, scan_number};
+use crate::number::{PLAIN_CHUNK, parse_number, plain_number, scan_number};
 use crate::words::suggest;
 use crate::{ClEvent, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units, Vec3};
 
@@ -1439,7 +1439,7 @@ fn trim_end_ascii(line: &[u8]) -> usize {
 }
 
 /// A plain `GOTO` line at the start of `buf`, the common case: `GOTO/`,
-/// then numbers [`plain_quotient`] takes, separated by commas, then the line
+/// then numbers [`plain_number`] takes, separated by commas, then the line
 /// end (`\n` or `\r\n`), nothing else (no blanks), all within
 /// [`GOTO_WINDOW`] bytes after `GOTO/`. Returns the number of values (at
 /// most 9, in `v`) and the length of the line without and with its line
@@ -1491,8 +1491,7 @@ fn plain_goto_window(
         separators |= bits << (8 * k);
     }
     let mut start = 0;
-    let mut quotients = [Quotient(0.0, 1.0); 9];
-    for (count, slot) in quotients.iter_mut().enumerate() {
+    for (count, slot) in v.iter_mut().enumerate() {
         if separators == 0 {
             return None; // no line end in the window
         }
@@ -1506,23 +1505,15 @@ fn plain_goto_window(
             _ => return None, // a blank, `$`, `+`, …: the general path reads it
         };
         let chunk = window[start..].first_chunk::<PLAIN_CHUNK>()?;
-        let (x, len) = plain_quotient(chunk)?;
+        // (Each number divided by its power of ten at once: quotients
+        // stored to be divided two at a time later were loaded in other
+        // pieces than they were stored in, which stalls the loads.)
+        let (x, len) = plain_number(chunk)?;
         if start + len != at {
             return None;
         }
         *slot = x;
         if line_end {
-            // The divisions, two at a time: six (the usual count), then
-            // the others if there are.
-            let divide = |v: &mut [f64], q: &[Quotient]| {
-                for (v, Quotient(m, d)) in v.iter_mut().zip(q) {
-                    *v = m / d;
-                }
-            };
-            divide(&mut v[..6], &quotients[..6]);
-            if count >= 6 {
-                divide(&mut v[6..], &quotients[6..]);
-            }
             return Some(PlainGoto {
                 count: count + 1,
                 end: at,

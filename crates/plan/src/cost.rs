@@ -5,7 +5,7 @@
 //! closed-form branch, for running close to a travel limit and for values
 //! the user does not prefer.
 
-use kinpost_machine::{Joints, MAX_AXES, Machine, Prefer, Wrap, wrap180};
+use kinpost_machine::{Joints, Machine, Prefer, Wrap, wrap180};
 
 /// Cost of switching the orientation branch between two points of a cut.
 const BRANCH_SWITCH: f64 = 1.0;
@@ -132,11 +132,6 @@ pub struct Costs {
     /// The rotary axes with a preference (in the order of `rotary`).
     preferring: Vec<Rotary>,
     limited: Vec<Limited>,
-    /// `limited` by axis index, for a quick test whether any axis is within
-    /// its margin (axes without limits: -inf, +inf, 0, never within).
-    lo: [f64; MAX_AXES],
-    hi: [f64; MAX_AXES],
-    margin: [f64; MAX_AXES],
     /// Largest rotary step per degree of tool-axis turn on a continuous
     /// path outside the singular cone: 1 / sin(cone).
     step_rate: f64,
@@ -176,14 +171,6 @@ impl Costs {
                 })
             })
             .collect::<Vec<Limited>>();
-        let mut lo = [f64::NEG_INFINITY; MAX_AXES];
-        let mut hi = [f64::INFINITY; MAX_AXES];
-        let mut margin = [0.0; MAX_AXES];
-        for l in &limited {
-            lo[l.index] = l.lo;
-            hi[l.index] = l.hi;
-            margin[l.index] = l.margin;
-        }
         // Outside the cone a rotary angle changes at most 1/sin(cone) times
         // as fast as the tool axis turns; a cone of zero (no pole handling)
         // still bounds the rate by that of a 0.1° cone.
@@ -192,9 +179,6 @@ impl Costs {
             rotary,
             preferring,
             limited,
-            lo,
-            hi,
-            margin,
             step_rate,
             singular_axis,
         }
@@ -217,12 +201,14 @@ impl Costs {
     /// and distance from the preferred values.
     pub fn unary(&self, q: &Joints) -> f64 {
         let mut cost = 0.0;
-        // min(a, b) < m exactly when a < m or b < m (min ignores one NaN;
-        // with both NaN neither holds): the same test for every axis at
-        // once, without branches, before the loop that adds.
+        // Whether any axis is within its margin, without branches, before
+        // the loop that adds. The axes with limits only, each value loaded on its own: `q` was
+        // just written value by value (the inverse kinematics), and a load
+        // of several at once would wait for those stores to retire.
         let mut near = false;
-        for (((&v, &lo), &hi), &m) in q.iter().zip(&self.lo).zip(&self.hi).zip(&self.margin) {
-            near |= (v - lo < m) | (hi - v < m);
+        for l in &self.limited {
+            let v = q[l.index];
+            near |= (v - l.lo < l.margin) | (l.hi - v < l.margin);
         }
         if near {
             cost = self.near_limits(q);
