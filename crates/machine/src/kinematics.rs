@@ -1390,8 +1390,13 @@ impl Slot {
             None => {
                 // The nearest turn lies within half a turn of the hint;
                 // the one beyond it too when that is within the reach.
+                // (A product, not a division: the hint comes from the
+                // planner's last point, and this is on the path from one
+                // point to the next. A quotient an ulp off can move `t` by
+                // one only where `d` is ±180°, and the turns chosen below
+                // are the same either way.)
                 let h = hint.map_or(0.0, |h| h[self.axis]);
-                let t = turns_nearest((h - principal) / 360.0);
+                let t = turns_nearest((h - principal) * (1.0 / 360.0));
                 let d = principal + 360.0 * t - h;
                 let below = d - 360.0 >= -ENDLESS_REACH_DEG;
                 let above = d + 360.0 <= ENDLESS_REACH_DEG;
