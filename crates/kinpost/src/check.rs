@@ -89,12 +89,31 @@ impl Tolerance {
     }
 }
 
-/// Position and tool-axis error of `got` against `want`.
+/// Position and orientation error of `got` against `want`: the angle
+/// between the tool axes, or between the reference directions if that is
+/// larger (both poses with one: 6-axis output).
 pub fn pose_error(want: &Pose, got: &Pose) -> (f64, f64) {
     (
         (want.point - got.point).norm(),
-        angle_between(&want.axis, &got.axis),
+        angle_between(&want.axis, &got.axis).max(reference_error(want, got)),
     )
+}
+
+/// The angle between the reference directions of `want` and `got`, each
+/// taken normal to its tool axis (the part of a CL reference along the tool
+/// axis says nothing: the inverse kinematics leaves it out too); 0 unless
+/// both have one.
+pub fn reference_error(want: &Pose, got: &Pose) -> f64 {
+    let (Some(a), Some(b)) = (&want.reference, &got.reference) else {
+        return 0.0;
+    };
+    let normal = |r: &nalgebra::Vector3<f64>, axis: &nalgebra::Vector3<f64>| r - axis * r.dot(axis);
+    let (a, b) = (normal(a, &want.axis), normal(b, &got.axis));
+    match (a.try_normalize(1e-12), b.try_normalize(1e-12)) {
+        (Some(a), Some(b)) => angle_between(&a, &b),
+        // A reference along the tool axis gives no direction to compare.
+        _ => 0.0,
+    }
 }
 
 /// Running maxima of the check.
@@ -121,8 +140,8 @@ impl CheckStats {
         }
         let sin = want.axis.cross(&got.axis).norm();
         let cos = want.axis.dot(&got.axis);
-        if cos <= 0.0 || sin > self.sin_max_axis {
-            let a = sin.atan2(cos);
+        if cos <= 0.0 || sin > self.sin_max_axis || want.reference.is_some() {
+            let a = sin.atan2(cos).max(reference_error(want, got));
             if a > self.max_axis_error_rad {
                 self.max_axis_error_rad = a;
                 self.sin_max_axis = if a < std::f64::consts::FRAC_PI_2 {
@@ -191,6 +210,36 @@ mod tests {
         assert_eq!(s.worst_line, Some(7));
         assert!(!s.record(&pose(0.0, 0.0), &pose(0.0, 2.5), 9, &tol));
         assert!((s.max_axis_error_rad - 2.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn six_axis_blocks_are_checked_on_their_reference_too() {
+        // The same point and tool axis, the reference turned 0.1 rad about
+        // the axis: an orientation error of 0.1 rad.
+        let pose = |r: Vector3<f64>| Pose {
+            point: Vector3::zeros(),
+            axis: Vector3::z(),
+            reference: Some(r),
+        };
+        let tol = Tolerance {
+            position_mm: 0.01,
+            axis_rad: 1e-3,
+        };
+        let turned = Vector3::new(0.1f64.cos(), 0.1f64.sin(), 0.0);
+        let mut s = CheckStats::default();
+        assert!(!s.record(&pose(Vector3::x()), &pose(turned), 3, &tol));
+        assert!((s.max_axis_error_rad - 0.1).abs() < 1e-12);
+        assert!((pose_error(&pose(Vector3::x()), &pose(turned)).1 - 0.1).abs() < 1e-12);
+        // A CL reference with a part along the tool axis points the same
+        // way once that part is left out, as the inverse kinematics has it.
+        let mut s = CheckStats::default();
+        let leaning = Vector3::new(1.0, 0.0, 0.3).normalize();
+        assert!(s.record(&pose(leaning), &pose(Vector3::x()), 4, &tol));
+        assert_eq!(s.max_axis_error_rad, 0.0);
+        // Without a reference on both sides there is nothing to compare.
+        let mut none = pose(Vector3::x());
+        none.reference = None;
+        assert_eq!(reference_error(&pose(turned), &none), 0.0);
     }
 
     #[test]

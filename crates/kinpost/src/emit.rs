@@ -16,7 +16,7 @@ use kinpost_nc::{Block, Motion, NcWriter};
 use kinpost_plan::STEP_CEILING_DEG;
 use nalgebra::Vector3;
 
-use crate::check::{CheckStats, Tolerance, angle_between, pose_error};
+use crate::check::{CheckStats, Tolerance, angle_between, pose_error, reference_error};
 use crate::post::{FeedMode, Pending, PostError, describe, write_pending};
 use crate::solve::{Hold, Near, interpolate, solve_near};
 use crate::summary::{FeedClamp, Planning, Reconfiguration};
@@ -731,7 +731,11 @@ impl<W: Write> Emitter<W> {
         }
         self.writer
             .quantize_axes(&values[..n], &mut self.written[..n]);
-        let (mut reached, written_lever) = kin.fk_lever(&self.written[..n], &mut self.sin_cos);
+        let (mut reached, written_lever) = kin.fk_lever(
+            &self.written[..n],
+            &mut self.sin_cos,
+            pose.reference.is_some(),
+        );
         // The lever at the exact values, from that at the written ones.
         let (w, v) = self.rounding_travel;
         let mut lever = lever_over(written_lever, w, v);
@@ -938,6 +942,7 @@ impl<W: Write> Emitter<W> {
             || gap > kin.axis_rounding()
             || (want.point - got.point).norm() > t.position_mm
             || angle_between(&nearest, &got.axis) > t.axis_rad
+            || reference_error(want, got) > t.axis_rad
         {
             return false;
         }

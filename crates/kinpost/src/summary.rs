@@ -17,7 +17,9 @@ pub struct Summary {
     pub max_position_error_mm: f64,
     /// CL line of the block with that largest position error.
     pub max_position_error_line: Option<usize>,
-    /// Largest angle between a block's tool axis and its CL axis, rad.
+    /// Largest angle between a block's tool axis and its CL axis (in
+    /// 6-axis output also between the reference directions, each normal to
+    /// its tool axis), rad.
     pub max_axis_error_rad: f64,
     /// The position tolerance the check used, mm.
     pub tolerance_mm: f64,

@@ -588,7 +588,7 @@ impl Kinematics {
     /// Forward kinematics: the tool pose in the part frame for NC values `q`
     /// (machine-file order; every axis, fixed ones included).
     pub fn fk(&self, q: &[f64]) -> Pose {
-        self.chain::<false>(q, |_, deg| sin_cos_deg(deg)).0
+        self.chain::<false>(q, true, |_, deg| sin_cos_deg(deg)).0
     }
 
     /// The forward kinematics, and with `LEVER` the largest distance from
@@ -599,6 +599,7 @@ impl Kinematics {
     fn chain<const LEVER: bool>(
         &self,
         q: &[f64],
+        with_reference: bool,
         mut sin_cos: impl FnMut(usize, f64) -> (f64, f64),
     ) -> (Pose, f64) {
         let mut point = self.tip;
@@ -607,7 +608,7 @@ impl Kinematics {
         let mut lever2: f64 = 0.0;
         // (A machine without a reference direction returns none: not
         // turned.)
-        let with_reference = self.r0.is_some();
+        let with_reference = with_reference && self.r0.is_some();
         for step in self.steps.iter().rev() {
             match step {
                 Step::Linear { axis: i, dir, .. } => point += dir * q[*i],
@@ -630,7 +631,7 @@ impl Kinematics {
         let pose = Pose {
             point,
             axis,
-            reference: self.r0.map(|_| reference),
+            reference: with_reference.then_some(reference),
         };
         (pose, if LEVER { lever2.sqrt() } else { 0.0 })
     }

@@ -258,8 +258,8 @@ proptest! {
             let mid: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.5 * (x + y)).collect();
             let (pa, pb, pm) = (reference_fk(&m, &a), reference_fk(&m, &b), reference_fk(&m, &mid));
             let deviation = (pm.point - 0.5 * (pa.point + pb.point)).norm();
-            let (_, lever_a) = kin.fk_lever(&a, &mut crate::angle::SinCosMemo::default());
-            let (_, lever_b) = kin.fk_lever(&b, &mut crate::angle::SinCosMemo::default());
+            let (_, lever_a) = kin.fk_lever(&a, &mut crate::angle::SinCosMemo::default(), false);
+            let (_, lever_b) = kin.fk_lever(&b, &mut crate::angle::SinCosMemo::default(), false);
             let (w, v) = kin.joint_travel(&a, &b);
             let bound = midpoint_bound(lever_a, w, v);
             prop_assert!(deviation <= bound + 1e-9, "{deviation} > {bound} (w {w}, v {v}, lever {lever_a})\n{m:?}");

@@ -55,9 +55,10 @@ impl Kinematics {
     /// its lever: the largest distance from the tool point to the reference
     /// point of a free rotary axis (0 without one). `memo` keeps the sines
     /// and cosines of the rotary values for the next call (a sequence of
-    /// blocks whose rotary values often repeat).
-    pub fn fk_lever(&self, q: &[f64], memo: &mut SinCosMemo) -> (Pose, f64) {
-        self.chain::<true>(q, |axis, deg| memo.sin_cos_deg(axis, deg))
+    /// blocks whose rotary values often repeat). The reference direction
+    /// only `with_reference` (else `None`: a 5-axis check has no use for it).
+    pub fn fk_lever(&self, q: &[f64], memo: &mut SinCosMemo, with_reference: bool) -> (Pose, f64) {
+        self.chain::<true>(q, with_reference, |axis, deg| memo.sin_cos_deg(axis, deg))
     }
 
     /// The travel of the straight joint motion from `a` to `b`: summed over
@@ -102,7 +103,7 @@ mod tests {
         let q = [459.0, 12.0, 8.8, 361.4, -17.0, 0.0];
         let mut memo = SinCosMemo::default();
         for q in [q, q, [459.0, 12.0, 8.8, 361.4, -17.5, 0.0], q] {
-            let (pose, lever) = kin.fk_lever(&q, &mut memo);
+            let (pose, lever) = kin.fk_lever(&q, &mut memo, true);
             let want = kin.fk(&q);
             let bits = |v: &nalgebra::Vector3<f64>| v.map(f64::to_bits);
             assert_eq!(bits(&pose.point), bits(&want.point));
