@@ -748,11 +748,21 @@ impl Kinematics {
         pose: &Pose,
         branches: &mut [Branch<N>; 2],
     ) -> Option<usize> {
-        let (sols, n) = self.sp2.solve_xy(&self.axis_to_sp2.apply(&pose.axis), 0.0);
+        let q = self.axis_to_sp2.apply(&pose.axis);
+        let (sols, n) = self.sp2.solve_xy(&q, 0.0);
+        let lengths = self.sp2.xy_lengths(&q);
         for (b, s) in branches.iter_mut().zip(&sols[..n]) {
             let ((x1, y1), (x2, y2)) = (s.theta1?, s.theta2?);
-            b.angles[0] = SlotAngle::from_xy(x1, y1);
-            b.angles[1] = SlotAngle::from_xy(x2, y2);
+            match lengths {
+                Some([r1, r2]) => {
+                    b.angles[0] = SlotAngle::from_xy_length(x1, y1, r1);
+                    b.angles[1] = SlotAngle::from_xy_length(x2, y2, r2);
+                }
+                None => {
+                    b.angles[0] = SlotAngle::from_xy(x1, y1);
+                    b.angles[1] = SlotAngle::from_xy(x2, y2);
+                }
+            }
         }
         (n > 0).then_some(n)
     }
@@ -1285,6 +1295,18 @@ impl SlotAngle {
         SlotAngle {
             cos,
             sin,
+            x,
+            y,
+            degrees: f64::NAN,
+        }
+    }
+
+    /// [`SlotAngle::from_xy`] with the length of `(x, y)` known.
+    #[inline]
+    fn from_xy_length(x: f64, y: f64, length: f64) -> SlotAngle {
+        SlotAngle {
+            cos: x / length,
+            sin: y / length,
             x,
             y,
             degrees: f64::NAN,

@@ -316,6 +316,26 @@ impl Sp2 {
         }
     }
 
+    /// For axes along coordinate axes, the lengths of the two `(x, y)` of
+    /// [`Sp2::solve_xy`] (the same for both solutions): `|θ1| =
+    /// √((b² + g²)(q_j² + q_k²))` and `|θ2| = √((p_i² + p_k²)(a² + g²))`,
+    /// their components being the products of those pairs. They need
+    /// neither `g`'s square root nor `(x, y)` itself, so that `(x, y)` turned
+    /// into a cosine and sine does not wait for two square roots in a row.
+    /// `None` for other axes.
+    #[inline(always)]
+    pub fn xy_lengths(&self, q: &Vector3<f64>) -> Option<[f64; 2]> {
+        let al = self.aligned.as_ref()?;
+        let a = al.s1 * q[al.i];
+        let b = self.w2p;
+        let g2 = (self.p2 - a * a - b * b).max(0.0);
+        let (qj, qk) = (q[al.j], q[al.k]);
+        Some([
+            ((b * b + g2) * (qj * qj + qk * qk)).sqrt(),
+            ((al.po_i * al.po_i + al.po_k * al.po_k) * (a * a + g2)).sqrt(),
+        ])
+    }
+
     /// The angles for the intersection point `z = a·w1 + b·w2 + g·(w1 × w2)`.
     #[inline(always)]
     fn at(&self, a: f64, b: f64, g: f64, q_off_w1: &Vector3<f64>, q_on_w1: bool) -> Sp2Xy {
@@ -441,7 +461,19 @@ mod tests {
             };
             let sp2 = Sp2::new(&w1, &w2, &p);
             prop_assert!(sp2.aligned.is_some());
-            prop_assert_eq!(sp2.solve_xy(&q, 1e-12), sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
+            let (sols, n) = sp2.solve_xy(&q, 1e-12);
+            prop_assert_eq!((sols, n), sp2_from_scratch(&w1, &w2, &p, &q, 1e-12));
+            // The lengths known in closed form are those of the solutions,
+            // within rounding (relative to the unit scale of p and q).
+            let lengths = sp2.xy_lengths(&q).unwrap();
+            for s in &sols[..n] {
+                for (xy, length) in [s.theta1, s.theta2].iter().zip(lengths) {
+                    if let Some((x, y)) = xy {
+                        let r = (x * x + y * y).sqrt();
+                        prop_assert!((r - length).abs() <= 1e-15, "{} vs {}", r, length);
+                    }
+                }
+            }
         }
 
         #[test]
