@@ -862,27 +862,27 @@ fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
     );
 }
 
+/// A block on the mts1600 axes with Z at `z` (feed blocks at F500).
+fn z_block(w: &mut NcWriter<Vec<u8>>, motion: Motion, z: f64) {
+    let q = [459.0, -90.0, 8.5, z, 10.25, 0.0];
+    w.block(&Block {
+        cl_line: None,
+        motion,
+        axes: &q,
+        feed: (motion == Motion::Feed).then_some(500.0),
+    })
+    .unwrap();
+}
+
 #[test]
 fn after_a_tool_change_the_motion_word_and_every_axis_are_written_again() {
     let dialect = Dialect::builtin("fanuc").unwrap();
     let axes = mts_axes();
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
-    let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
-    let block = |w: &mut NcWriter<Vec<u8>>, z: f64| {
-        let mut q = p;
-        q[3] = z;
-        w.block(&Block {
-            cl_line: None,
-            motion: Motion::Rapid,
-            axes: &q,
-            feed: None,
-        })
-        .unwrap();
-    };
-    block(&mut w, 380.0);
-    block(&mut w, 400.0);
+    z_block(&mut w, Motion::Rapid, 380.0);
+    z_block(&mut w, Motion::Rapid, 400.0);
     w.tool_change(2, "T2").unwrap();
-    block(&mut w, 400.0);
+    z_block(&mut w, Motion::Rapid, 400.0);
     let out = text(w);
     assert_eq!(
         out,
@@ -897,23 +897,13 @@ fn after_an_insert_the_next_block_states_motion_axes_and_feed() {
     let dialect = Dialect::builtin("fanuc").unwrap();
     let axes = mts_axes();
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
-    let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
-    let block = |w: &mut NcWriter<Vec<u8>>, z: f64| {
-        let mut q = p;
-        q[3] = z;
-        w.block(&Block {
-            cl_line: None,
-            motion: Motion::Feed,
-            axes: &q,
-            feed: Some(500.0),
-        })
-        .unwrap();
-    };
-    block(&mut w, 380.0);
-    block(&mut w, 400.0);
+    for z in [380.0, 400.0] {
+        z_block(&mut w, Motion::Feed, z);
+    }
     w.insert("G00 Z450.").unwrap();
-    block(&mut w, 410.0);
-    block(&mut w, 420.0);
+    for z in [410.0, 420.0] {
+        z_block(&mut w, Motion::Feed, z);
+    }
     assert_eq!(
         text(w),
         "G01 X459.000 Y8.500 Z380.000 A-90.000 B10.250 F500.\nZ400.000\nG00 Z450.\n\
