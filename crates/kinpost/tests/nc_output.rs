@@ -16,13 +16,20 @@ fn dialect_with(name: &str, key: &str, line: &str) -> Dialect {
     Dialect::from_toml(&edited.join("\n"), "edited.toml").unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn post_error(dialect: &Dialect, cl: &str) -> kinpost::nc::Diagnostic {
+/// `cl` posted on `trunnion-ac` in `dialect`: the program.
+fn post_on_trunnion(dialect: &Dialect, cl: &str) -> Result<String, PostError> {
     let machine = builtin::load("trunnion-ac").unwrap().unwrap();
     let options = PostOptions {
         cl_file: "job.cls".into(),
         ..PostOptions::default()
     };
-    match post(cl.as_bytes(), &machine, dialect, Vec::new(), &options) {
+    let mut out = Vec::new();
+    post(cl.as_bytes(), &machine, dialect, &mut out, &options)?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+fn post_error(dialect: &Dialect, cl: &str) -> kinpost::nc::Diagnostic {
+    match post_on_trunnion(dialect, cl) {
         Err(PostError::Input(d)) => *d,
         Err(e) => panic!("not an input error: {e}"),
         Ok(_) => panic!("posted"),
@@ -87,18 +94,8 @@ fn a_coolant_mode_without_a_code_stops_the_post_at_its_line() {
             "{name}: {}",
             d.message
         );
-        let machine = builtin::load("trunnion-ac").unwrap().unwrap();
-        let mut out = Vec::new();
         let mist = cl.replace("COOLNT/AIR", "COOLNT/ON,MIST");
-        post(
-            mist.as_bytes(),
-            &machine,
-            &dialect,
-            &mut out,
-            &PostOptions::default(),
-        )
-        .unwrap();
-        let nc = String::from_utf8(out).unwrap();
+        let nc = post_on_trunnion(&dialect, &mist).unwrap();
         assert!(
             nc.lines().any(|l| l.ends_with("M07") || l.ends_with("M7")),
             "{name}\n{nc}"

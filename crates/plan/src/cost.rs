@@ -202,9 +202,10 @@ impl Costs {
     pub fn unary(&self, q: &Joints) -> f64 {
         let mut cost = 0.0;
         // Whether any axis is within its margin, without branches, before
-        // the loop that adds. The axes with limits only, each value loaded on its own: `q` was
-        // just written value by value (the inverse kinematics), and a load
-        // of several at once would wait for those stores to retire.
+        // the loop that adds. The axes with limits only, each value loaded
+        // on its own: `q` was just written value by value (the inverse
+        // kinematics), and a load of several at once would wait for those
+        // stores to retire.
         let mut near = false;
         for l in &self.limited {
             let v = q[l.index];
