@@ -443,15 +443,20 @@ impl<W: Write> Emitter<W> {
             let mut nodes = std::mem::take(&mut self.pieces);
             nodes.clear();
             let mut off: f64 = 0.0;
+            let held_ends = a.hold.is_some() || b.hold.is_some();
             for k in 1..pieces as u32 {
                 match self.node_at(kin, a, b, f64::from(k) / pieces) {
-                    Ok((m, false, m_off)) => {
+                    Ok((m, false, m_off)) if m.hold.is_some() == held_ends => {
                         nodes.push(m);
                         off = off.max(m_off);
                     }
-                    // An interpolated tool axis the machine cannot point, or
-                    // a node it cannot reach: halving decides, as it does
-                    // for shorter segments.
+                    // An interpolated tool axis the machine cannot point, a
+                    // node it cannot reach, or one in the singular cone
+                    // between ends outside it (its angle held beside
+                    // exact ones that swing round the pole): halving
+                    // decides, as it does for shorter segments. (Halving
+                    // holds the angle of every node of a half with a held
+                    // end.)
                     _ => break,
                 }
             }

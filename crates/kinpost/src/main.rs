@@ -175,8 +175,9 @@ struct PostArgs {
     #[arg(long, value_name = "MM", default_value_t = kinpost::DEFAULT_LINTOL_MM)]
     lintol: f64,
     /// Half-angle in degrees of the cone around a singular tool-axis
-    /// direction inside which the free rotary angle is held (default: the
-    /// machine's `[post] singular_cone`, else 0.5).
+    /// direction inside which the free rotary angle is held where the exact
+    /// one would swing (default: the machine's `[post] singular_cone`, else
+    /// 0.5).
     #[arg(long, value_name = "DEG")]
     singular_cone: Option<f64>,
     /// Retract distance along the tool axis for a reconfiguration, mm

@@ -3,9 +3,11 @@
 //! order, until the planner decides (every `lag` points and at the end).
 //!
 //! Points whose tool axis lies within the singular cone are not planned by
-//! the trellis: their singular angle is interpolated between the decided
-//! points around them in the same segment (held at the one there is, if
-//! only one), and the other axes are solved for it exactly.
+//! the trellis. Between the decided points around them, they are solved
+//! exactly where no rotary axis then moves faster than a cut allows
+//! (see [`PathPlan::exact_run`]); elsewhere their singular angle is
+//! interpolated between those points in the same segment (held at the one
+//! there is, if only one), and the other axes are solved for it exactly.
 
 use std::io::Write;
 use std::ops::Range;
@@ -440,9 +442,11 @@ impl PathPlan {
         Ok(())
     }
 
-    /// Holds the singular angle over the waiting points `run` and solves
-    /// them, into `self.run`. The point before is the last one written;
-    /// `next` is the choice of the planned point after the run, if any.
+    /// Solves the waiting points `run` of the singular cone, into
+    /// `self.run`: exactly if that needs no swing ([`PathPlan::exact_run`]),
+    /// else with the singular angle held. The point before is the last one
+    /// written; `next` is the choice of the planned point after the run, if
+    /// any.
     fn fill_run(
         &mut self,
         kin: &mut Kinematics,
@@ -481,12 +485,22 @@ impl PathPlan {
                 (v, v)
             }
         };
+        if self.exact_run(
+            kin,
+            wheel,
+            run.clone(),
+            before.as_ref(),
+            after.as_ref(),
+            &anchor,
+        ) {
+            return Ok(());
+        }
         // Interpolate by distance along the CL path from the point before
         // to the point after (by count where it does not move).
         let mut lengths = Vec::with_capacity(run.len() + 1);
         let mut total = 0.0;
         let mut previous = before.map(|b| b.pose.point);
-        for p in &points[run.clone()] {
+        for p in &self.points[run.clone()] {
             let p = p.pose.point;
             total += previous.map_or(0.0, |q| (p - q).norm());
             lengths.push(total);
@@ -497,8 +511,6 @@ impl PathPlan {
         }
         let count = run.len() + usize::from(after.is_some());
         let mut guess = before.map_or(anchor, |b| b.joints);
-        let mut deviation: f64 = 0.0;
-        let mut held_values = (f64::NAN, f64::NAN);
         self.run.clear();
         for (j, k) in run.clone().enumerate() {
             let p = &self.points[k];
@@ -537,28 +549,112 @@ impl PathPlan {
                     ),
                 ));
             };
-            deviation = deviation.max(angle_between(&pose.axis, &p.pose.axis));
-            if j == 0 {
-                held_values.0 = axis.map_or(0.0, |i| sol.joints[i]);
-            }
-            held_values.1 = axis.map_or(0.0, |i| sol.joints[i]);
             guess = sol.joints;
             self.run.push(Decided {
                 node: Node::solved(pose, &sol, hold),
                 continuous: true,
             });
         }
-        if let Some(i) = axis {
-            self.stretches.push(SingularStretch {
-                first_line: self.points[run.start].line,
-                last_line: self.points[run.end - 1].line,
-                axis: self.names[i].clone(),
-                from_deg: held_values.0,
-                to_deg: held_values.1,
-                max_axis_deviation_deg: deviation.to_degrees(),
+        self.record_stretch(run);
+        Ok(())
+    }
+
+    /// The run solved exactly, into `self.run`, when that needs no swing:
+    /// each point at the solution nearest the one before, every rotary axis
+    /// moving from point to point (from the point before the run, and into
+    /// the point after it) by no more than a cut allows for the turn of the
+    /// tool axis ([`Costs::step_bound`], the rate at the edge of the
+    /// singular cone). A path that comes into the cone without passing
+    /// close by the pole is then written as the CL has it, with no tool
+    /// axis held off. `false` (nothing solved) where the exact angle would
+    /// swing: there the angle is held (see [`PathPlan::fill_run`]). A point
+    /// exactly on the singular direction takes the angle of the point
+    /// before (free there), and its run is reported as a stretch held at
+    /// that angle.
+    fn exact_run(
+        &mut self,
+        kin: &mut Kinematics,
+        wheel: &mut Option<Wheel>,
+        run: Range<usize>,
+        before: Option<&Node>,
+        after: Option<&Node>,
+        anchor: &Joints,
+    ) -> bool {
+        let costs = self.trellis.costs();
+        let rotary = &self.rotary;
+        let within = |a: &Joints, a_pose: &Pose, b: &Joints, b_pose: &Pose| {
+            let mut turn = angle_between(&a_pose.axis, &b_pose.axis);
+            if let (Some(ra), Some(rb)) = (&a_pose.reference, &b_pose.reference) {
+                turn = turn.max(angle_between(ra, rb));
+            }
+            let bound = costs.step_bound(turn.to_degrees());
+            rotary.iter().all(|&i| (b[i] - a[i]).abs() <= bound)
+        };
+        self.run.clear();
+        let mut last: Option<(Joints, Pose)> = before.map(|b| (b.joints, b.pose));
+        let mut singular = false;
+        for k in run.clone() {
+            let p = &self.points[k];
+            select(kin, wheel, p.pressure);
+            let near = Near {
+                joints: last.as_ref().map_or(anchor, |(j, _)| j),
+                hold: None,
+                branch: None,
+            };
+            let Some((pose, sol)) = solve_near(kin, &p.pose, &near, rotary, &mut self.solutions)
+            else {
+                self.run.clear();
+                return false;
+            };
+            if sol.nearest_axis
+                || last
+                    .as_ref()
+                    .is_some_and(|(j, q)| !within(j, q, &sol.joints, &p.pose))
+            {
+                self.run.clear();
+                return false;
+            }
+            singular |= sol.singular;
+            last = Some((sol.joints, p.pose));
+            self.run.push(Decided {
+                node: Node::solved(pose, &sol, None),
+                continuous: true,
             });
         }
-        Ok(())
+        if let (Some(a), Some((j, q))) = (after, &last)
+            && !within(j, q, &a.joints, &a.pose)
+        {
+            self.run.clear();
+            return false;
+        }
+        if singular {
+            self.record_stretch(run);
+        }
+        true
+    }
+
+    /// Reports the run solved in `self.run` as a singular stretch: the
+    /// singular angle at its ends, and how far its tool axes lie from the
+    /// CL's.
+    fn record_stretch(&mut self, run: Range<usize>) {
+        let Some(i) = self.singularity.map(|s| s.axis) else {
+            return;
+        };
+        let value = |d: &Decided| d.node.joints[i];
+        let deviation = self
+            .run
+            .iter()
+            .zip(&self.points[run.clone()])
+            .map(|(d, p)| angle_between(&d.node.pose.axis, &p.pose.axis))
+            .fold(0.0, f64::max);
+        self.stretches.push(SingularStretch {
+            first_line: self.points[run.start].line,
+            last_line: self.points[run.end - 1].line,
+            axis: self.names[i].clone(),
+            from_deg: self.run.first().map_or(f64::NAN, value),
+            to_deg: self.run.last().map_or(f64::NAN, value),
+            max_axis_deviation_deg: deviation.to_degrees(),
+        });
     }
 
     /// An error diagnostic at a waiting point's CL line.

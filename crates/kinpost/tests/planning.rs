@@ -182,6 +182,56 @@ fn near_the_pole_c_turns_no_more_than_the_pass_needs() {
     }
 }
 
+/// The tool axis tilts towards the pole 0.45° beside it, turns at 0.46°
+/// from it (inside the 0.5° cone) and tilts away at right angles: the
+/// exact C turns by 41° and then 6.5° while the tool axis turns by 0.5°,
+/// no faster than at the edge of the cone (0.5° / sin 0.5° = 57°). The
+/// corner is written as the CL has it, not with C held between its
+/// neighbours (which put its tool axis 0.13° off).
+#[test]
+fn a_point_in_the_cone_whose_exact_angle_does_not_swing_is_not_held() {
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let kin = Kinematics::new(&m);
+    let ic = m.axis_index("C").unwrap();
+    // (Tilts about Y and X in degrees, as in `pole_pass`.)
+    let tilts = (0..=40)
+        .map(|k| (20.1 - 0.5 * f64::from(k), 0.45))
+        .chain((1..=40).map(|k| (0.1, 0.45 + 0.5 * f64::from(k))));
+    let mut cl = String::from("FEDRAT/MMPM,1000\nRAPID\n");
+    let mut axes = Vec::new();
+    for (k, (x, y)) in tilts.enumerate() {
+        let (x, y) = (x.to_radians(), y.to_radians());
+        let axis = Vector3::new(x.sin() * y.cos(), y.sin(), x.cos() * y.cos()).normalize();
+        cl.push_str(&goto(&Vector3::new(-40.0 + k as f64, 15.0, 5.0), &axis));
+        axes.push(axis);
+    }
+    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    assert!(summary.planning.reconfigurations.is_empty());
+    assert!(
+        summary.planning.singular_stretches.is_empty(),
+        "{:?}",
+        summary.planning.singular_stretches
+    );
+    let cl_rows: Vec<_> = rows(&csv, m.axes.len())
+        .into_iter()
+        .filter(|r| r.0.is_some())
+        .collect();
+    assert_eq!(cl_rows.len(), axes.len());
+    for (k, row) in cl_rows.iter().enumerate() {
+        let angle = kin.fk(&row.2).axis.angle(&axes[k]);
+        assert!(
+            angle <= summary.tolerance_rad,
+            "line {:?}: the tool axis {angle} rad off",
+            row.0
+        );
+    }
+    let steps: Vec<f64> = cl_rows
+        .windows(2)
+        .map(|w| (w[1].2[ic] - w[0].2[ic]).abs())
+        .collect();
+    assert!(steps.iter().all(|&s| s < 57.0), "{steps:?}");
+}
+
 /// One feed move whose tool axis swings by 40° about X and passes the pole
 /// of `head-head-bc` (its C axis, +Z) 0.59° away, outside the 0.5° cone:
 /// the branch stays (B keeps its sign) and C turns through the pass, one
@@ -988,6 +1038,18 @@ fn posts_fold_fixture(machine: &str, cl: &str, points: usize) -> Summary {
     let all = rows(&csv, m.axes.len());
     assert_eq!(all.iter().filter(|r| r.0.is_some()).count(), points);
     summary
+}
+
+/// Between its last two points the tool axis passes the singular cone,
+/// their C angles 49° apart. The linearization cuts such a segment into
+/// equal pieces at once, but a piece's node in the cone holds C (at the
+/// joint-space interpolation) beside nodes outside it whose exact C swings
+/// round the pole: halving decides there, holding C over every half with a
+/// held end. (Cut into pieces, the segment did not converge.)
+#[test]
+fn a_segment_through_the_singular_cone_is_halved_not_cut_into_pieces() {
+    let summary = posts_fold_fixture("random-tt.toml", "pole-pieces.cls", 23);
+    assert!(summary.planning.inserted_blocks > 100);
 }
 
 /// Between CL lines 13 and 14 the tool axis passes within 0.0003° of a fold

@@ -67,7 +67,7 @@ impl CutRule {
         fold_deg: f64,
         across_fold: bool,
     ) -> CutLimits {
-        let bound = (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
+        let bound = step_bound(turn_deg, self.step_rate) + fold_deg;
         let switching = if across_singular || across_fold {
             bound
         } else {
@@ -83,6 +83,13 @@ impl CutRule {
         }
         CutLimits { same, switch }
     }
+}
+
+/// The largest rotary step of a cut on one branch while the tool axis
+/// turns by `turn_deg` (see [`Costs::step_bound`]).
+#[inline(always)]
+fn step_bound(turn_deg: f64, step_rate: f64) -> f64 {
+    (turn_deg * step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG)
 }
 
 /// How two consecutive points are connected.
@@ -251,6 +258,14 @@ impl Costs {
         })
     }
 
+    /// The largest step of any rotary axis between two points of a cut on
+    /// one branch, away from folds, while the tool axis turns by `turn_deg`:
+    /// the turn times 1/sin(cone) (how fast an angle turns at the edge of
+    /// the singular cone), at least 1° and less than half a turn.
+    pub fn step_bound(&self, turn_deg: f64) -> f64 {
+        step_bound(turn_deg, self.step_rate)
+    }
+
     /// Cost of moving from `a` (branch `ba`) to `b` (branch `bb`) and whether
     /// the move is continuous (a cut may follow it without lifting the tool).
     pub fn transition(&self, a: &Joints, ba: u8, b: &Joints, bb: u8, link: Link) -> (f64, bool) {
@@ -282,8 +297,7 @@ impl Costs {
                 // the folds (the edges of the reachable directions of axes
                 // at other angles, `across_fold`): a switch elsewhere is a
                 // flip.
-                let bound =
-                    (turn_deg * self.step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG) + fold_deg;
+                let bound = self.step_bound(turn_deg) + fold_deg;
                 let switch = ba != bb;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();

@@ -12,9 +12,9 @@
 //! posts do.
 //!
 //! Points whose tool axis lies within the singular cone are not candidates
-//! here: the caller holds the singular angle there (interpolating it between
-//! the decided neighbours) and links the neighbours with
-//! `across_singular`.
+//! here: the caller solves them between the decided neighbours (exactly
+//! where no axis swings, else with the singular angle held and
+//! interpolated) and links the neighbours with `across_singular`.
 
 mod cost;
 mod trellis;
