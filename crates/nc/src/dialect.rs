@@ -214,6 +214,21 @@ impl TemplateKind {
         }
     }
 
+    /// A template written for a CL statement between motion blocks (not
+    /// the header or footer, nor a switch of tool-centre-point control or
+    /// inverse time): one `outside_tcp` may name.
+    pub fn is_command(self) -> bool {
+        matches!(
+            self,
+            TemplateKind::ToolChange
+                | TemplateKind::SpindleOn
+                | TemplateKind::SpindleOff
+                | TemplateKind::CoolantOn
+                | TemplateKind::CoolantOff
+                | TemplateKind::Pressure
+        )
+    }
+
     /// The key in `[templates]`.
     pub fn key(self) -> &'static str {
         match self {
@@ -253,6 +268,9 @@ pub struct Dialect {
     pub(crate) numbering: Numbering,
     pub(crate) comment: CommentSyntax,
     templates: BTreeMap<TemplateKind, String>,
+    /// The templates written with tool-centre-point control off (`tcp_off`
+    /// before, `tcp_on` after, while it is on).
+    pub(crate) outside_tcp: Vec<TemplateKind>,
     pub(crate) env: Arc<Environment<'static>>,
 }
 
@@ -487,6 +505,36 @@ impl Dialect {
             templates.insert(kind_t, t.get_ref().clone());
         }
 
+        // A tool change moves the axes, and takes the new tool's length:
+        // outside tool-centre-point control unless the file says otherwise.
+        let mut outside_tcp = Vec::new();
+        match &raw.templates.outside_tcp {
+            None => outside_tcp.push(TemplateKind::ToolChange),
+            Some(names) => {
+                for name in names {
+                    match TemplateKind::ALL
+                        .into_iter()
+                        .find(|k| k.key() == name.get_ref())
+                    {
+                        Some(k) if k.is_command() => outside_tcp.push(k),
+                        _ => err(
+                            name.span(),
+                            format!(
+                                "`templates.outside_tcp`: `{}` is not a command template (one of {})",
+                                name.get_ref(),
+                                TemplateKind::ALL
+                                    .into_iter()
+                                    .filter(|k| k.is_command())
+                                    .map(TemplateKind::key)
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        ),
+                    }
+                }
+            }
+        }
+
         let motion = MotionWords {
             rapid: raw.motion.rapid,
             feed: raw.motion.feed,
@@ -593,6 +641,7 @@ impl Dialect {
                 ascii: raw.comment.ascii,
             },
             templates,
+            outside_tcp,
             env: Arc::new(env),
         })
     }
@@ -1193,6 +1242,7 @@ struct RawTemplates {
     tcp_off: Option<Spanned<String>>,
     inverse_time_on: Option<Spanned<String>>,
     inverse_time_off: Option<Spanned<String>>,
+    outside_tcp: Option<Vec<Spanned<String>>>,
 }
 
 impl RawTemplates {

@@ -258,6 +258,9 @@ pub struct NcWriter<W: Write> {
     /// Tool-centre-point control is on: a tool change turns it off first
     /// and on again for the new tool (its length).
     tcp_on: bool,
+    /// The templates written with tool-centre-point control off
+    /// ([`Dialect`]'s `templates.outside_tcp`).
+    outside_tcp: Vec<TemplateKind>,
 }
 
 /// The pressure word: its format and state (modal), and whether the
@@ -380,6 +383,7 @@ impl<W: Write> NcWriter<W> {
             feed_mode_column: false,
             inverse_time_on: false,
             tcp_on: false,
+            outside_tcp: dialect.outside_tcp.clone(),
         }
     }
 
@@ -472,12 +476,9 @@ impl<W: Write> NcWriter<W> {
     /// Tool change (template `tool_change` with `tool_number` and `tool_name`;
     /// `tool` and `tool_number` are updated for later templates too). With
     /// tool-centre-point control on, it is turned off before and on again
-    /// after, for the new tool. The next block writes every axis word.
+    /// after, for the new tool (unless the dialect's `outside_tcp` leaves
+    /// `tool_change` out). The next block writes every axis word.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
-        let tcp = self.tcp_on;
-        if tcp {
-            self.tcp(false)?;
-        }
         self.vars.insert("tool_number".into(), Value::from(number));
         self.vars.insert("tool".into(), Value::from(name));
         self.vars.insert("tool_name".into(), Value::from(name));
@@ -485,9 +486,6 @@ impl<W: Write> NcWriter<W> {
         // The change moves the axes to where the machine changes tools, and
         // its cycle may leave another motion mode and feed in force.
         self.forget_modal_state();
-        if tcp {
-            self.tcp(true)?;
-        }
         Ok(())
     }
 
@@ -580,9 +578,19 @@ impl<W: Write> NcWriter<W> {
         self.write_lines(&text, self.numbering.commands, "template")
     }
 
+    /// A command template (tool change, spindle, coolant, pressure), with
+    /// tool-centre-point control off around it where the dialect says so.
     fn command(&mut self, kind: TemplateKind, extra: Vec<(&str, Value)>) -> Result<(), NcError> {
         if self.kind == DialectKind::Csv {
             return Ok(());
+        }
+        if self.tcp_on
+            && self.outside_tcp.contains(&kind)
+            && self.env.get_template(kind.key()).is_ok()
+        {
+            self.tcp(false)?;
+            self.command(kind, extra)?;
+            return self.tcp(true);
         }
         let extra = if extra.is_empty() {
             None

@@ -61,6 +61,21 @@ fn template_syntax_error_points_into_the_file() {
 }
 
 #[test]
+fn outside_tcp_names_command_templates_only() {
+    let d = err(
+        "name = \"x\"\nextension = \"nc\"\n[templates]\noutside_tcp = [\"spindle_on\", \"header\"]\n",
+    );
+    assert_eq!((d.line, d.column), (4, 30), "{d}");
+    assert_eq!(
+        d.message,
+        "`templates.outside_tcp`: `header` is not a command template (one of tool_change, \
+         spindle_on, spindle_off, coolant_on, coolant_off, pressure)"
+    );
+    let d = err("name = \"x\"\nextension = \"nc\"\n[templates]\noutside_tcp = \"spindle_on\"\n");
+    assert_eq!(d.line, 4, "{d}");
+}
+
+#[test]
 fn rendered_diagnostic() {
     let e =
         Dialect::from_toml("name = \"x\"\nextension = \"nc\"\nbogus = 1\n", "my.toml").unwrap_err();
@@ -95,7 +110,7 @@ fn every_unknown_key_and_value_at_once() {
             ),
             (
                 12,
-                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`"
+                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`, `outside_tcp`"
             ),
         ]
     );

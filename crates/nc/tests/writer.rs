@@ -862,6 +862,31 @@ fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
     );
 }
 
+/// `templates.outside_tcp` says which commands are written with
+/// tool-centre-point control off: here the coolant, and not the tool
+/// change (the default list is the tool change alone).
+#[test]
+fn outside_tcp_lists_the_commands_written_with_tcp_off() {
+    let source = Dialect::builtin_source("fanuc").unwrap().replace(
+        "[templates]\n",
+        "[templates]\noutside_tcp = [\"coolant_on\"]\n",
+    );
+    let dialect = Dialect::from_toml(&source, "fanuc-coolant.toml").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    w.tool_change(1, "T1").unwrap();
+    w.tcp(true).unwrap();
+    w.coolant(Some("flood")).unwrap();
+    w.tool_change(2, "T2").unwrap();
+    w.coolant(None).unwrap();
+    w.tcp(false).unwrap();
+    w.coolant(Some("flood")).unwrap();
+    assert_eq!(
+        text(w),
+        "T1 M06\nG43.4 H1\nG49\nM08\nG43.4 H1\nT2 M06\nM09\nG49\nM08\n"
+    );
+}
+
 /// A block on the mts1600 axes with Z at `z` (feed blocks at F500).
 fn z_block(w: &mut NcWriter<Vec<u8>>, motion: Motion, z: f64) {
     let q = [459.0, -90.0, 8.5, z, 10.25, 0.0];
