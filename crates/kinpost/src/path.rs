@@ -485,11 +485,15 @@ impl PathPlan {
                 (v, v)
             }
         };
+        // (At the start of a segment, from the last point written: a
+        // rapid need not swing the free angle for a tool axis that CL
+        // rounding put a hair beside the pole.)
+        let written = before.or(self.last.map(|(n, _)| n));
         if self.exact_run(
             kin,
             wheel,
             run.clone(),
-            before.as_ref(),
+            written.as_ref(),
             after.as_ref(),
             &anchor,
         ) {
@@ -561,10 +565,10 @@ impl PathPlan {
 
     /// The run solved exactly, into `self.run`, when that needs no swing:
     /// each point at the solution nearest the one before, every rotary axis
-    /// moving from point to point (from the point before the run, and into
-    /// the point after it) by no more than a cut allows for the turn of the
-    /// tool axis ([`Costs::step_bound`], the rate at the edge of the
-    /// singular cone). A path that comes into the cone without passing
+    /// moving from point to point (from `from`, the point written before
+    /// the run, and into `after`, the point after it) by no more than a cut
+    /// allows for the turn of the tool axis ([`Costs::step_bound`], the
+    /// rate at the edge of the singular cone). A path that comes into the cone without passing
     /// close by the pole is then written as the CL has it, with no tool
     /// axis held off. `false` (nothing solved) where the exact angle would
     /// swing: there the angle is held (see [`PathPlan::fill_run`]). A point
@@ -576,7 +580,7 @@ impl PathPlan {
         kin: &mut Kinematics,
         wheel: &mut Option<Wheel>,
         run: Range<usize>,
-        before: Option<&Node>,
+        from: Option<&Node>,
         after: Option<&Node>,
         anchor: &Joints,
     ) -> bool {
@@ -591,7 +595,7 @@ impl PathPlan {
             rotary.iter().all(|&i| (b[i] - a[i]).abs() <= bound)
         };
         self.run.clear();
-        let mut last: Option<(Joints, Pose)> = before.map(|b| (b.joints, b.pose));
+        let mut last: Option<(Joints, Pose)> = from.map(|b| (b.joints, b.pose));
         let mut singular = false;
         for k in run.clone() {
             let p = &self.points[k];

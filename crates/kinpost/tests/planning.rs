@@ -232,6 +232,37 @@ fn a_point_in_the_cone_whose_exact_angle_does_not_swing_is_not_held() {
     assert!(steps.iter().all(|&s| s < 57.0), "{steps:?}");
 }
 
+/// A rapid to a tool axis that CL rounding put 0.0057° beside the pole:
+/// solved exactly it needs C at 90° (the axis leans towards X), a quarter
+/// turn from where the cut before it left C; the rapid keeps C where it was
+/// and holds it (the axis 0.0057° off, reported as a stretch), as it did
+/// before points in the cone were written exactly where they can be.
+#[test]
+fn a_rapid_a_hair_beside_the_pole_does_not_swing_the_free_angle() {
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let ic = m.axis_index("C").unwrap();
+    let cl = "FEDRAT/MMPM,1000\n\
+              GOTO/0,10,36,0,0,1\n\
+              GOTO/4,10,36,0,0,1\n\
+              RAPID\n\
+              GOTO/4,10,40,0.0001,0,0.9999\n";
+    let (csv, summary) = post_csv(&m, cl, &PostOptions::default()).unwrap();
+    let all = rows(&csv, m.axes.len());
+    assert_eq!(all.len(), 3);
+    assert_eq!(all[2].1, "rapid");
+    assert_eq!(all[2].2[ic], all[1].2[ic], "C swings in the rapid");
+    // (The vertical points before are singular too: C is free there.)
+    let s = &summary.planning.singular_stretches;
+    let rapid = s
+        .iter()
+        .find(|s| s.first_line == 5)
+        .expect("a stretch at line 5");
+    assert!(
+        (rapid.max_axis_deviation_deg - 0.0057).abs() < 1e-4,
+        "{s:?}"
+    );
+}
+
 /// One feed move whose tool axis swings by 40° about X and passes the pole
 /// of `head-head-bc` (its C axis, +Z) 0.59° away, outside the 0.5° cone:
 /// the branch stays (B keeps its sign) and C turns through the pass, one
