@@ -1083,6 +1083,23 @@ fn a_segment_through_the_singular_cone_is_halved_not_cut_into_pieces() {
     assert!(summary.planning.inserted_blocks > 100);
 }
 
+/// Between CL lines 8 and 9 the tool axis passes 0.0007° outside the small
+/// hole of a machine whose C turns without end: near the fold the exact C
+/// turns by 142° there. The planner's allowance near a fold (the change of
+/// the branches' separation) let it take the other turn of C at line 9, a
+/// step of 218° that joint interpolation makes the other way round; the
+/// linearization found nodes a whole turn apart and did not converge. No
+/// step of a cut reaches half a turn, near a fold either.
+#[test]
+fn near_a_fold_no_rotary_step_reaches_half_a_turn() {
+    let summary = posts_fold_fixture("random-tt-modulo.toml", "fold-graze.cls", 60);
+    assert!(
+        summary.planning.max_rotary_step_deg < 10.0,
+        "{:?}",
+        summary.planning.max_rotary_step_deg
+    );
+}
+
 /// Between CL lines 13 and 14 the tool axis passes within 0.0003° of a fold
 /// without reaching it: the branches lie within a degree of each other at
 /// line 14 but do not meet between the points, so the path keeps its

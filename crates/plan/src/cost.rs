@@ -67,7 +67,7 @@ impl CutRule {
         fold_deg: f64,
         across_fold: bool,
     ) -> CutLimits {
-        let bound = step_bound(turn_deg, self.step_rate) + fold_deg;
+        let bound = (step_bound(turn_deg, self.step_rate) + fold_deg).min(STEP_CEILING_DEG);
         let switching = if across_singular || across_fold {
             bound
         } else {
@@ -106,7 +106,8 @@ pub enum Link {
     /// Near a fold (see [`kinpost_machine::Folds`]) the two branches meet
     /// and the angles move like the square root of the distance to it, far
     /// faster than the turn: `fold_deg` is how much more every rotary axis
-    /// may move than the turn allows (0 on machines without folds).
+    /// may move than the turn allows (0 on machines without folds), up to
+    /// less than half a turn ([`STEP_CEILING_DEG`]).
     /// `across_fold`: the tool axis may pass a fold between the points, so
     /// a branch may switch there.
     Cut {
@@ -297,7 +298,9 @@ impl Costs {
                 // the folds (the edges of the reachable directions of axes
                 // at other angles, `across_fold`): a switch elsewhere is a
                 // flip.
-                let bound = self.step_bound(turn_deg) + fold_deg;
+                // (Near a fold too: a step of half a turn or more goes the
+                // other way round in joint space.)
+                let bound = (self.step_bound(turn_deg) + fold_deg).min(STEP_CEILING_DEG);
                 let switch = ba != bb;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();
@@ -412,6 +415,19 @@ mod tests {
             assert_eq!(l.same[0], 2.5);
             assert_eq!(l.switch[0], if across_fold { 2.5 } else { 0.0 });
         }
+        // However far apart the branches, no step of a cut reaches half a
+        // turn (joint interpolation would go the other way round).
+        let (d, e) = (joints(10.0, -142.0), joints(10.0, 76.0));
+        assert!(!costs.transition(&d, 0, &e, 0, link(250.0, false)).1);
+        assert!(
+            costs
+                .transition(&d, 0, &joints(10.0, 36.0), 0, link(250.0, false))
+                .1
+        );
+        assert_eq!(
+            rule.limits(0.005, false, 250.0, false).same[0],
+            STEP_CEILING_DEG
+        );
     }
 
     #[test]
