@@ -564,17 +564,18 @@ impl PathPlan {
     }
 
     /// The run solved exactly, into `self.run`, when that needs no swing:
-    /// each point at the solution nearest the one before, every rotary axis
+    /// each point at the solution nearest the one before (at the start of
+    /// the program, nearest the one after, backwards), every rotary axis
     /// moving from point to point (from `from`, the point written before
-    /// the run, and into `after`, the point after it) by no more than a cut
-    /// allows for the turn of the tool axis ([`Costs::step_bound`], the
-    /// rate at the edge of the singular cone). A path that comes into the cone without passing
-    /// close by the pole is then written as the CL has it, with no tool
-    /// axis held off. `false` (nothing solved) where the exact angle would
-    /// swing: there the angle is held (see [`PathPlan::fill_run`]). A point
-    /// exactly on the singular direction takes the angle of the point
-    /// before (free there), and its run is reported as a stretch held at
-    /// that angle.
+    /// the run, and into `after`, the point after it) by no more than a
+    /// cut allows for the turn of the tool axis ([`Costs::step_bound`], the
+    /// rate at the edge of the singular cone). A path that comes into the
+    /// cone without passing close by the pole is then written as the CL
+    /// has it, with no tool axis held off. `false` (nothing solved) where
+    /// the exact angle would swing: there the angle is held (see
+    /// [`PathPlan::fill_run`]). A point exactly on the singular direction
+    /// takes the angle of its neighbour (free there), and its run is
+    /// reported as a stretch held at that angle.
     fn exact_run(
         &mut self,
         kin: &mut Kinematics,
@@ -595,9 +596,21 @@ impl PathPlan {
             rotary.iter().all(|&i| (b[i] - a[i]).abs() <= bound)
         };
         self.run.clear();
-        let mut last: Option<(Joints, Pose)> = from.map(|b| (b.joints, b.pose));
+        // Backwards from the point after when nothing was written before.
+        let backwards = from.is_none();
+        let (first, end) = if backwards {
+            (after, None)
+        } else {
+            (from, after)
+        };
+        let mut last: Option<(Joints, Pose)> = first.map(|b| (b.joints, b.pose));
         let mut singular = false;
-        for k in run.clone() {
+        let order: Vec<usize> = if backwards {
+            run.clone().rev().collect()
+        } else {
+            run.clone().collect()
+        };
+        for k in order {
             let p = &self.points[k];
             select(kin, wheel, p.pressure);
             let near = Near {
@@ -625,11 +638,14 @@ impl PathPlan {
                 continuous: true,
             });
         }
-        if let (Some(a), Some((j, q))) = (after, &last)
+        if let (Some(a), Some((j, q))) = (end, &last)
             && !within(j, q, &a.joints, &a.pose)
         {
             self.run.clear();
             return false;
+        }
+        if backwards {
+            self.run.reverse();
         }
         if singular {
             self.record_stretch(run);

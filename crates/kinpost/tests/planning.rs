@@ -232,6 +232,49 @@ fn a_point_in_the_cone_whose_exact_angle_does_not_swing_is_not_held() {
     assert!(steps.iter().all(|&s| s < 57.0), "{steps:?}");
 }
 
+/// A program that starts 0.32° beside the pole and tilts away from it to
+/// 40°: A cannot go below −30°, so the cut takes A positive and C about
+/// 170°. A second cut, after a rapid, tilts the other way (A positive, C
+/// about 0°) and ends where the planner stands when it solves the first
+/// point, which lies in the cone: it is solved from the point after it,
+/// on the branch of its cut. (Solved nearest the planner's last point, it
+/// fell on the other branch, so C was held instead, 0.06° off.)
+#[test]
+fn a_program_that_starts_in_the_cone_starts_on_the_branch_of_its_cut() {
+    let m = builtin::load("trunnion-ac").unwrap().unwrap();
+    let kin = Kinematics::new(&m);
+    let ia = m.axis_index("A").unwrap();
+    let mut cl = String::from("FEDRAT/MMPM,1000\n");
+    let mut axes = Vec::new();
+    let tilts = (0..=80)
+        .map(|k| -0.3 - 0.5 * f64::from(k))
+        .chain((0..=20).map(|k| 40.0 + 0.5 * f64::from(k)));
+    for (k, y) in tilts.enumerate() {
+        if k == 81 {
+            cl.push_str("RAPID\n");
+        }
+        let (x, y) = (0.1f64.to_radians(), y.to_radians());
+        let axis = Vector3::new(x.sin() * y.cos(), y.sin(), x.cos() * y.cos()).normalize();
+        cl.push_str(&goto(&Vector3::new(-40.0 + k as f64, 15.0, 5.0), &axis));
+        axes.push(axis);
+    }
+    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
+    assert!(summary.planning.reconfigurations.is_empty());
+    assert!(
+        summary.planning.singular_stretches.is_empty(),
+        "{:?}",
+        summary.planning.singular_stretches
+    );
+    let cl_rows: Vec<_> = rows(&csv, m.axes.len())
+        .into_iter()
+        .filter(|r| r.0.is_some())
+        .collect();
+    let first = &cl_rows[0];
+    assert!(first.2[ia] > 0.0, "{first:?}");
+    let angle = kin.fk(&first.2).axis.angle(&axes[0]);
+    assert!(angle <= summary.tolerance_rad, "{angle} rad off");
+}
+
 /// A rapid to a tool axis that CL rounding put 0.0057° beside the pole:
 /// solved exactly it needs C at 90° (the axis leans towards X), a quarter
 /// turn from where the cut before it left C; the rapid keeps C where it was

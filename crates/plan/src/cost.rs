@@ -67,7 +67,7 @@ impl CutRule {
         fold_deg: f64,
         across_fold: bool,
     ) -> CutLimits {
-        let bound = (step_bound(turn_deg, self.step_rate) + fold_deg).min(STEP_CEILING_DEG);
+        let bound = cut_bound(turn_deg, self.step_rate, fold_deg);
         let switching = if across_singular || across_fold {
             bound
         } else {
@@ -90,6 +90,14 @@ impl CutRule {
 #[inline(always)]
 fn step_bound(turn_deg: f64, step_rate: f64) -> f64 {
     (turn_deg * step_rate).clamp(STEP_FLOOR_DEG, STEP_CEILING_DEG)
+}
+
+/// [`step_bound`] with the allowance `fold_deg` near a fold, still less
+/// than half a turn (a step of half a turn or more goes the other way round
+/// in joint space).
+#[inline(always)]
+fn cut_bound(turn_deg: f64, step_rate: f64, fold_deg: f64) -> f64 {
+    (step_bound(turn_deg, step_rate) + fold_deg).min(STEP_CEILING_DEG)
 }
 
 /// How two consecutive points are connected.
@@ -298,9 +306,7 @@ impl Costs {
                 // the folds (the edges of the reachable directions of axes
                 // at other angles, `across_fold`): a switch elsewhere is a
                 // flip.
-                // (Near a fold too: a step of half a turn or more goes the
-                // other way round in joint space.)
-                let bound = (self.step_bound(turn_deg) + fold_deg).min(STEP_CEILING_DEG);
+                let bound = cut_bound(turn_deg, self.step_rate, fold_deg);
                 let switch = ba != bb;
                 for r in &self.rotary {
                     let step = (b[r.index] - a[r.index]).abs();
