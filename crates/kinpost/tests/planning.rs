@@ -24,9 +24,12 @@ fn post_csv(
     Ok((String::from_utf8(out).unwrap(), summary))
 }
 
-/// Rows of a csv program: (CL line or None for an inserted block, motion,
-/// axis values in machine order).
-fn rows(csv: &str, n: usize) -> Vec<(Option<usize>, String, Vec<f64>)> {
+/// A row of a csv program: CL line (None for an inserted block), motion,
+/// axis values in machine order.
+type Row = (Option<usize>, String, Vec<f64>);
+
+/// The rows of a csv program.
+fn rows(csv: &str, n: usize) -> Vec<Row> {
     csv.lines()
         .skip(1)
         .map(|r| {
@@ -50,17 +53,45 @@ fn goto(p: &Vector3<f64>, a: &Vector3<f64>) -> String {
 /// A pass along X on the trunnion's table whose tool axis tilts in the XZ
 /// plane from +20° to −20°, `offset_deg` beside the pole (the C axis, +Z).
 fn pole_pass(offset_deg: f64) -> (String, Vec<Vector3<f64>>) {
-    let mut cl = String::from("FEDRAT/MMPM,1000\nRAPID\n");
+    tilted_pass((0..=80).map(|k| (20.0 - 0.5 * f64::from(k), offset_deg)), 0)
+}
+
+/// A pass along X on the trunnion's table whose tool axis takes the
+/// `tilts` (degrees about Y, then about X) one point a millimetre, at feed
+/// but for a rapid to point `rapid_at`.
+fn tilted_pass(
+    tilts: impl Iterator<Item = (f64, f64)>,
+    rapid_at: usize,
+) -> (String, Vec<Vector3<f64>>) {
+    let mut cl = String::from("FEDRAT/MMPM,1000\n");
     let mut axes = Vec::new();
-    let o = offset_deg.to_radians();
-    for k in 0..=80 {
-        let t = (20.0 - 0.5 * k as f64).to_radians();
-        let axis = Vector3::new(t.sin() * o.cos(), o.sin(), t.cos() * o.cos()).normalize();
-        let point = Vector3::new(-40.0 + k as f64, 15.0, 5.0);
-        cl.push_str(&goto(&point, &axis));
+    for (k, (x, y)) in tilts.enumerate() {
+        if k == rapid_at {
+            cl.push_str("RAPID\n");
+        }
+        let (x, y) = (x.to_radians(), y.to_radians());
+        let axis = Vector3::new(x.sin() * y.cos(), y.sin(), x.cos() * y.cos()).normalize();
+        cl.push_str(&goto(&Vector3::new(-40.0 + k as f64, 15.0, 5.0), &axis));
         axes.push(axis);
     }
     (cl, axes)
+}
+
+/// Posts `cl` on `m` with the defaults, without a reconfiguration or a
+/// tool axis held off the CL: the rows of the CL points.
+fn posts_exactly(m: &Machine, cl: &str) -> (Vec<Row>, Summary) {
+    let (csv, summary) = post_csv(m, cl, &PostOptions::default()).unwrap();
+    assert!(summary.planning.reconfigurations.is_empty());
+    assert!(
+        summary.planning.singular_stretches.is_empty(),
+        "{:?}",
+        summary.planning.singular_stretches
+    );
+    let cl_rows = rows(&csv, m.axes.len())
+        .into_iter()
+        .filter(|r| r.0.is_some())
+        .collect();
+    (cl_rows, summary)
 }
 
 #[test]
@@ -193,29 +224,11 @@ fn a_point_in_the_cone_whose_exact_angle_does_not_swing_is_not_held() {
     let m = builtin::load("trunnion-ac").unwrap().unwrap();
     let kin = Kinematics::new(&m);
     let ic = m.axis_index("C").unwrap();
-    // (Tilts about Y and X in degrees, as in `pole_pass`.)
     let tilts = (0..=40)
         .map(|k| (20.1 - 0.5 * f64::from(k), 0.45))
         .chain((1..=40).map(|k| (0.1, 0.45 + 0.5 * f64::from(k))));
-    let mut cl = String::from("FEDRAT/MMPM,1000\nRAPID\n");
-    let mut axes = Vec::new();
-    for (k, (x, y)) in tilts.enumerate() {
-        let (x, y) = (x.to_radians(), y.to_radians());
-        let axis = Vector3::new(x.sin() * y.cos(), y.sin(), x.cos() * y.cos()).normalize();
-        cl.push_str(&goto(&Vector3::new(-40.0 + k as f64, 15.0, 5.0), &axis));
-        axes.push(axis);
-    }
-    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
-    assert!(summary.planning.reconfigurations.is_empty());
-    assert!(
-        summary.planning.singular_stretches.is_empty(),
-        "{:?}",
-        summary.planning.singular_stretches
-    );
-    let cl_rows: Vec<_> = rows(&csv, m.axes.len())
-        .into_iter()
-        .filter(|r| r.0.is_some())
-        .collect();
+    let (cl, axes) = tilted_pass(tilts, 0);
+    let (cl_rows, summary) = posts_exactly(&m, &cl);
     assert_eq!(cl_rows.len(), axes.len());
     for (k, row) in cl_rows.iter().enumerate() {
         let angle = kin.fk(&row.2).axis.angle(&axes[k]);
@@ -244,31 +257,11 @@ fn a_program_that_starts_in_the_cone_starts_on_the_branch_of_its_cut() {
     let m = builtin::load("trunnion-ac").unwrap().unwrap();
     let kin = Kinematics::new(&m);
     let ia = m.axis_index("A").unwrap();
-    let mut cl = String::from("FEDRAT/MMPM,1000\n");
-    let mut axes = Vec::new();
     let tilts = (0..=80)
         .map(|k| -0.3 - 0.5 * f64::from(k))
         .chain((0..=20).map(|k| 40.0 + 0.5 * f64::from(k)));
-    for (k, y) in tilts.enumerate() {
-        if k == 81 {
-            cl.push_str("RAPID\n");
-        }
-        let (x, y) = (0.1f64.to_radians(), y.to_radians());
-        let axis = Vector3::new(x.sin() * y.cos(), y.sin(), x.cos() * y.cos()).normalize();
-        cl.push_str(&goto(&Vector3::new(-40.0 + k as f64, 15.0, 5.0), &axis));
-        axes.push(axis);
-    }
-    let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
-    assert!(summary.planning.reconfigurations.is_empty());
-    assert!(
-        summary.planning.singular_stretches.is_empty(),
-        "{:?}",
-        summary.planning.singular_stretches
-    );
-    let cl_rows: Vec<_> = rows(&csv, m.axes.len())
-        .into_iter()
-        .filter(|r| r.0.is_some())
-        .collect();
+    let (cl, axes) = tilted_pass(tilts.map(|y| (0.1, y)), 81);
+    let (cl_rows, summary) = posts_exactly(&m, &cl);
     let first = &cl_rows[0];
     assert!(first.2[ia] > 0.0, "{first:?}");
     let angle = kin.fk(&first.2).axis.angle(&axes[0]);
