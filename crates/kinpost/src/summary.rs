@@ -36,7 +36,9 @@ pub struct Summary {
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Planning {
     /// Runs of CL points whose tool axis lies within the singular cone,
-    /// where the singular angle was held or interpolated.
+    /// where the singular angle was held or interpolated (or was free: a
+    /// point exactly on the singular direction, written exactly, takes the
+    /// angle of its neighbour).
     pub singular_stretches: Vec<SingularStretch>,
     /// Retract-and-reconfigure events.
     pub reconfigurations: Vec<Reconfiguration>,
@@ -83,7 +85,8 @@ pub struct SingularStretch {
     pub from_deg: f64,
     pub to_deg: f64,
     /// Largest angle between the CL tool axis and the axis the machine
-    /// points with the angle held, degrees (at most the cone).
+    /// points with the angle held, degrees (about the cone at most; see
+    /// README.md).
     pub max_axis_deviation_deg: f64,
 }
 
