@@ -605,12 +605,12 @@ impl PathPlan {
         };
         let mut last: Option<(Joints, Pose)> = first.map(|b| (b.joints, b.pose));
         let mut singular = false;
-        let order: Vec<usize> = if backwards {
-            run.clone().rev().collect()
-        } else {
-            run.clone().collect()
-        };
-        for k in order {
+        for j in 0..run.len() {
+            let k = if backwards {
+                run.end - 1 - j
+            } else {
+                run.start + j
+            };
             let p = &self.points[k];
             select(kin, wheel, p.pressure);
             let near = Near {
