@@ -255,8 +255,9 @@ pub struct NcWriter<W: Write> {
     /// Inverse-time feed is on (between `inverse_time(true)` and
     /// `inverse_time(false)`).
     inverse_time_on: bool,
-    /// Tool-centre-point control is on: a tool change turns it off first
-    /// and on again for the new tool (its length).
+    /// Tool-centre-point control is on: the commands of `outside_tcp` (a
+    /// tool change, for the new tool's length) turn it off first and on
+    /// again after.
     tcp_on: bool,
     /// The templates written with tool-centre-point control off
     /// ([`Dialect`]'s `templates.outside_tcp`).
@@ -439,8 +440,7 @@ impl<W: Write> NcWriter<W> {
         info: &ProgramInfo,
         override_template: Option<&str>,
     ) -> Result<(), NcError> {
-        self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
-        self.vars.insert("tcp".into(), Value::from(self.tcp_on));
+        self.program_vars(info);
         if self.kind == DialectKind::Csv {
             self.csv_header()?;
             return Ok(());
@@ -460,8 +460,7 @@ impl<W: Write> NcWriter<W> {
         info: &ProgramInfo,
         override_template: Option<&str>,
     ) -> Result<(), NcError> {
-        self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
-        self.vars.insert("tcp".into(), Value::from(self.tcp_on));
+        self.program_vars(info);
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
@@ -471,6 +470,12 @@ impl<W: Write> NcWriter<W> {
             None,
             self.numbering.header,
         )
+    }
+
+    /// The template variables of the program `info`, with `tcp` as it is.
+    fn program_vars(&mut self, info: &ProgramInfo) {
+        self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
+        self.vars.insert("tcp".into(), Value::from(self.tcp_on));
     }
 
     /// Tool change (template `tool_change` with `tool_number` and `tool_name`;
