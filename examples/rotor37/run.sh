@@ -2,8 +2,7 @@
 # NASA Rotor 37, blade side 1: measured points → B-spline surface → belt-
 # grinding path → NC program for the MTS1600 grinder, checked in closed loop.
 # Run from the repository root:  bash examples/rotor37/run.sh [OUTDIR]
-# (../shared/data sits beside the repository; set KINPOST to use an
-# installed kinpost instead of cargo run).
+# (set KINPOST to use an installed kinpost instead of cargo run).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-target/rotor37}
@@ -11,7 +10,7 @@ mkdir -p "$out"
 kinpost() {
   if [ -n "${KINPOST:-}" ]; then "$KINPOST" "$@"; else cargo run --release --quiet -- "$@"; fi
 }
-data=../shared/data/nasa-rotors/rotor37geometry.dat
+data=data/nasa-rotors/rotor37geometry.dat
 
 # 1. Side 1 (THETA 1) of the blade as a 13 × 100 grid in mm, fitted with
 #    chord-length parameters (the table's points crowd at the edges).

@@ -2,7 +2,7 @@
 //! built-in dialect's reader give blocks or a located diagnostic, never a
 //! panic. Run with `cargo +nightly fuzz run nc_program` (seed the corpus
 //! with `crates/kinpost/tests/snapshots/*.snap` and
-//! `../shared/data/linuxcnc/*.ngc`).
+//! `data/linuxcnc/*.ngc`).
 
 #![no_main]
 

@@ -3,7 +3,7 @@
 //! give a grid / surface or located diagnostics, never a panic; what loads
 //! is fitted or evaluated. Run with `cargo +nightly fuzz run surface_files`
 //! from the repository root (seed the corpus with
-//! `../shared/data/seed002/points.csv` and a `kinpost surface fit` output).
+//! `data/li-bspline/points.csv` and a `kinpost surface fit` output).
 
 #![no_main]
 

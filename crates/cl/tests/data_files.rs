@@ -1,4 +1,4 @@
-//! The reader on the project's test data (`shared/data`, next to the repository).
+//! The reader on the real CL files in the repository's `data/` folder.
 
 use std::fs::File;
 use std::io::BufReader;
@@ -8,7 +8,7 @@ use kinpost_cl::{ClEvent, ClReader, Diagnostic, FeedUnit, Motion, Severity, Stat
 
 fn data(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
+        .join("../../data")
         .join(path)
 }
 
@@ -34,7 +34,7 @@ fn read_all<R: std::io::BufRead>(
 
 #[test]
 fn seed_figure_28a() {
-    let (statements, warnings, error) = read_all(open("seed000/figure28a-verbatim.cls"));
+    let (statements, warnings, error) = read_all(open("qiao2022/figure28a-verbatim.cls"));
     assert_eq!(error, None);
 
     let gotos: Vec<_> = statements
@@ -113,7 +113,7 @@ fn seed_figure_28a() {
 #[test]
 fn apt_files_read_up_to_the_first_circle() {
     for (path, circle_line, gotos_before) in
-        [("apt/boss.apt", 37, 19), ("apt/RotateThin.apt", 23, 4)]
+        [("cl/solidworks/boss.apt", 37, 19), ("cl/solidworks/RotateThin.apt", 23, 4)]
     {
         // Without a default axis the first GOTO is already an error.
         let (_, _, error) = read_all(open(path));
@@ -142,7 +142,7 @@ fn apt_files_read_up_to_the_first_circle() {
             == ClEvent::ToolData {
                 kind: "CUTTER".into(),
                 values: match path {
-                    "apt/boss.apt" => vec![6.0, 0.0, 3.0, 0.0, 0.0, 0.0, 51.0],
+                    "cl/solidworks/boss.apt" => vec![6.0, 0.0, 3.0, 0.0, 0.0, 0.0, 51.0],
                     _ => vec![20.0, 0.0, 10.0, 0.0, 0.0, 0.0, 100.0],
                 },
             }));
@@ -153,7 +153,7 @@ fn apt_files_read_up_to_the_first_circle() {
             .count();
         assert_eq!(
             cutcom,
-            usize::from(path == "apt/RotateThin.apt"),
+            usize::from(path == "cl/solidworks/RotateThin.apt"),
             "{warnings:#?}"
         );
         assert_eq!(warnings.len(), cutcom, "{warnings:#?}");
@@ -162,7 +162,7 @@ fn apt_files_read_up_to_the_first_circle() {
 
 #[test]
 fn apt_first_moves_are_rapid_then_feed() {
-    let (statements, _, _) = read_all(open("apt/boss.apt").with_default_axis([0.0, 0.0, 1.0]));
+    let (statements, _, _) = read_all(open("cl/solidworks/boss.apt").with_default_axis([0.0, 0.0, 1.0]));
     let moves: Vec<_> = statements
         .iter()
         .filter_map(|s| match s.event {

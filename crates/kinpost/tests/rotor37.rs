@@ -36,7 +36,7 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
     let o = kinpost(&[
         "surface",
         "fit",
-        "../shared/data/nasa-rotors/rotor37geometry.dat",
+        "data/nasa-rotors/rotor37geometry.dat",
         "--blade-side",
         "1",
         "--params",
@@ -147,7 +147,7 @@ fn rotor67_reads_both_blade_sides() {
         let o = kinpost(&[
             "surface",
             "fit",
-            "../shared/data/nasa-rotors/rotor67geometry.dat",
+            "data/nasa-rotors/rotor67geometry.dat",
             "--blade-side",
             side,
             "-o",

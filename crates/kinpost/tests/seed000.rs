@@ -4,16 +4,16 @@
 
 use kinpost::{PostOptions, post};
 
-fn shared(path: &str) -> String {
-    let p = format!("{}/../../../shared/data/{path}", env!("CARGO_MANIFEST_DIR"));
+fn data(path: &str) -> String {
+    let p = format!("{}/../../data/{path}", env!("CARGO_MANIFEST_DIR"));
     std::fs::read_to_string(&p)
-        .unwrap_or_else(|e| panic!("{p}: {e} (shared/ must sit beside the repository)"))
+        .unwrap_or_else(|e| panic!("{p}: {e} (data/ of the repository)"))
 }
 
 #[test]
 fn figure28_posts_to_the_printed_program() {
-    let cl = shared("seed000/figure28a-verbatim.cls");
-    let printed = shared("seed000/figure28b-verbatim.mpf");
+    let cl = data("qiao2022/figure28a-verbatim.cls");
+    let printed = data("qiao2022/figure28b-verbatim.mpf");
     // The example shipped in the repository is the same file.
     let example = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -65,7 +65,7 @@ fn figure28_posts_to_the_printed_program() {
 
 #[test]
 fn same_input_same_bytes() {
-    let cl = shared("seed000/figure28a-verbatim.cls");
+    let cl = data("qiao2022/figure28a-verbatim.cls");
     let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
     let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
     let run = || {

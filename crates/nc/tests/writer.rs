@@ -17,7 +17,7 @@ fn mts_axes() -> Vec<AxisSpec> {
     ]
 }
 
-const SEED: &str = include_str!("../../../../shared/data/seed000/figure28b-verbatim.mpf");
+const SEED: &str = include_str!("../../../data/qiao2022/figure28b-verbatim.mpf");
 
 /// The motion blocks of seed 000 Figure 28(b), as (X, Y, Z, B, A).
 fn seed_blocks() -> Vec<(String, [f64; 5])> {

@@ -1,5 +1,5 @@
 //! Grids of measured points: `row,col,x,y,z` CSV files (as
-//! `../shared/data/seed002/points.csv`), whitespace tables, and NASA blade
+//! `data/li-bspline/points.csv`), whitespace tables, and NASA blade
 //! geometry tables (Rotor 37: per stream surface Z, R, θ1, θ2; Rotor 67:
 //! blocks of axial distance, r·θ, thickness and radius per stream surface).
 //!

@@ -12,11 +12,11 @@ pub fn root() -> PathBuf {
 
 /// The 35 measured points of seed 002 (Tables 1–5).
 pub fn seed002_path() -> PathBuf {
-    root().join("../shared/data/seed002/points.csv")
+    root().join("data/li-bspline/points.csv")
 }
 
 pub fn seed002() -> Grid {
     let path = seed002_path();
-    let text = std::fs::read_to_string(&path).expect("../shared/data/seed002/points.csv");
+    let text = std::fs::read_to_string(&path).expect("data/li-bspline/points.csv");
     read_grid(&text, &path.to_string_lossy()).expect("valid grid")
 }
