@@ -26,7 +26,6 @@ macro_rules! note {
 }
 
 mod cmd_surface;
-mod cpu;
 mod sinks;
 
 use sinks::{Sink, deliver, open_outputs};
@@ -279,14 +278,6 @@ fn usage(message: impl Into<String>) -> anyhow::Error {
 }
 
 fn main() -> ExitCode {
-    // First: nothing compiled for the build's processor features may run
-    // before it.
-    cpu::require_build_features();
-    cli_main()
-}
-
-#[inline(never)]
-fn cli_main() -> ExitCode {
     let cli = Cli::parse();
     // (Text still buffered is flushed here, where its error can be seen.)
     match run(cli).and_then(|()| Ok(io::stdout().flush()?)) {
