@@ -22,7 +22,7 @@ fuzz_target!(|data: &[u8]| {
             }
         }
         Ok(machine) => {
-            if let Err(diags) = kinpost::check_machine_templates(&text, "fuzz.toml") {
+            if let Err(diags) = kinpost_post::check_machine_templates(&text, "fuzz.toml") {
                 let lines = text.split('\n').count();
                 for d in &diags.0 {
                     assert!(d.line >= 1 && d.line <= lines && d.column >= 1);

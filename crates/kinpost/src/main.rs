@@ -8,11 +8,11 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, anyhow};
 use clap::{Parser, Subcommand};
-use kinpost::machine::{
+use kinpost_post::machine::{
     Kinematics, MAX_AXIS_ROUNDING_RAD, Machine, OutputMode, Pose, builtin, machine_from_toml,
 };
-use kinpost::nc::Dialect;
-use kinpost::{FeedMode, PlannerMode, PostError, PostOptions};
+use kinpost_post::nc::Dialect;
+use kinpost_post::{FeedMode, PlannerMode, PostError, PostOptions};
 use nalgebra::Vector3;
 
 /// `eprintln!` that does not panic when standard error is gone (its reader
@@ -26,6 +26,8 @@ macro_rules! note {
 }
 
 mod cmd_surface;
+mod cmd_wheel;
+mod output;
 mod sinks;
 
 use sinks::{Sink, deliver, open_outputs};
@@ -171,7 +173,7 @@ struct PostArgs {
     /// Linearization tolerance in mm: blocks are inserted until the contact
     /// point, moved linearly in joint space, stays this close to the straight
     /// CL segment. 0 turns linearization off. Joint output only.
-    #[arg(long, value_name = "MM", default_value_t = kinpost::DEFAULT_LINTOL_MM)]
+    #[arg(long, value_name = "MM", default_value_t = kinpost_post::DEFAULT_LINTOL_MM)]
     lintol: f64,
     /// Half-angle in degrees of the cone around a singular tool-axis
     /// direction inside which the free rotary angle is held where the exact
@@ -478,7 +480,7 @@ fn is_file_to_read(path: &Path) -> bool {
 /// A machine file's machine, its `[post]` templates checked too.
 fn machine_from_source(src: &str, name: &str) -> Result<Machine> {
     let machine = machine_from_toml(src, name).map_err(report)?;
-    kinpost::check_machine_templates(src, name).map_err(report)?;
+    kinpost_post::check_machine_templates(src, name).map_err(report)?;
     Ok(machine)
 }
 
@@ -622,7 +624,7 @@ fn post(args: PostArgs) -> Result<()> {
         ))
     };
 
-    let result = kinpost::post(input, &machine, &dialect, &mut sinks[0], &options);
+    let result = kinpost_post::post(input, &machine, &dialect, &mut sinks[0], &options);
     if let Some(bar) = &progress {
         bar.finish_and_clear();
     }
@@ -737,8 +739,8 @@ fn machine_at_pressure(m: &Machine, pressure: Option<f64>) -> Result<Machine> {
         return Ok(m.clone());
     };
     let h = check_pressure_value(h)?;
-    let p = kinpost::wheel::pressure_axis(m).map_err(|e| anyhow!("{e}"))?;
-    if p.clamp(h) != kinpost::machine::Clamp::Inside {
+    let p = cmd_wheel::pressure_axis(m).map_err(|e| anyhow!("{e}"))?;
+    if p.clamp(h) != kinpost_post::machine::Clamp::Inside {
         let [lo, hi] = p.range();
         note!(
             "warning: {} = {h} is outside the calibration ({lo} .. {hi}): the wheel sits on its stop",
@@ -883,23 +885,23 @@ fn wheel(args: &WheelArgs) -> Result<()> {
     };
     let mut sinks = open_outputs(inputs, &outputs)?;
     let m = load_machine(&args.machine)?;
-    let p = kinpost::wheel::pressure_axis(&m).map_err(|e| anyhow!("{e}"))?;
+    let p = cmd_wheel::pressure_axis(&m).map_err(|e| anyhow!("{e}"))?;
     let mut pressures = args
         .pressure
         .iter()
         .map(|&v| check_pressure_value(v))
         .collect::<Result<Vec<f64>>>()?;
     if let Some(t) = &args.table {
-        pressures.extend(kinpost::wheel::parse_table(t).map_err(usage)?);
+        pressures.extend(cmd_wheel::parse_table(t).map_err(usage)?);
     }
     if pressures.is_empty() {
-        pressures = kinpost::wheel::default_pressures(p);
+        pressures = cmd_wheel::default_pressures(p);
     }
-    let rows = kinpost::wheel::rows(&m, &pressures).map_err(|e| anyhow!("{e}"))?;
-    let table = kinpost::wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?;
+    let rows = cmd_wheel::rows(&m, &pressures).map_err(|e| anyhow!("{e}"))?;
+    let table = cmd_wheel::table_text(&m, &rows).map_err(|e| anyhow!("{e}"))?;
     sinks[0].write_all(table.as_bytes())?;
     if let Some(path) = &args.svg {
-        let svg = kinpost::wheel::svg(&m, &rows).map_err(|e| anyhow!("{e}"))?;
+        let svg = cmd_wheel::svg(&m, &rows).map_err(|e| anyhow!("{e}"))?;
         sinks[1]
             .write_all(svg.as_bytes())
             .with_context(|| format!("cannot write {}", path.display()))?;

@@ -64,6 +64,7 @@ impl AtomicFile {
     }
 
     /// Flushes and renames the file into place.
+    #[cfg(test)]
     pub fn commit(self) -> io::Result<()> {
         self.finish()?.persist()
     }

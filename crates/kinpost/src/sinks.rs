@@ -6,7 +6,7 @@ use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use kinpost::output::{AtomicFile, Finished};
+use crate::output::{AtomicFile, Finished};
 
 use crate::usage;
 

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use kinpost::machine::machine_from_toml;
+use kinpost_post::machine::machine_from_toml;
 
 /// The repository root.
 fn root() -> PathBuf {
@@ -517,7 +517,7 @@ fn machine_check() {
 
     // A nutating head whose tool is 0.2° off its B axis's inclination
     // (45.2° from B): the tool axis makes 0.2° to 90.2° with the C axis.
-    let folds = root().join("crates/kinpost/tests/folds/nutating-off.toml");
+    let folds = root().join("crates/post/tests/folds/nutating-off.toml");
     let o = run(&["machine", "check", folds.to_str().unwrap()]);
     assert_exit(&o, 0);
     assert!(
@@ -824,7 +824,7 @@ fn wheel_svg_pressures_and_mistakes() {
     );
 
     // A machine file of measured offsets, not one of the built-ins.
-    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let src = kinpost_post::machine::builtin::source("mts1600").unwrap();
     let cut = src.find("link_length = 250").unwrap();
     let file = dir.path().join("measured.toml");
     std::fs::write(
@@ -962,7 +962,7 @@ fn fk_and_ik_turn_an_axis_free_with_reference() {
     // The mts1600's C axis is locked at 0 but free with a reference
     // direction: fk and ik must agree with a copy where C is simply free.
     let dir = tempfile::tempdir().unwrap();
-    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let src = kinpost_post::machine::builtin::source("mts1600").unwrap();
     let unlocked = src
         .replace("fixed = 0\n", "")
         .replace("free_with_reference = true\n", "");
@@ -1031,7 +1031,7 @@ fn outputs_never_replace_inputs_or_each_other() {
     let machine = dir.path().join("m.toml");
     std::fs::write(
         &machine,
-        kinpost::machine::builtin::source("mts1600").unwrap(),
+        kinpost_post::machine::builtin::source("mts1600").unwrap(),
     )
     .unwrap();
     let link = dir.path().join("link.cls");
@@ -1115,7 +1115,7 @@ fn dash_outputs_are_standard_output() {
 
 #[test]
 fn machine_check_reads_standard_input() {
-    let src = kinpost::machine::builtin::source("mts1600").unwrap();
+    let src = kinpost_post::machine::builtin::source("mts1600").unwrap();
     let o = run_with_stdin(&["machine", "check", "-"], src.as_bytes());
     assert_exit(&o, 0);
     assert!(

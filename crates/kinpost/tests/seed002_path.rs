@@ -11,9 +11,9 @@ mod seed002_paper;
 
 use std::path::Path;
 
-use kinpost::cl::{ClEvent, ClReader};
-use kinpost::machine::builtin;
-use kinpost::{PostOptions, post};
+use kinpost_post::cl::{ClEvent, ClReader};
+use kinpost_post::machine::builtin;
+use kinpost_post::{PostOptions, post};
 use kinpost_surface::grid::read_grid;
 use kinpost_surface::{FitOptions, Surface};
 use kinpost_toolpath::cl::{ClOptions, write_cl};
@@ -54,7 +54,7 @@ fn cl_text(direction: Direction) -> String {
 #[test]
 fn posted_angles_are_those_of_eq_30() {
     let machine = builtin::load("ac-grinder").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
     for direction in [Direction::U, Direction::V] {
         let cl = cl_text(direction);
         let mut csv = Vec::new();

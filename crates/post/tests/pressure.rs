@@ -13,9 +13,9 @@
 mod common;
 mod rng;
 
-use kinpost::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
-use kinpost::nc::{Dialect, read_program};
-use kinpost::{PostError, PostOptions, post};
+use kinpost_post::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use kinpost_post::nc::{Dialect, read_program};
+use kinpost_post::{PostError, PostOptions, post};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 use rng::{Rng, random_body, singular_allowance, vec_toml};
@@ -226,7 +226,7 @@ fn post_text(
     machine: &Machine,
     dialect: &str,
     options: &PostOptions,
-) -> Result<(String, kinpost::Summary), PostError> {
+) -> Result<(String, kinpost_post::Summary), PostError> {
     let dialect = Dialect::builtin(dialect).unwrap();
     let mut out = Vec::new();
     // These tests pair every block with its CL point: no linearization
@@ -417,7 +417,7 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
     // block's pressure, and the blocks land on the CL at it.
     let (nc, summary) = post_text(&cl, &machine, "sinumerik", &options)
         .map_err(|e| TestCaseError::fail(format!("{e}\n{toml}")))?;
-    let axes = kinpost::axis_specs(&machine);
+    let axes = kinpost_post::axis_specs(&machine);
     let blocks = read_program(&Dialect::builtin("sinumerik").unwrap(), &axes, "r.mpf", &nc)
         .map_err(|e| TestCaseError::fail(e.to_string()))?;
     // Sinumerik writes whole pressures: a change it writes as none (4507.5
@@ -628,7 +628,7 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
     for dialect in ["sinumerik", "csv"] {
         let (nc, summary) = post_text(&cl, &machine, dialect, &PostOptions::default()).unwrap();
         let d = Dialect::builtin(dialect).unwrap();
-        let blocks = read_program(&d, &kinpost::axis_specs(&machine), "job", &nc).unwrap();
+        let blocks = read_program(&d, &kinpost_post::axis_specs(&machine), "job", &nc).unwrap();
         let blocks = &blocks[blocks.len() - reached.len()..];
         for (b, (want, h1)) in blocks.iter().zip(&reached) {
             assert_eq!(b.axes[6], Some(*h1), "{dialect} line {}", b.line);
@@ -829,7 +829,7 @@ fn pressure_mistakes_are_located() {
     assert!(matches!(e, PostError::Setup(_)), "{e}");
     // Tool-centre-point output cannot compensate; joint output can.
     let tcp = PostOptions {
-        output: Some(kinpost::machine::OutputMode::Tcp),
+        output: Some(kinpost_post::machine::OutputMode::Tcp),
         ..Default::default()
     };
     let e = post_text(cl, &machine, "sinumerik", &tcp).unwrap_err();

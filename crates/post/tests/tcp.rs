@@ -4,9 +4,9 @@
 
 mod common;
 
-use kinpost::machine::{Kinematics, OutputMode, builtin};
-use kinpost::nc::Dialect;
-use kinpost::{PostError, PostOptions, post};
+use kinpost_post::machine::{Kinematics, OutputMode, builtin};
+use kinpost_post::nc::Dialect;
+use kinpost_post::{PostError, PostOptions, post};
 
 fn run(machine: &str, dialect: &str, output: OutputMode, cl: &str) -> Result<String, PostError> {
     let machine = builtin::load(machine).unwrap().unwrap();
@@ -111,7 +111,7 @@ fn inverse_time_needs_a_dialect_that_can_switch() {
     let machine = builtin::load("mts1600").unwrap().unwrap();
     let dialect = Dialect::builtin("heidenhain").unwrap();
     let options = PostOptions {
-        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        feed_mode: Some(kinpost_post::FeedMode::InverseTime),
         ..Default::default()
     };
     let err = post(

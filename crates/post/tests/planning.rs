@@ -3,9 +3,9 @@
 //! the travel forces a flip, and the linearization property over random
 //! machines.
 
-use kinpost::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
-use kinpost::nc::Dialect;
-use kinpost::{PostError, PostOptions, Summary, post};
+use kinpost_post::machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
+use kinpost_post::nc::Dialect;
+use kinpost_post::{PostError, PostOptions, Summary, post};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
@@ -316,7 +316,7 @@ fn a_swing_just_outside_the_singular_cone_keeps_its_branch() {
     let (csv, summary) = post_csv(&m, cl, &PostOptions::default()).unwrap();
     assert!(summary.planning.reconfigurations.is_empty());
     assert!(summary.planning.singular_stretches.is_empty());
-    assert!(summary.planning.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM + 1e-9);
+    assert!(summary.planning.max_linearization_error_mm <= kinpost_post::DEFAULT_LINTOL_MM + 1e-9);
     let all = rows(&csv, m.axes.len());
     assert!(
         all.len() > 10,
@@ -631,7 +631,7 @@ fn point_by_point_planning_needs_more_reconfigurations() {
         &m,
         &cl,
         &PostOptions {
-            planner: kinpost::PlannerMode::Nearest,
+            planner: kinpost_post::PlannerMode::Nearest,
             ..Default::default()
         },
     )
@@ -811,7 +811,7 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
         lintol_mm: Some(0.0),
         ..Default::default()
     };
-    let (csv, summary) = post_csv(&m, &cl, &options(kinpost::FeedMode::InverseTime)).unwrap();
+    let (csv, summary) = post_csv(&m, &cl, &options(kinpost_post::FeedMode::InverseTime)).unwrap();
     let clamps = &summary.planning.feed_clamps;
     assert_eq!(summary.planning.feed_clamp_count, 5, "{clamps:?}");
     assert!(
@@ -845,7 +845,7 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
         );
     }
     // dpm: F is the length of the change of all axes over the same time.
-    let (csv, _) = post_csv(&m, &cl, &options(kinpost::FeedMode::Dpm)).unwrap();
+    let (csv, _) = post_csv(&m, &cl, &options(kinpost_post::FeedMode::Dpm)).unwrap();
     let all = rows(&csv, m.axes.len());
     let f = feed_col(&csv);
     for k in 2..all.len() {
@@ -868,7 +868,7 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
 }
 
 /// Posts `cl` on the built-in trunnion to `dialect` without linearization.
-fn post_trunnion(cl: &str, dialect: &str, mode: kinpost::FeedMode) -> Result<String, PostError> {
+fn post_trunnion(cl: &str, dialect: &str, mode: kinpost_post::FeedMode) -> Result<String, PostError> {
     let m = builtin::load("trunnion-ac").unwrap().unwrap();
     let dialect = Dialect::builtin(dialect).unwrap();
     let options = PostOptions {
@@ -888,8 +888,8 @@ fn a_block_that_turns_while_the_tool_point_barely_moves_takes_the_turning_time()
     // 1e-7 mm / 1000 mm/min (F ≈ 1e10 in inverse time).
     let cl = "RAPID\nGOTO/0,0,10,0,0,1\nFEDRAT/1000\nGOTO/0,0,10.0000001,0,0.5,0.8660254\n";
     for (mode, want) in [
-        (kinpost::FeedMode::InverseTime, 1000.0 / 30.0),
-        (kinpost::FeedMode::Tip, 1000.0),
+        (kinpost_post::FeedMode::InverseTime, 1000.0 / 30.0),
+        (kinpost_post::FeedMode::Tip, 1000.0),
     ] {
         let csv = post_trunnion(cl, "csv", mode).unwrap();
         let last = csv.lines().last().unwrap();
@@ -904,7 +904,7 @@ fn inverse_time_starts_where_the_start_is_known() {
     // machine happens to be: no block time, so they are written at the CL
     // feed rate per minute (G94), inverse time (G93) in between.
     let cl = "FEDRAT/MMPM,100\nGOTO/0,0,50,0,0,1\nGOTO/0,0,10\nLOAD/TOOL,2\nGOTO/10,0,10\nGOTO/20,0,10\n";
-    let nc = post_trunnion(cl, "fanuc", kinpost::FeedMode::InverseTime).unwrap();
+    let nc = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::InverseTime).unwrap();
     let body: Vec<&str> = nc
         .lines()
         .skip_while(|l| !l.starts_with("T1"))
@@ -934,7 +934,7 @@ fn csv_says_which_feeds_are_inverse_time() {
     // the start is unknown and inverse-time feeds elsewhere; a last column
     // says which.
     let cl = "FEDRAT/MMPM,100\nGOTO/0,0,50,0,0,1\nGOTO/0,0,10\nLOAD/TOOL,2\nGOTO/10,0,10\nGOTO/20,0,10\n";
-    let csv = post_trunnion(cl, "csv", kinpost::FeedMode::InverseTime).unwrap();
+    let csv = post_trunnion(cl, "csv", kinpost_post::FeedMode::InverseTime).unwrap();
     let rows: Vec<(&str, &str)> = csv
         .lines()
         .map(|l| {
@@ -954,15 +954,15 @@ fn csv_says_which_feeds_are_inverse_time() {
         "{csv}"
     );
     // Read back as the CSV dialect reads it.
-    let m = kinpost::machine::builtin::load("trunnion-ac")
+    let m = kinpost_post::machine::builtin::load("trunnion-ac")
         .unwrap()
         .unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
-    let axes = kinpost::axis_specs(&m);
-    let program = kinpost::nc::read_program(&dialect, &axes, "job.csv", &csv).unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
+    let axes = kinpost_post::axis_specs(&m);
+    let program = kinpost_post::nc::read_program(&dialect, &axes, "job.csv", &csv).unwrap();
     assert_eq!(program.len(), 4);
     // Feed per minute: no such column.
-    let tip = post_trunnion(cl, "csv", kinpost::FeedMode::Tip).unwrap();
+    let tip = post_trunnion(cl, "csv", kinpost_post::FeedMode::Tip).unwrap();
     assert!(tip.starts_with("line,motion,X,Y,Z,A,C,feed\n"), "{tip}");
 }
 
@@ -972,7 +972,7 @@ fn loading_the_tool_in_the_spindle_again_is_no_tool_change() {
     // same tool too: only a different tool is a tool change cycle.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nLOAD/TOOL,1\nFEDRAT/MMPM,100\nGOTO/0,0,10\n\
               LOAD/TOOL,2\nGOTO/10,0,10\nLOAD/TOOL,2\nGOTO/20,0,10\nLOAD/TOOL,1\nGOTO/30,0,10\n";
-    let nc = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap();
+    let nc = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::Tip).unwrap();
     let changes: Vec<&str> = nc.lines().filter(|l| l.contains("M06")).collect();
     assert_eq!(changes, ["T1 M06", "T2 M06", "T1 M06"], "{nc}");
 }
@@ -981,7 +981,7 @@ fn loading_the_tool_in_the_spindle_again_is_no_tool_change() {
 fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
     // Fanuc's feed word has too few decimals for 0.0001 mm/min: F0.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,0.0001\nGOTO/0,0,10\n";
-    let e = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap_err();
+    let e = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::Tip).unwrap_err();
     let PostError::Input(d) = e else {
         panic!("{e}")
     };
@@ -989,7 +989,7 @@ fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
     assert!(d.message.contains("rounds to 0"), "{}", d.message);
     // Too large to be written: the CL line, once.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/1e13\nGOTO/0,0,10\n";
-    let e = post_trunnion(cl, "fanuc", kinpost::FeedMode::Tip).unwrap_err();
+    let e = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::Tip).unwrap_err();
     let PostError::Input(d) = e else {
         panic!("{e}")
     };
@@ -1014,7 +1014,7 @@ fn deciding_point_by_point_keeps_the_branch_it_is_on() {
             &Vector3::new(t.sin(), 0.0, t.cos()),
         ));
     }
-    for planner in [kinpost::PlannerMode::Global, kinpost::PlannerMode::Nearest] {
+    for planner in [kinpost_post::PlannerMode::Global, kinpost_post::PlannerMode::Nearest] {
         let options = PostOptions {
             planner,
             ..Default::default()
@@ -1069,7 +1069,7 @@ fn a_segment_through_a_cone_the_machine_cannot_point_passes_at_its_rim() {
             "{cone:?}: {p:?}"
         );
         assert_eq!(p.max_inserted_axis_deviation_line, Some(8));
-        assert!(p.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
+        assert!(p.max_linearization_error_mm <= kinpost_post::DEFAULT_LINTOL_MM);
         assert!(summary.one_line().contains(&format!(
             "an inserted block's tool axis up to {:.4}° off the CL's interpolation (before CL line 8)",
             0.2 - nearest
@@ -1101,7 +1101,7 @@ fn posts_fold_fixture(machine: &str, cl: &str, points: usize) -> Summary {
     let cl = std::fs::read_to_string(format!("{dir}/{cl}")).unwrap();
     let (csv, summary) = post_csv(&m, &cl, &PostOptions::default()).unwrap();
     assert!(summary.planning.reconfigurations.is_empty());
-    assert!(summary.planning.max_linearization_error_mm <= kinpost::DEFAULT_LINTOL_MM);
+    assert!(summary.planning.max_linearization_error_mm <= kinpost_post::DEFAULT_LINTOL_MM);
     let all = rows(&csv, m.axes.len());
     assert_eq!(all.iter().filter(|r| r.0.is_some()).count(), points);
     summary
@@ -1318,7 +1318,7 @@ fn a_long_turning_move_is_cut_into_the_pieces_it_needs() {
     };
     let whole = off_chord(&rows[0].2, &rows[rows.len() - 1].2);
     assert!(whole > 4.0 && whole < 6.0, "{whole}");
-    let needed = (whole / kinpost::DEFAULT_LINTOL_MM).sqrt();
+    let needed = (whole / kinpost_post::DEFAULT_LINTOL_MM).sqrt();
     let pieces = rows.len() - 1;
     assert_eq!(summary.planning.inserted_blocks as usize, pieces - 1);
     assert!(
@@ -1327,7 +1327,7 @@ fn a_long_turning_move_is_cut_into_the_pieces_it_needs() {
     );
     for w in rows.windows(2) {
         let d = off_chord(&w[0].2, &w[1].2);
-        assert!(d <= kinpost::DEFAULT_LINTOL_MM, "{d}");
+        assert!(d <= kinpost_post::DEFAULT_LINTOL_MM, "{d}");
     }
     // Equal pieces along the CL segment.
     let points: Vec<_> = rows.iter().map(|r| kin.fk(&r.2).point).collect();
@@ -1360,7 +1360,7 @@ fn inverse_time_feed_words_are_the_same_in_every_dialect() {
         );
     }
     let options = PostOptions {
-        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        feed_mode: Some(kinpost_post::FeedMode::InverseTime),
         lintol_mm: Some(0.0),
         ..Default::default()
     };
@@ -1388,7 +1388,7 @@ fn inverse_time_feed_words_are_the_same_in_every_dialect() {
                 GOTO/-400.0000,60.0000,5.0000,0.0000000,0.0000000,1.0000000\n\
                 GOTO/-399.9500,60.0000,5.0000,0.5000000,0.0000000,0.8660254\n";
     let options = PostOptions {
-        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        feed_mode: Some(kinpost_post::FeedMode::InverseTime),
         ..Default::default()
     };
     let (_, summary) = post_csv(&m, fast, &options).unwrap();

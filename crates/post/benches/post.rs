@@ -3,7 +3,7 @@
 //! points per second on one core). Figures go to BENCHMARKS.md.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use kinpost::{PostOptions, post};
+use kinpost_post::{PostOptions, post};
 
 mod cl_gen;
 use cl_gen::generate_cl;
@@ -11,8 +11,8 @@ use cl_gen::generate_cl;
 fn bench(c: &mut Criterion) {
     let points = 1_000_000;
     let cl = generate_cl(points);
-    let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let mut group = c.benchmark_group("post");
     group.sample_size(10);
     group.throughput(Throughput::Elements(points as u64));
@@ -20,7 +20,7 @@ fn bench(c: &mut Criterion) {
     // run without linearization is the foundation's pipeline (issue 4: the
     // planned run stays within 2× of it).
     let point_by_point = PostOptions {
-        planner: kinpost::PlannerMode::Nearest,
+        planner: kinpost_post::PlannerMode::Nearest,
         lintol_mm: Some(0.0),
         ..PostOptions::default()
     };

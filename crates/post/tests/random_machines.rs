@@ -3,8 +3,8 @@
 //! the CL within the closed-loop tolerance. Machines, paths and the reading
 //! of the CSV are all made here, independently of the post.
 
-use kinpost::machine::{Kinematics, Machine, Side, machine_from_toml};
-use kinpost::{PostOptions, post};
+use kinpost_post::machine::{Kinematics, Machine, Side, machine_from_toml};
+use kinpost_post::{PostOptions, post};
 use nalgebra::Vector3;
 use proptest::prelude::*;
 
@@ -129,7 +129,7 @@ fn posts_within_tolerance(seed: u64, lintol_mm: Option<f64>) -> Result<(), TestC
         ));
         poses.push(p);
     }
-    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
     let mut out = Vec::new();
     let options = PostOptions {
         lintol_mm,

@@ -1,6 +1,6 @@
 //! Test jobs shared by the golden and tool-centre-point tests.
 
-use kinpost::machine::{Kinematics, Machine};
+use kinpost_post::machine::{Kinematics, Machine};
 
 /// Joint values a fraction `t` of the way between two corners well inside
 /// the travel (23 % and 64 % of each range, rotary ranges cut to ±150° so

@@ -16,21 +16,21 @@ fn main() {
         .and_then(|a| a.parse().ok())
         .unwrap_or(1_000_000);
     let options = match std::env::args().nth(2).as_deref() {
-        Some("point-by-point") => kinpost::PostOptions {
-            planner: kinpost::PlannerMode::Nearest,
+        Some("point-by-point") => kinpost_post::PostOptions {
+            planner: kinpost_post::PlannerMode::Nearest,
             lintol_mm: Some(0.0),
             ..Default::default()
         },
-        _ => kinpost::PostOptions::default(),
+        _ => kinpost_post::PostOptions::default(),
     };
     let cl = match file {
         Some(path) => std::fs::read_to_string(path).expect("a readable CL file"),
         None => cl_gen::generate_cl(points),
     };
-    let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let summary =
-        kinpost::post(cl.as_bytes(), &machine, &dialect, std::io::sink(), &options).unwrap();
+        kinpost_post::post(cl.as_bytes(), &machine, &dialect, std::io::sink(), &options).unwrap();
     eprintln!(
         "{} points, {} blocks in {:.3} s: {:.2} M points/s",
         summary.cl_points,

@@ -1,12 +1,12 @@
 //! 6-axis output: on the mts1600, CL points with a reference direction free
 //! the C axis (locked at 0 for 5-axis CL, as in seed 000).
 
-use kinpost::machine::{Kinematics, builtin};
-use kinpost::{PostOptions, post};
+use kinpost_post::machine::{Kinematics, builtin};
+use kinpost_post::{PostOptions, post};
 
-fn post_csv(cl: &str) -> Result<String, kinpost::PostError> {
+fn post_csv(cl: &str) -> Result<String, kinpost_post::PostError> {
     let machine = builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
     let mut out = Vec::new();
     post(
         cl.as_bytes(),
@@ -66,7 +66,7 @@ fn references_drive_the_c_axis_and_the_check_covers_them() {
 #[test]
 fn sinumerik_writes_c_only_in_six_axis_programs() {
     let machine = builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let run = |cl: &str| {
         let mut out = Vec::new();
         post(
@@ -114,7 +114,7 @@ fn mixing_five_and_six_axis_points_is_an_error_naming_the_line() {
 /// message.
 fn warnings(machine: &str, cl: &str) -> Vec<(usize, String)> {
     let machine = builtin::load(machine).unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
     let summary = post(
         cl.as_bytes(),
         &machine,

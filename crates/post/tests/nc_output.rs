@@ -1,9 +1,9 @@
 //! What the NC writer cannot write is an error naming the CL statement it
 //! comes from.
 
-use kinpost::machine::builtin;
-use kinpost::nc::Dialect;
-use kinpost::{PostError, PostOptions, post};
+use kinpost_post::machine::builtin;
+use kinpost_post::nc::Dialect;
+use kinpost_post::{PostError, PostOptions, post};
 
 /// A built-in dialect with one line of its file replaced.
 fn dialect_with(name: &str, key: &str, line: &str) -> Dialect {
@@ -28,7 +28,7 @@ fn post_on_trunnion(dialect: &Dialect, cl: &str) -> Result<String, PostError> {
     Ok(String::from_utf8(out).unwrap())
 }
 
-fn post_error(dialect: &Dialect, cl: &str) -> kinpost::nc::Diagnostic {
+fn post_error(dialect: &Dialect, cl: &str) -> kinpost_post::nc::Diagnostic {
     match post_on_trunnion(dialect, cl) {
         Err(PostError::Input(d)) => *d,
         Err(e) => panic!("not an input error: {e}"),

@@ -1,4 +1,4 @@
-//! kinpost: an open multi-axis CNC post-processor.
+//! The kinpost post-processor as a library.
 //!
 //! CL data (NX CLSF / APT) is read as a stream of statements
 //! ([`cl`]), every tool pose is solved through the machine's kinematic chain
@@ -8,9 +8,9 @@
 //! compared with its CL pose ([`check`]).
 //!
 //! ```
-//! use kinpost::{post, PostOptions};
-//! let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
-//! let dialect = kinpost::nc::Dialect::builtin("csv").unwrap();
+//! use kinpost_post::{post, PostOptions};
+//! let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+//! let dialect = kinpost_post::nc::Dialect::builtin("csv").unwrap();
 //! let cl = "RAPID\nGOTO/-416,70.5,16.53,0,0,1\nFEDRAT/MMPM,250\nGOTO/-416,70.3931,11.3684\n";
 //! let mut nc = Vec::new();
 //! let options = PostOptions { cl_file: "flat.cls".into(), ..Default::default() };
@@ -22,13 +22,11 @@
 pub mod check;
 mod emit;
 mod machine_templates;
-pub mod output;
 mod path;
 mod post;
 mod pressure;
 mod solve;
 pub mod summary;
-pub mod wheel;
 
 pub use kinpost_cl as cl;
 pub use kinpost_diag as diag;

@@ -2,7 +2,7 @@
 //! built-in `mts1600` to the feed moves printed in Figure 28(b), to the last
 //! printed decimal, with its two defects reported as warnings.
 
-use kinpost::{PostOptions, post};
+use kinpost_post::{PostOptions, post};
 
 fn data(path: &str) -> String {
     let p = format!("{}/../../data/{path}", env!("CARGO_MANIFEST_DIR"));
@@ -22,8 +22,8 @@ fn figure28_posts_to_the_printed_program() {
     .unwrap();
     assert_eq!(example, cl);
 
-    let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin(machine.post.dialect.as_deref().unwrap()).unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin(machine.post.dialect.as_deref().unwrap()).unwrap();
     let mut out = Vec::new();
     let options = PostOptions {
         cl_file: "figure28a-verbatim.cls".into(),
@@ -66,8 +66,8 @@ fn figure28_posts_to_the_printed_program() {
 #[test]
 fn same_input_same_bytes() {
     let cl = data("qiao2022/figure28a-verbatim.cls");
-    let machine = kinpost::machine::builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost::nc::Dialect::builtin("sinumerik").unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let run = || {
         let mut out = Vec::new();
         post(

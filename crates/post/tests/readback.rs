@@ -5,9 +5,9 @@
 
 mod common;
 
-use kinpost::machine::{Kinematics, OutputMode, Pose, builtin};
-use kinpost::nc::{Dialect, read_program};
-use kinpost::{PostOptions, post};
+use kinpost_post::machine::{Kinematics, OutputMode, Pose, builtin};
+use kinpost_post::nc::{Dialect, read_program};
+use kinpost_post::{PostOptions, post};
 use nalgebra::Vector3;
 
 /// The CL poses of a job, in order, as the reader sees them.
@@ -32,7 +32,7 @@ fn every_dialect_reads_back_onto_the_cl() {
         let kin = Kinematics::new(&machine);
         let cl = common::job(&machine);
         let poses = cl_poses(&cl);
-        let axes = kinpost::axis_specs(&machine);
+        let axes = kinpost_post::axis_specs(&machine);
         for dialect_name in Dialect::builtin_names() {
             let dialect = Dialect::builtin(dialect_name).unwrap();
             for output in [OutputMode::Joint, OutputMode::Tcp] {

@@ -116,14 +116,14 @@ pub fn random_body(rng: &mut Rng, name: &str, linear: [Vector3<f64>; 3], limits:
 /// and points the nearest axis it can, off by no more than the (default)
 /// cone, and it reports every such point in a stretch; elsewhere nothing.
 #[allow(dead_code)]
-pub fn singular_allowance(summary: &kinpost::Summary, line: usize) -> f64 {
+pub fn singular_allowance(summary: &kinpost_post::Summary, line: usize) -> f64 {
     let held = summary
         .planning
         .singular_stretches
         .iter()
         .any(|s| (s.first_line..=s.last_line).contains(&line));
     if held {
-        kinpost::DEFAULT_SINGULAR_CONE_DEG.to_radians()
+        kinpost_post::DEFAULT_SINGULAR_CONE_DEG.to_radians()
     } else {
         0.0
     }

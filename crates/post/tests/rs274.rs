@@ -18,9 +18,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use kinpost::machine::{Kinematics, Machine, builtin, machine_from_toml};
-use kinpost::nc::Dialect;
-use kinpost::{PostOptions, post};
+use kinpost_post::machine::{Kinematics, Machine, builtin, machine_from_toml};
+use kinpost_post::nc::Dialect;
+use kinpost_post::{PostOptions, post};
 
 /// The axis letters rs274 prints, in its order.
 const RS274_AXES: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
@@ -238,9 +238,9 @@ fn compare(rs274: &Path, machine: &Machine, cl: &str, cl_file: &str) -> usize {
     // exact value), plus float noise.
     let decimals = |d: &Dialect, rotary: bool| {
         let spec = if rotary {
-            kinpost::nc::AxisSpec::rotary("A")
+            kinpost_post::nc::AxisSpec::rotary("A")
         } else {
-            kinpost::nc::AxisSpec::linear("X")
+            kinpost_post::nc::AxisSpec::linear("X")
         };
         d.word_format(&spec).number.decimals
     };
@@ -582,7 +582,7 @@ fn inverse_time_block_times_are_the_cl_times() {
     let dialect = Dialect::builtin("linuxcnc").unwrap();
     let mut out = Vec::new();
     let options = PostOptions {
-        feed_mode: Some(kinpost::FeedMode::InverseTime),
+        feed_mode: Some(kinpost_post::FeedMode::InverseTime),
         ..PostOptions::default()
     };
     post(cl.as_bytes(), &machine, &dialect, &mut out, &options).unwrap();

@@ -12,9 +12,9 @@
 mod common;
 
 use common::job;
-use kinpost::machine::builtin;
-use kinpost::nc::Dialect;
-use kinpost::{PostOptions, post};
+use kinpost_post::machine::builtin;
+use kinpost_post::nc::Dialect;
+use kinpost_post::{PostOptions, post};
 
 #[test]
 fn every_machine_in_every_dialect() {
