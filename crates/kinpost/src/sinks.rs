@@ -5,8 +5,8 @@
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
 use crate::output::{AtomicFile, Finished};
+use anyhow::{Context, Result};
 
 use crate::usage;
 

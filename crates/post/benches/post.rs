@@ -11,7 +11,9 @@ use cl_gen::generate_cl;
 fn bench(c: &mut Criterion) {
     let points = 1_000_000;
     let cl = generate_cl(points);
-    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600")
+        .unwrap()
+        .unwrap();
     let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let mut group = c.benchmark_group("post");
     group.sample_size(10);

@@ -27,7 +27,9 @@ fn main() {
         Some(path) => std::fs::read_to_string(path).expect("a readable CL file"),
         None => cl_gen::generate_cl(points),
     };
-    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600")
+        .unwrap()
+        .unwrap();
     let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let summary =
         kinpost_post::post(cl.as_bytes(), &machine, &dialect, std::io::sink(), &options).unwrap();

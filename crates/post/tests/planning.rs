@@ -868,7 +868,11 @@ fn feed_words_give_the_cl_time_and_slow_down_to_max_velocity() {
 }
 
 /// Posts `cl` on the built-in trunnion to `dialect` without linearization.
-fn post_trunnion(cl: &str, dialect: &str, mode: kinpost_post::FeedMode) -> Result<String, PostError> {
+fn post_trunnion(
+    cl: &str,
+    dialect: &str,
+    mode: kinpost_post::FeedMode,
+) -> Result<String, PostError> {
     let m = builtin::load("trunnion-ac").unwrap().unwrap();
     let dialect = Dialect::builtin(dialect).unwrap();
     let options = PostOptions {
@@ -1014,7 +1018,10 @@ fn deciding_point_by_point_keeps_the_branch_it_is_on() {
             &Vector3::new(t.sin(), 0.0, t.cos()),
         ));
     }
-    for planner in [kinpost_post::PlannerMode::Global, kinpost_post::PlannerMode::Nearest] {
+    for planner in [
+        kinpost_post::PlannerMode::Global,
+        kinpost_post::PlannerMode::Nearest,
+    ] {
         let options = PostOptions {
             planner,
             ..Default::default()

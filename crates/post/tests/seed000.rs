@@ -6,8 +6,7 @@ use kinpost_post::{PostOptions, post};
 
 fn data(path: &str) -> String {
     let p = format!("{}/../../data/{path}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&p)
-        .unwrap_or_else(|e| panic!("{p}: {e} (data/ of the repository)"))
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e} (data/ of the repository)"))
 }
 
 #[test]
@@ -22,8 +21,11 @@ fn figure28_posts_to_the_printed_program() {
     .unwrap();
     assert_eq!(example, cl);
 
-    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
-    let dialect = kinpost_post::nc::Dialect::builtin(machine.post.dialect.as_deref().unwrap()).unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600")
+        .unwrap()
+        .unwrap();
+    let dialect =
+        kinpost_post::nc::Dialect::builtin(machine.post.dialect.as_deref().unwrap()).unwrap();
     let mut out = Vec::new();
     let options = PostOptions {
         cl_file: "figure28a-verbatim.cls".into(),
@@ -66,7 +68,9 @@ fn figure28_posts_to_the_printed_program() {
 #[test]
 fn same_input_same_bytes() {
     let cl = data("qiao2022/figure28a-verbatim.cls");
-    let machine = kinpost_post::machine::builtin::load("mts1600").unwrap().unwrap();
+    let machine = kinpost_post::machine::builtin::load("mts1600")
+        .unwrap()
+        .unwrap();
     let dialect = kinpost_post::nc::Dialect::builtin("sinumerik").unwrap();
     let run = || {
         let mut out = Vec::new();
