@@ -15,7 +15,10 @@
 
 use std::fmt;
 
+mod site;
 pub mod toml_names;
+
+pub use site::{Located, Site};
 
 /// How bad a diagnostic is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -12,7 +12,7 @@ use kinpost_post::machine::{
     Kinematics, MAX_AXIS_ROUNDING_RAD, Machine, OutputMode, Pose, builtin, machine_from_toml,
 };
 use kinpost_post::nc::Dialect;
-use kinpost_post::{FeedMode, PlannerMode, PostError, PostOptions};
+use kinpost_post::{Config, FeedMode, PlannerMode, PostOptions};
 use nalgebra::Vector3;
 
 /// `eprintln!` that does not panic when standard error is gone (its reader
@@ -577,30 +577,13 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
-        pressure: args.pressure.map(check_pressure_value).transpose()?,
+        pressure: args.pressure,
         no_pressure_compensation: args.no_pressure_compensation,
-        axis_rounding_rad: args.axis_rounding.map(check_axis_rounding).transpose()?,
+        axis_rounding_rad: args.axis_rounding,
     };
-    if !(args.lintol.is_finite() && args.lintol >= 0.0) {
-        return Err(usage("--lintol must be a distance of 0 or more (mm)"));
-    }
-    if let Some(c) = args.singular_cone
-        && !(c.is_finite() && (0.0..45.0).contains(&c))
-    {
-        return Err(usage(
-            "--singular-cone must be an angle from 0 to less than 45 degrees",
-        ));
-    }
-    if let Some(r) = args.retract
-        && !(r.is_finite() && r > 0.0)
-    {
-        return Err(usage("--retract must be a distance greater than zero (mm)"));
-    }
-    if let Some(t) = args.tolerance
-        && !(t.is_finite() && t > 0.0)
-    {
-        return Err(usage("--tolerance must be a positive number of mm"));
-    }
+    // Every option value checked in one place, the library's: a bad one is
+    // a usage error.
+    let config = Config::resolve(&options, &machine, &dialect).map_err(|e| usage(e.to_string()))?;
     let progress = progress_bar(&args);
     let input: Box<dyn BufRead> = if args.input == "-" {
         Box::new(BufReader::with_capacity(1 << 16, io::stdin().lock()))
@@ -624,14 +607,16 @@ fn post(args: PostArgs) -> Result<()> {
         ))
     };
 
-    let result = kinpost_post::post(input, &machine, &dialect, &mut sinks[0], &options);
+    let result = kinpost_post::post_with(input, &machine, &dialect, &mut sinks[0], &config);
     if let Some(bar) = &progress {
         bar.finish_and_clear();
     }
     let summary = match result {
         Ok(s) => s,
-        Err(PostError::Input(d)) => return Err(report(d)),
-        Err(e) => return Err(e.into()),
+        Err(e) => match e.diagnostic() {
+            Some(d) => return Err(report(d)),
+            None => return Err(e.into()),
+        },
     };
     if let Some(json) = sinks.get_mut(1) {
         json.write_all(summary.to_json().as_bytes())
@@ -851,7 +836,7 @@ fn ik(
     }
     let mut sols = Vec::new();
     kin.ik_all_branches(&pose, None, &mut sols)
-        .map_err(|e| anyhow!("no solution: {}", kin.ik_error_text(e, &pose.axis)))?;
+        .map_err(|e| anyhow!("no solution: {}", kin.ik_failure(e, &pose.axis)))?;
     let names: Vec<String> = m.axes.iter().map(|a| format!("{:>12}", a.name)).collect();
     writeln!(out, "branch {}  status", names.join(""))?;
     for s in &sols {

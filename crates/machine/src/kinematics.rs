@@ -46,7 +46,7 @@ mod chord;
 mod reach;
 mod singular;
 pub use chord::{lever_over, midpoint_bound};
-pub use reach::{AXIS_ROUNDING_RAD, MAX_AXIS_ROUNDING_RAD};
+pub use reach::{AXIS_ROUNDING_RAD, IkFailure, MAX_AXIS_ROUNDING_RAD};
 pub use singular::{Excursion, Folds, Singularity};
 
 use crate::model::{AxisKind, MAX_AXES, Machine, Pose, Side};

@@ -14,18 +14,23 @@
 //! ```
 
 pub mod angle;
+mod at_pressure;
 pub use angle::angle_between;
 pub mod builtin;
+mod describe;
 mod file;
 mod kinematics;
 mod model;
 mod pressure;
 pub mod subproblems;
+pub mod tolerance;
 
+pub use at_pressure::KinematicsAtPressure;
+pub use describe::Mm;
 pub use file::machine_from_toml;
 pub use kinematics::{
-    AXIS_ROUNDING_RAD, Excursion, Folds, IkError, Joints, Kinematics, MAX_AXIS_ROUNDING_RAD,
-    Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,
+    AXIS_ROUNDING_RAD, Excursion, Folds, IkError, IkFailure, Joints, Kinematics,
+    MAX_AXIS_ROUNDING_RAD, Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,
 };
 pub use model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,

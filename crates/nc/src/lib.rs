@@ -298,6 +298,103 @@ impl From<std::io::Error> for NcError {
     }
 }
 
+/// Why a motion block cannot be written.
+#[derive(Debug)]
+pub enum BlockError {
+    /// The block has another number of values than the writer has axes.
+    AxisCount {
+        /// Values in the block.
+        got: usize,
+        /// Axes of the writer.
+        want: usize,
+    },
+    /// A value that is not finite, or too large for the word's format.
+    Value {
+        /// The word's axis name, or `feed`.
+        word: String,
+        /// The value.
+        value: f64,
+        /// Why it cannot be written.
+        error: NumberError,
+    },
+    /// The block's line is longer than the dialect's `max_line_length`.
+    TooLong {
+        /// The line, without its line end.
+        text: String,
+        /// The CL line of the block (`None`: a block the post added).
+        cl_line: Option<usize>,
+        /// Its length in bytes, line end included.
+        length: usize,
+        /// The dialect's `max_line_length`.
+        max: usize,
+    },
+    /// A pressure is programmed, and the dialect has no pressure word.
+    NoPressureWord {
+        /// The dialect.
+        dialect: String,
+        /// The machine's pressure word.
+        word: String,
+    },
+    /// The dialect's `pressure` template, written with a new pressure word,
+    /// failed.
+    Template(NcError),
+    /// Writing failed.
+    Io(std::io::Error),
+}
+
+impl std::fmt::Display for BlockError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BlockError::AxisCount { got, want } => {
+                write!(
+                    f,
+                    "block has {got} axis values, the machine has {want} axes"
+                )
+            }
+            BlockError::Value { word, value, error } => {
+                write!(f, "cannot write {word} = {value}: {error}")
+            }
+            BlockError::TooLong {
+                text,
+                cl_line,
+                length,
+                max,
+            } => {
+                write!(f, "the line `{text}` for ")?;
+                match cl_line {
+                    Some(l) => write!(f, "CL line {l}")?,
+                    None => f.write_str("a block the post added")?,
+                }
+                write!(
+                    f,
+                    " has {length} bytes with its line end, more than the dialect's max_line_length of {max}"
+                )
+            }
+            BlockError::NoPressureWord { dialect, word } => write!(
+                f,
+                "dialect `{dialect}` cannot write the pressure word `{word}`: it has no [pressure] table"
+            ),
+            BlockError::Template(e) => e.fmt(f),
+            BlockError::Io(e) => write!(f, "cannot write the NC program: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for BlockError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            BlockError::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<std::io::Error> for BlockError {
+    fn from(e: std::io::Error) -> Self {
+        BlockError::Io(e)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

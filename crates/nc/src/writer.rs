@@ -9,7 +9,7 @@ use minijinja::{Environment, Value};
 use crate::dialect::{CommentSyntax, Dialect, DialectKind, Numbering, TemplateKind};
 use crate::number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 use crate::template;
-use crate::{AxisSpec, Block, Motion, NcError, ProgramInfo};
+use crate::{AxisSpec, Block, BlockError, Motion, NcError, ProgramInfo};
 
 /// Spindle state for [`NcWriter::spindle`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -759,49 +759,39 @@ impl<W: Write> NcWriter<W> {
 
     /// The line in `self.line` is longer than `max_line_length`.
     #[cold]
-    fn too_long(&self, cl_line: Option<usize>) -> io::Error {
-        let text = String::from_utf8_lossy(self.line.as_slice());
-        let of = cl_line.map_or_else(
-            || "a block the post added".into(),
-            |l| format!("CL line {l}"),
-        );
-        io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "the line `{}` for {of} has {} bytes with its line end, more than the dialect's \
-                 max_line_length of {}",
-                text.trim_end(),
-                self.line.len,
-                self.max_line
-            ),
-        )
+    fn too_long(&self, cl_line: Option<usize>) -> BlockError {
+        BlockError::TooLong {
+            text: String::from_utf8_lossy(self.line.as_slice())
+                .trim_end()
+                .to_string(),
+            cl_line,
+            length: self.line.len,
+            max: self.max_line,
+        }
     }
 
-    fn bad_value(&self, axis: usize, value: f64, e: crate::NumberError) -> io::Error {
-        let name = self.names.get(axis).map_or("feed", String::as_str);
-        io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!("cannot write {name} = {value}: {e}"),
-        )
+    fn bad_value(&self, axis: usize, value: f64, error: crate::NumberError) -> BlockError {
+        BlockError::Value {
+            word: self.names.get(axis).map_or("feed", String::as_str).into(),
+            value,
+            error,
+        }
     }
 
     /// Writes one motion block. Modal words that did not change are left
     /// out; a block in which no axis word would be written is skipped
     /// entirely (with non-modal axis words every block is written; a CSV
     /// row is written for every block).
-    /// Fails (`InvalidInput`) for a wrong number of axis values, or a value
-    /// that is not finite or too large to write.
+    /// Fails for a wrong number of axis values, a value that is not finite
+    /// or too large to write, a line longer than the dialect allows, or the
+    /// output.
     #[inline]
-    pub fn block(&mut self, block: &Block) -> io::Result<()> {
+    pub fn block(&mut self, block: &Block) -> Result<(), BlockError> {
         if block.axes.len() != self.formats.len() {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!(
-                    "block has {} axis values, the machine has {} axes",
-                    block.axes.len(),
-                    self.formats.len()
-                ),
-            ));
+            return Err(BlockError::AxisCount {
+                got: block.axes.len(),
+                want: self.formats.len(),
+            });
         }
         if self.kind == DialectKind::Csv {
             return self.csv_block(block);
@@ -895,7 +885,7 @@ impl<W: Write> NcWriter<W> {
             return Err(self.too_long(block.cl_line));
         }
         self.blocks += 1;
-        self.out.write_all(self.line.as_slice())
+        Ok(self.out.write_all(self.line.as_slice())?)
     }
 
     /// Starts the motion block line: empty, or the block number when
@@ -918,7 +908,7 @@ impl<W: Write> NcWriter<W> {
     /// looked up. Nothing changes (the block number included) when a value
     /// cannot be written.
     #[inline(always)]
-    fn plain_block(&mut self, block: &Block) -> io::Result<()> {
+    fn plain_block(&mut self, block: &Block) -> Result<(), BlockError> {
         let write_motion = !self.motion_word(block.motion).is_empty()
             && (!self.motion_modal || self.motion_state != Some(block.motion));
         let number_before = self.next_number;
@@ -983,7 +973,7 @@ impl<W: Write> NcWriter<W> {
         }
         self.motion_state = Some(block.motion);
         self.blocks += 1;
-        self.out.write_all(self.line.as_slice())
+        Ok(self.out.write_all(self.line.as_slice())?)
     }
 
     /// The units of feed value `f`, remembered while it does not change.
@@ -1013,7 +1003,7 @@ impl<W: Write> NcWriter<W> {
     /// The pressure word on its own line, when the block's pressure differs
     /// from the last one written (then the `pressure` template, if any, e.g.
     /// a dwell while the wheel settles). NaN: no pressure programmed.
-    fn pressure_line(&mut self, block: &Block) -> io::Result<()> {
+    fn pressure_line(&mut self, block: &Block) -> Result<(), BlockError> {
         let Some(p) = &self.pressure else {
             return Ok(());
         };
@@ -1022,13 +1012,10 @@ impl<W: Write> NcWriter<W> {
             return Ok(());
         }
         if !p.writable {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!(
-                    "dialect `{}` cannot write the pressure word `{}`: it has no [pressure] table",
-                    self.dialect_name, p.name
-                ),
-            ));
+            return Err(BlockError::NoPressureWord {
+                dialect: self.dialect_name.clone(),
+                word: p.name.clone(),
+            });
         }
         let n = match p.word.fmt.units(value) {
             Ok(n) => n,
@@ -1063,8 +1050,8 @@ impl<W: Write> NcWriter<W> {
             vec![("pressure", Value::from(written)), ("pressure_word", name)],
         )
         .map_err(|e| match e {
-            NcError::Io(e) => e,
-            other => io::Error::other(other.to_string()),
+            NcError::Io(e) => BlockError::Io(e),
+            other => BlockError::Template(other),
         })
     }
 
@@ -1091,7 +1078,7 @@ impl<W: Write> NcWriter<W> {
         self.out.write_all(&self.buf)
     }
 
-    fn csv_block(&mut self, block: &Block) -> io::Result<()> {
+    fn csv_block(&mut self, block: &Block) -> Result<(), BlockError> {
         if !self.csv_header_done {
             self.csv_header()?;
         }
@@ -1148,7 +1135,7 @@ impl<W: Write> NcWriter<W> {
             return Err(self.too_long(block.cl_line));
         }
         self.blocks += 1;
-        self.out.write_all(self.line.as_slice())
+        Ok(self.out.write_all(self.line.as_slice())?)
     }
 
     /// Flushes and returns the output.

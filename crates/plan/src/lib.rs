@@ -11,15 +11,29 @@
 //! retract and reconfigure. A lag of 1 decides point by point, as simple
 //! posts do.
 //!
-//! Points whose tool axis lies within the singular cone are not candidates
-//! here: the caller solves them between the decided neighbours (exactly
-//! where no axis swings, else with the singular angle held and
-//! interpolated) and links the neighbours with `across_singular`.
+//! The [`Planner`] is the post's planning stage around the trellis: CL
+//! points and the commands between them wait in it until it decides; points
+//! whose tool axis lies within the singular cone are not candidates of the
+//! trellis but are solved between their decided neighbours (exactly where
+//! no axis swings, else with the singular angle held and interpolated), and
+//! the neighbours are linked with `across_singular`; folds of machines that
+//! reach only a band of tool axes are crossed where the tool axis reaches
+//! them. Every decided point goes to a [`PlanSink`] as a [`Node`] (the
+//! configuration and the pose it reaches), the commands in their places.
+//! [`solve_near`] solves a pose near a known configuration, for the
+//! planner and for the points the later stages insert.
 
 mod cost;
+mod node;
+mod planner;
+mod pole;
+mod solve;
 mod trellis;
 
 pub use cost::{Costs, Link, STEP_CEILING_DEG};
+pub use node::Node;
+pub use planner::{PathPoint, PlanError, PlanSink, Planned, Planner, SingularStretch};
+pub use solve::{Hold, Near, interpolate, solve_near};
 pub use trellis::{Choice, RECONFIGURE, Trellis, UNCUT};
 
 use kinpost_machine::{Solution, Violation};

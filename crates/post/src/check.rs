@@ -1,9 +1,42 @@
-//! The closed-loop check: every block, with its values exactly as written, is
-//! run back through the forward kinematics and compared with the CL pose it
-//! was made from.
+//! The closed-loop check: every block, with its values exactly as written,
+//! is run back through the forward kinematics and compared with the CL
+//! pose it was made from. The [`Check`] stage wraps any [`BlockSink`] (the
+//! NC writer): it asks the sink how it rounds the values, checks them, and
+//! hands the block on only when it passes.
 
+use kinpost_machine::angle::SinCosMemo;
 pub use kinpost_machine::angle_between;
-use kinpost_machine::{Kinematics, Machine, Pose};
+use kinpost_machine::tolerance::{
+    CHECK_SLACK_MM, CHECK_SLACK_RAD, LEVER_PROBE_DEG, REFERENCE_NORMAL_MIN, SECOND_ORDER_MARGIN,
+};
+use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, lever_over};
+use kinpost_nc::{Block, BlockError};
+use nalgebra::Vector3;
+
+use crate::command::Pending;
+use crate::error::{CheckError, PostError};
+use crate::motion::{MotionBlock, MotionSink};
+
+/// Where the blocks of a program go, once checked: the NC writer, or a
+/// test's list ([`Recorded`](crate::Recorded)).
+pub trait BlockSink {
+    /// `values` (the first `values.len()` machine axes) as this sink writes
+    /// them, into `written`: the closed-loop check runs on these.
+    fn round(&mut self, values: &[f64], written: &mut [f64]);
+
+    /// A motion block: the machine's axis values (and its pressure, if it
+    /// has a pressure axis) exactly as they were checked.
+    fn block(&mut self, block: &Block) -> Result<(), BlockError>;
+
+    /// A command, in its place among the blocks.
+    fn command(&mut self, pending: Pending) -> Result<(), PostError>;
+
+    /// Inverse-time feed on (`G93`) or off (`G94`).
+    fn inverse_time(&mut self, on: bool) -> Result<(), PostError>;
+
+    /// Whether a feed word of `word` writes as 0.
+    fn feed_rounds_to_zero(&self, word: f64) -> bool;
+}
 
 /// How far a block may put the tool from its CL pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,7 +79,7 @@ impl Tolerance {
         resolution: impl Fn(usize) -> f64,
     ) -> Tolerance {
         let mut probe = q.to_vec();
-        let h = 1e-3; // degrees
+        let h = LEVER_PROBE_DEG;
         let t = Self::with_levers(machine, resolution, |i| {
             probe[i] = q[i] + h;
             let plus = kin.fk(&probe).point;
@@ -56,7 +89,7 @@ impl Tolerance {
             (plus - minus).norm() / (2.0 * h).to_radians()
         });
         Tolerance {
-            position_mm: 1.5 * t.position_mm,
+            position_mm: SECOND_ORDER_MARGIN * t.position_mm,
             axis_rad: t.axis_rad,
         }
     }
@@ -81,10 +114,10 @@ impl Tolerance {
                 position += half;
             }
         }
-        // Slack for the arithmetic itself (1e-9 mm / rad).
+        // Slack for the arithmetic itself.
         Tolerance {
-            position_mm: position + 1e-9,
-            axis_rad: axis + 1e-9,
+            position_mm: position + CHECK_SLACK_MM,
+            axis_rad: axis + CHECK_SLACK_RAD,
         }
     }
 }
@@ -107,9 +140,12 @@ pub fn reference_error(want: &Pose, got: &Pose) -> f64 {
     let (Some(a), Some(b)) = (&want.reference, &got.reference) else {
         return 0.0;
     };
-    let normal = |r: &nalgebra::Vector3<f64>, axis: &nalgebra::Vector3<f64>| r - axis * r.dot(axis);
+    let normal = |r: &Vector3<f64>, axis: &Vector3<f64>| r - axis * r.dot(axis);
     let (a, b) = (normal(a, &want.axis), normal(b, &got.axis));
-    match (a.try_normalize(1e-12), b.try_normalize(1e-12)) {
+    match (
+        a.try_normalize(REFERENCE_NORMAL_MIN),
+        b.try_normalize(REFERENCE_NORMAL_MIN),
+    ) {
         (Some(a), Some(b)) => angle_between(&a, &b),
         // A reference along the tool axis gives no direction to compare.
         _ => 0.0,
@@ -119,7 +155,10 @@ pub fn reference_error(want: &Pose, got: &Pose) -> f64 {
 /// Running maxima of the check.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CheckStats {
+    /// Largest distance of a block's tool point from its CL point, mm.
     pub max_position_error_mm: f64,
+    /// Largest angle of a block's tool axis (or reference) from its CL
+    /// one, radians.
     pub max_axis_error_rad: f64,
     /// CL line of the block with the largest position error.
     pub worst_line: Option<usize>,
@@ -153,6 +192,218 @@ impl CheckStats {
         }
         self.max_position_error_mm <= tolerance.position_mm
             && self.max_axis_error_rad <= tolerance.axis_rad
+    }
+}
+
+/// What the check found, for the summary.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckReport {
+    /// The largest errors and where.
+    pub stats: CheckStats,
+    /// The tolerance in force at the end (it grows for blocks whose CL
+    /// tool axis lies just beyond reach, and, with the derived tolerance,
+    /// for blocks checked at their own levers).
+    pub tolerance: Tolerance,
+    /// Blocks whose CL tool axis lies just outside the directions the
+    /// machine can point, checked against the nearest direction it can.
+    pub beyond_reach_blocks: u64,
+    /// The largest distance of such a CL axis from that direction, radians.
+    pub max_beyond_reach_rad: f64,
+    /// The CL line of the first.
+    pub first_beyond_reach_line: Option<usize>,
+}
+
+/// How the check is set up.
+#[derive(Debug, Clone)]
+pub struct CheckSettings {
+    /// The tolerance (derived from the output decimals, or given).
+    pub tolerance: Tolerance,
+    /// The position tolerance was given: it does not grow.
+    pub tolerance_given: bool,
+    /// Tool-centre-point output: indices of X, Y, Z.
+    pub tcp: Option<[usize; 3]>,
+    /// One unit of the last written decimal, per axis.
+    pub resolution: Vec<f64>,
+}
+
+/// The check stage (see the module's documentation), writing to `S`.
+pub struct Check<S> {
+    sink: S,
+    machine: Machine,
+    settings: CheckSettings,
+    n: usize,
+    has_pressure: bool,
+    /// How far rounding can move the axes, as [`Kinematics::joint_travel`]
+    /// measures it: one unit of the last decimal of every free axis.
+    rounding_travel: (f64, f64),
+    written: Joints,
+    /// The sines and cosines of the written rotary values, for the next
+    /// block's check.
+    sin_cos: SinCosMemo,
+    report: CheckReport,
+}
+
+impl<S: BlockSink> Check<S> {
+    /// The check of `machine`'s blocks (as the program drives it) with
+    /// `settings`, handing them to `sink`.
+    pub fn new(machine: &Machine, settings: CheckSettings, sink: S) -> Self {
+        let axes = &machine.axes;
+        let free = |rotary: bool| {
+            (0..axes.len())
+                .filter(|&i| axes[i].is_free() && axes[i].is_rotary() == rotary)
+                .map(|i| settings.resolution[i])
+                .sum::<f64>()
+        };
+        Check {
+            sink,
+            rounding_travel: (free(true).to_radians(), free(false)),
+            n: axes.len(),
+            has_pressure: machine.pressure.is_some(),
+            machine: machine.clone(),
+            report: CheckReport {
+                stats: CheckStats::default(),
+                tolerance: settings.tolerance,
+                beyond_reach_blocks: 0,
+                max_beyond_reach_rad: 0.0,
+                first_beyond_reach_line: None,
+            },
+            settings,
+            written: [0.0; MAX_AXES],
+            sin_cos: SinCosMemo::default(),
+        }
+    }
+
+    /// The sink, and what the check found.
+    pub fn finish(self) -> (S, CheckReport) {
+        (self.sink, self.report)
+    }
+
+    /// Whether the block `b`, written as `self.written` and reaching
+    /// `reached`, is within the tolerance (growing it where the rules
+    /// allow).
+    fn passes(&mut self, kin: &Kinematics, b: &MotionBlock<'_>, reached: &Pose) -> bool {
+        let tolerance = self.report.tolerance;
+        self.report
+            .stats
+            .record(b.target, reached, b.site.line, &tolerance)
+            || self.within_cl_rounding(kin, b.target, reached, b.site.line)
+            || self.within_block_bound(kin, b.target, reached)
+    }
+
+    /// A CL tool axis just outside the directions the machine can point (CL
+    /// rounding, see [`Kinematics::axis_rounding`]) is solved at the nearest
+    /// one it can point: the block is right if it is within the tolerance
+    /// of that direction. The axis tolerance in force (and reported) grows
+    /// to the block's error (at most that distance more), and the block is
+    /// counted in the report.
+    fn within_cl_rounding(
+        &mut self,
+        kin: &Kinematics,
+        want: &Pose,
+        got: &Pose,
+        line: usize,
+    ) -> bool {
+        let (gap, nearest) = kin.axis_reach(&want.axis);
+        let r = &mut self.report;
+        let t = &mut r.tolerance;
+        if gap == 0.0
+            || gap > kin.axis_rounding()
+            || (want.point - got.point).norm() > t.position_mm
+            || angle_between(&nearest, &got.axis) > t.axis_rad
+            || reference_error(want, got) > t.axis_rad
+        {
+            return false;
+        }
+        t.axis_rad = t.axis_rad.max(pose_error(want, got).1);
+        r.beyond_reach_blocks += 1;
+        r.max_beyond_reach_rad = r.max_beyond_reach_rad.max(gap);
+        r.first_beyond_reach_line.get_or_insert(line);
+        true
+    }
+
+    /// With the derived tolerance, a block beyond the machine-wide bound is
+    /// still right if its error is what rounding causes at its own levers;
+    /// the tolerance in force (and reported) grows to it.
+    fn within_block_bound(&mut self, kin: &Kinematics, want: &Pose, got: &Pose) -> bool {
+        let s = &self.settings;
+        if s.tolerance_given || s.tcp.is_some() {
+            return false;
+        }
+        let resolution = &s.resolution;
+        let block = Tolerance::at_block(&self.machine, kin, &self.written[..self.n], |i| {
+            resolution[i]
+        });
+        let (p, a) = pose_error(want, got);
+        if p > block.position_mm || a > block.axis_rad {
+            return false;
+        }
+        let t = &mut self.report.tolerance;
+        t.position_mm = t.position_mm.max(p);
+        t.axis_rad = t.axis_rad.max(a);
+        true
+    }
+}
+
+impl<S: BlockSink> MotionSink for Check<S> {
+    /// Rounds the block as the sink writes it, runs it through the forward
+    /// kinematics, compares it with its target and hands it on.
+    fn block(&mut self, kin: &Kinematics, b: &MotionBlock<'_>) -> Result<f64, PostError> {
+        let n = self.n;
+        self.sink.round(&b.values[..n], &mut self.written[..n]);
+        let (mut reached, written_lever) = kin.fk_lever(
+            &self.written[..n],
+            &mut self.sin_cos,
+            b.target.reference.is_some(),
+        );
+        // The lever at the exact values, from that at the written ones.
+        let (w, v) = self.rounding_travel;
+        let mut lever = lever_over(written_lever, w, v);
+        if let Some([x, y, z]) = self.settings.tcp {
+            // The controller puts the tool point where the words say; the
+            // orientation comes from the rotary words alone.
+            reached.point = Vector3::new(self.written[x], self.written[y], self.written[z]);
+            lever = f64::INFINITY;
+        }
+        if !self.passes(kin, b, &reached) {
+            let (position_mm, axis_rad) = pose_error(b.target, &reached);
+            let t = &self.report.tolerance;
+            return Err(b
+                .site
+                .locate(CheckError {
+                    position_mm,
+                    axis_rad,
+                    tolerance_mm: t.position_mm,
+                    tolerance_rad: t.axis_rad,
+                    target: *b.target,
+                })
+                .into());
+        }
+        // The pressure column, if any, follows the axes (a copy of fixed
+        // length: no call to memcpy).
+        let mut row = [f64::NAN; MAX_AXES + 1];
+        row[..MAX_AXES].copy_from_slice(b.values);
+        row[n] = b.pressure;
+        self.sink
+            .block(&Block {
+                cl_line: b.cl_line,
+                motion: b.motion,
+                axes: &row[..n + usize::from(self.has_pressure)],
+                feed: b.feed,
+            })
+            .map_err(|e| PostError::from(b.site.locate(e)))?;
+        Ok(lever)
+    }
+
+    fn command(&mut self, pending: Pending) -> Result<(), PostError> {
+        self.sink.command(pending)
+    }
+
+    fn inverse_time(&mut self, on: bool) -> Result<(), PostError> {
+        self.sink.inverse_time(on)
+    }
+
+    fn feed_rounds_to_zero(&self, word: f64) -> bool {
+        self.sink.feed_rounds_to_zero(word)
     }
 }
 

@@ -1,7 +1,13 @@
 //! The summary of a post run, printed on the terminal and written as JSON.
 
 use kinpost_diag::Diagnostic;
+pub use kinpost_plan::SingularStretch;
 use serde::Serialize;
+
+use crate::check::CheckReport;
+use crate::motion::MotionReport;
+pub use crate::motion::Reconfiguration;
+pub use crate::motion::feed::FeedClamp;
 
 /// What a post run did.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,14 +60,17 @@ pub struct Planning {
     /// near the pole, or the interpolated axis passes where the machine
     /// cannot point), and the CL line of the segment.
     pub max_inserted_axis_deviation_deg: f64,
+    /// See `max_inserted_axis_deviation_deg`.
     pub max_inserted_axis_deviation_line: Option<usize>,
     /// Largest change of one rotary axis between two consecutive feed
     /// blocks, degrees, and the CL line of the block.
     pub max_rotary_step_deg: f64,
+    /// See `max_rotary_step_deg`.
     pub max_rotary_step_line: Option<usize>,
     /// Feed blocks slowed down to the axes' maximum velocities (the first
     /// 1000), and how many there were in all.
     pub feed_clamps: Vec<FeedClamp>,
+    /// See `feed_clamps`.
     pub feed_clamp_count: u64,
     /// Blocks whose CL tool axis lies just outside the directions the
     /// machine can point (CL rounding, up to
@@ -70,58 +79,35 @@ pub struct Planning {
     /// can point: how many, the largest distance of such a CL axis from
     /// that direction (rad), and the CL line of the first.
     pub beyond_reach_blocks: u64,
+    /// See `beyond_reach_blocks`.
     pub max_beyond_reach_rad: f64,
+    /// See `beyond_reach_blocks`.
     pub first_beyond_reach_line: Option<usize>,
 }
 
-/// A run of singular CL points.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SingularStretch {
-    pub first_line: usize,
-    pub last_line: usize,
-    /// The axis whose angle is free there.
-    pub axis: String,
-    /// Its value at the first and the last point of the run, degrees.
-    pub from_deg: f64,
-    pub to_deg: f64,
-    /// Largest angle between the CL tool axis and the axis the machine
-    /// points with the angle held, degrees (about the cone at most; see
-    /// README.md).
-    pub max_axis_deviation_deg: f64,
-}
-
-/// A retract and reconfiguration between two CL points of a cut.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Reconfiguration {
-    /// The CL line reached after the reconfiguration.
-    pub line: usize,
-    /// The CL line before it.
-    pub previous_line: Option<usize>,
-    /// The rotary axis with the largest jump, and its values before and after.
-    pub axis: String,
-    pub from_deg: f64,
-    pub to_deg: f64,
-    /// Retract distance along the tool axis, mm.
-    pub retract_mm: f64,
-    /// Length of the CL segment from `previous_line` to `line` that is not
-    /// cut, mm: 0 where the tool re-approaches the previous point in the
-    /// new setting and cuts the segment from there (the usual case); the
-    /// whole segment where the new setting cannot reach the previous point
-    /// or move on from it continuously (the re-approach is then onto
-    /// `line`).
-    pub uncut_mm: f64,
-}
-
-/// A feed block slowed down by an axis's maximum velocity.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FeedClamp {
-    /// CL line of the block (an inserted block gives the line it leads to).
-    pub line: usize,
-    /// The axis that limits the block.
-    pub axis: String,
-    /// Block time as programmed and as written, minutes.
-    pub programmed_min: f64,
-    pub written_min: f64,
+impl Planning {
+    /// The figures of the stages after the program.
+    pub(crate) fn of(
+        stretches: Vec<SingularStretch>,
+        m: MotionReport,
+        c: &CheckReport,
+    ) -> Planning {
+        Planning {
+            singular_stretches: stretches,
+            reconfigurations: m.reconfigurations,
+            inserted_blocks: m.inserted_blocks,
+            max_linearization_error_mm: m.linearization.max_error_mm,
+            max_inserted_axis_deviation_deg: m.linearization.max_axis_deviation_deg,
+            max_inserted_axis_deviation_line: m.linearization.max_axis_deviation_line,
+            max_rotary_step_deg: m.max_rotary_step_deg,
+            max_rotary_step_line: m.max_rotary_step_line,
+            feed_clamps: m.feed_clamps,
+            feed_clamp_count: m.feed_clamp_count,
+            beyond_reach_blocks: c.beyond_reach_blocks,
+            max_beyond_reach_rad: c.max_beyond_reach_rad,
+            first_beyond_reach_line: c.first_beyond_reach_line,
+        }
+    }
 }
 
 #[derive(Serialize)]

@@ -30,8 +30,10 @@ fn post_on_trunnion(dialect: &Dialect, cl: &str) -> Result<String, PostError> {
 
 fn post_error(dialect: &Dialect, cl: &str) -> kinpost_post::nc::Diagnostic {
     match post_on_trunnion(dialect, cl) {
-        Err(PostError::Input(d)) => *d,
-        Err(e) => panic!("not an input error: {e}"),
+        Err(e) => match e.diagnostic() {
+            Some(d) => d.clone(),
+            None => panic!("not an input error: {e}"),
+        },
         Ok(_) => panic!("posted"),
     }
 }

@@ -986,17 +986,27 @@ fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
     // Fanuc's feed word has too few decimals for 0.0001 mm/min: F0.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,0.0001\nGOTO/0,0,10\n";
     let e = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::Tip).unwrap_err();
-    let PostError::Input(d) = e else {
+    let PostError::Motion(located) = &e else {
         panic!("{e}")
     };
+    assert!(matches!(
+        located.error,
+        kinpost_post::MotionError::FeedRoundsToZero { .. }
+    ));
+    let d = e.diagnostic().unwrap();
     assert_eq!(d.line, 4);
     assert!(d.message.contains("rounds to 0"), "{}", d.message);
     // Too large to be written: the CL line, once.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/1e13\nGOTO/0,0,10\n";
     let e = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::Tip).unwrap_err();
-    let PostError::Input(d) = e else {
+    let PostError::Block(located) = &e else {
         panic!("{e}")
     };
+    assert!(matches!(
+        located.error,
+        kinpost_post::nc::BlockError::Value { .. }
+    ));
+    let d = e.diagnostic().unwrap();
     assert_eq!(d.line, 4);
     assert_eq!(
         d.message,

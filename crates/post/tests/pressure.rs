@@ -797,9 +797,14 @@ fn pressure_mistakes_are_located() {
     let machine = builtin::load("mts1600").unwrap().unwrap();
     let cl = "RAPID\nGOTO/-416,70.5,16.53,0,0,1\nPRESSURE/H2,3000\nGOTO/-416,70.5,13\n";
     let e = post_text(cl, &machine, "sinumerik", &PostOptions::default()).unwrap_err();
-    let PostError::Input(d) = e else {
+    let PostError::Program(located) = &e else {
         panic!("{e}")
     };
+    assert!(matches!(
+        located.error,
+        kinpost_post::ProgramError::PressureWord { .. }
+    ));
+    let d = e.diagnostic().unwrap();
     assert_eq!(d.line, 3);
     assert!(
         d.message
@@ -811,9 +816,14 @@ fn pressure_mistakes_are_located() {
     let cl =
         "RAPID\nGOTO/-416,70.5,16.53,0,0,1\nPRESSURE/3000\nFEDRAT/MMPM,250\nGOTO/-416,70.5,13\n";
     let e = post_text(cl, &machine, "fanuc", &PostOptions::default()).unwrap_err();
-    let PostError::Input(d) = e else {
+    let PostError::Program(located) = &e else {
         panic!("{e}")
     };
+    assert!(matches!(
+        located.error,
+        kinpost_post::ProgramError::Pressure(kinpost_post::PressureError::NoPressureWord { .. })
+    ));
+    let d = e.diagnostic().unwrap();
     assert_eq!(d.line, 3);
     assert!(
         d.message

@@ -111,32 +111,56 @@ impl Kinematics {
         };
     }
 
-    /// An inverse-kinematics failure in words; for a tool axis `axis` no
-    /// setting of the rotary axes gives, how far beyond what the machine can
-    /// point it lies, and, when that could be the rounding of a CL that
-    /// writes fewer decimals, the axis rounding that would take it.
-    pub fn ik_error_text(&self, e: IkError, axis: &Vector3<f64>) -> String {
-        let gap = self.axis_reach(axis).0;
-        if e != IkError::OrientationUnreachable || gap == 0.0 {
-            return e.to_string();
+    /// Why `ik` failed for a pose with tool axis `axis`, with how far that
+    /// axis lies beyond the directions the machine can point (its text says
+    /// which `--axis-rounding` would take it, where one would).
+    pub fn ik_failure(&self, error: IkError, axis: &Vector3<f64>) -> IkFailure {
+        IkFailure {
+            error,
+            beyond_rad: self.axis_reach(axis).0,
+            rounding_rad: self.axis_rounding,
         }
-        let rounding = self.axis_rounding;
-        let hint = if gap <= MAX_AXIS_ROUNDING_RAD {
+    }
+}
+
+/// An [`IkError`] with what its message tells the user: how far the tool
+/// axis lies beyond the directions the machine can point, radians (0 when
+/// it does not), and the axis rounding in force.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkFailure {
+    /// What failed.
+    pub error: IkError,
+    /// How far the tool axis lies beyond reach, radians.
+    pub beyond_rad: f64,
+    /// The axis rounding in force ([`Kinematics::axis_rounding`]), radians.
+    pub rounding_rad: f64,
+}
+
+impl std::fmt::Display for IkFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (e, gap, rounding) = (self.error, self.beyond_rad, self.rounding_rad);
+        if e != IkError::OrientationUnreachable || gap == 0.0 {
+            return write!(f, "{e}");
+        }
+        write!(
+            f,
+            "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {rounding:.1e} rad beyond, CL rounding, is taken at the nearest",
+            gap.to_degrees()
+        )?;
+        if gap <= MAX_AXIS_ROUNDING_RAD {
             // Two significant digits, rounded up: that value takes it.
             let scale = 10f64.powi(gap.log10().floor() as i32 - 1);
             let suggest = ((gap / scale).ceil() * scale).min(MAX_AXIS_ROUNDING_RAD);
-            format!(
+            write!(
+                f,
                 "; if the CL rounds its tool axes that coarsely, --axis-rounding {suggest:.1e} takes it at the nearest"
-            )
-        } else {
-            String::new()
-        };
-        format!(
-            "{e}: it lies {:.7}° ({gap:.1e} rad) beyond the directions the machine can point (an axis up to {rounding:.1e} rad beyond, CL rounding, is taken at the nearest{hint})",
-            gap.to_degrees()
-        )
+            )?;
+        }
+        f.write_str(")")
     }
 }
+
+impl std::error::Error for IkFailure {}
 
 #[cfg(test)]
 mod tests {
@@ -295,7 +319,7 @@ point = [0, 0, 0]
         assert_eq!(kin.axis_rounding(), AXIS_ROUNDING_RAD);
         let e = solve(&kin, axis).unwrap_err();
         assert_eq!(
-            kin.ik_error_text(e, &axis),
+            kin.ik_failure(e, &axis).to_string(),
             "no setting of the rotary axes gives this tool axis: it lies 0.0006711° (1.2e-5 rad) beyond the directions the machine can point (an axis up to 1.0e-6 rad beyond, CL rounding, is taken at the nearest; if the CL rounds its tool axes that coarsely, --axis-rounding 1.2e-5 takes it at the nearest)"
         );
         kin.set_axis_rounding(1.2e-5);
@@ -307,7 +331,9 @@ point = [0, 0, 0]
         assert_eq!(kin.axis_rounding(), AXIS_ROUNDING_RAD);
         // Beyond what any rounding can be: no hint.
         let far = unit(-0.2, 0.0, 0.98);
-        let text = kin.ik_error_text(solve(&kin, far).unwrap_err(), &far);
+        let text = kin
+            .ik_failure(solve(&kin, far).unwrap_err(), &far)
+            .to_string();
         assert!(!text.contains("--axis-rounding"), "{text}");
     }
 

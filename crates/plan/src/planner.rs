@@ -1,6 +1,8 @@
-//! The path waiting for its plan: CL points (with their candidate
-//! configurations in the [`Trellis`]) and the NC outputs between them, in
-//! order, until the planner decides (every `lag` points and at the end).
+//! The planner stage: CL points (with their candidate configurations in
+//! the [`Trellis`]) and the commands between them wait, in order, until the
+//! planner decides (every `lag` points and at the end); then every point
+//! goes to the [`PlanSink`] as a decided [`Node`], the commands in their
+//! places among them.
 //!
 //! Points whose tool axis lies within the singular cone are not planned by
 //! the trellis. Between the decided points around them, they are solved
@@ -9,54 +11,161 @@
 //! interpolated between those points in the same segment (held at the one
 //! there is, if only one), and the other axes are solved for it exactly.
 
-use std::io::Write;
 use std::ops::Range;
 
-use kinpost_diag::Diagnostic;
-use kinpost_machine::angle::{atan2_deg, atan2_rad};
-use kinpost_machine::{Folds, Joints, Kinematics, MAX_AXES, Machine, Pose, Singularity, Solution};
+use kinpost_diag::{Located, Site};
+use kinpost_machine::angle::atan2_deg;
+use kinpost_machine::tolerance::{ARC_SUM_SLACK_DEG, FOLD_SLACK_RAD, NO_LENGTH_MM, POLE_SLACK_RAD};
+use kinpost_machine::{
+    Folds, IkFailure, Joints, Kinematics, KinematicsAtPressure, MAX_AXES, Machine, Mm, Pose,
+    Singularity, Solution, angle_between,
+};
 use kinpost_nc::Motion;
-use kinpost_plan::{Choice, Link, Trellis, rejection};
 use nalgebra::Vector3;
+use serde::Serialize;
 
-use crate::check::angle_between;
-use crate::emit::{Emitter, Node, Target};
-use crate::post::{Pending, PostError, select};
-use crate::pressure::Wheel;
+use crate::node::Node;
+use crate::pole::Pole;
 use crate::solve::{Hold, Near, solve_near};
-use crate::summary::SingularStretch;
-
-/// How close to a fold the interpolated tool axis counts as reaching it,
-/// radians (the rounding of CL tool axes; the branches lie within
-/// ≈ √(1e-9) of each other there).
-const FOLD_SLACK_RAD: f64 = 1e-9;
-/// How far outside the singular cone an interpolated tool axis may pass
-/// the singular direction and still count as entering it, radians
-/// (round-off of the arc's least distance).
-const POLE_SLACK_RAD: f64 = 1e-9;
+use crate::{Choice, Link, Rejection, Trellis, rejection};
 
 /// Settled points (see [`PathPlan::is_full`]) written at once: enough that
 /// a decision costs next to nothing, few enough that the points, their
 /// candidates and their CL text stay in the cache until written.
 const SETTLED_BATCH: usize = 256;
 
-/// One CL point waiting for the plan.
-#[derive(Debug, Clone)]
-pub(crate) struct PlanPoint {
+/// A CL point as the program hands it to the planner.
+#[derive(Debug, Clone, Copy)]
+pub struct PathPoint {
+    /// The pose in the part frame, mm.
     pub pose: Pose,
-    pub line: usize,
+    /// Rapid or feed.
     pub motion: Motion,
+    /// Its 1-based CL line.
+    pub line: usize,
+    /// The CL feed rate in force, mm/min.
     pub feed: Option<f64>,
-    /// Its CL line's text in `PathPlan::source`.
-    pub source: Range<usize>,
-    /// In the singular cone: not in the trellis.
-    pub singular: bool,
     /// The pressure as written (NaN: none).
     pub pressure: f64,
+}
+
+/// A decided point, as the planner hands it to its [`PlanSink`].
+#[derive(Debug, Clone, Copy)]
+pub struct Planned<'a> {
+    /// The configuration decided and the pose it reaches.
+    pub node: Node,
+    /// Rapid or feed.
+    pub motion: Motion,
+    /// The CL feed rate in force, mm/min.
+    pub feed: Option<f64>,
+    /// The pressure as written (NaN: none); the kinematics handed over with
+    /// the point is that of this pressure.
+    pub pressure: f64,
+    /// The move into it is continuous (else: retract and reconfigure).
+    pub continuous: bool,
+    /// The move into it is part of a cut (not the start of a segment).
+    pub cut: bool,
+    /// Its CL statement: file, line and text.
+    pub site: Site<'a>,
+}
+
+/// Where the planner's decisions go: the next stage of the post (the
+/// motion stage), or a `Vec` in a test.
+pub trait PlanSink<C> {
+    /// The sink's error; a planner error at a point becomes one.
+    type Error: From<Located<PlanError>>;
+
+    /// A decided point; `kin` is the machine at the point's pressure.
+    fn point(&mut self, kin: &Kinematics, point: &Planned<'_>) -> Result<(), Self::Error>;
+
+    /// A command that stood between the points, in its place.
+    fn command(&mut self, command: C) -> Result<(), Self::Error>;
+}
+
+/// Why a point cannot be planned.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    /// The kinematics has no solution for the pose.
+    #[error("{failure}: {pose}")]
+    Ik {
+        /// Why.
+        failure: IkFailure,
+        /// The pose.
+        pose: Box<Pose>,
+    },
+    /// Every solution lies outside the travel; the violation of the first
+    /// branch is given.
+    #[error(
+        "no solution inside the travel: {axis} would be {} (limits {} .. {}) for {pose}",
+        Mm(*.value),
+        .limits[0],
+        .limits[1]
+    )]
+    OutsideTravel {
+        /// The axis outside its travel.
+        axis: String,
+        /// The value it would take.
+        value: f64,
+        /// Its limits.
+        limits: [f64; 2],
+        /// The pose.
+        pose: Box<Pose>,
+    },
+    /// The kinematics found no solution at all.
+    #[error("no solution for {pose}")]
+    NoSolution {
+        /// The pose.
+        pose: Box<Pose>,
+    },
+    /// A point in the singular cone cannot be reached with the free angle
+    /// held where the points around it say, nor exactly.
+    #[error(
+        "no solution inside the travel for this singular point with {axis} held at {held_deg:.4}°"
+    )]
+    HeldOutOfReach {
+        /// The axis held (`the free axis` when the machine has none).
+        axis: String,
+        /// The angle held, degrees.
+        held_deg: f64,
+    },
+}
+
+/// A run of CL points inside the singular cone: solved exactly where that
+/// needs no swing of the free axis, else with its angle held.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SingularStretch {
+    /// CL line of the first point of the run.
+    pub first_line: usize,
+    /// CL line of its last point.
+    pub last_line: usize,
+    /// The free (singular) axis.
+    pub axis: String,
+    /// Its angle at the first and the last point, degrees.
+    pub from_deg: f64,
+    /// See `from_deg`.
+    pub to_deg: f64,
+    /// The largest angle between a point's tool axis and its CL tool axis,
+    /// degrees.
+    pub max_axis_deviation_deg: f64,
+}
+
+/// One CL point waiting for the plan.
+#[derive(Debug, Clone)]
+struct PlanPoint {
+    pose: Pose,
+    line: usize,
+    motion: Motion,
+    feed: Option<f64>,
+    /// Its CL line's text in `Planner::source`.
+    source: Range<usize>,
+    /// In the singular cone: not in the trellis.
+    singular: bool,
+    /// The pressure as written (NaN: none).
+    pressure: f64,
     /// Segment number (a new one at every rapid and break).
-    pub segment: u64,
+    segment: u64,
     /// First point of its segment.
-    pub starts_segment: bool,
+    starts_segment: bool,
 }
 
 /// What was decided for a point.
@@ -66,7 +175,11 @@ struct Decided {
     continuous: bool,
 }
 
-pub(crate) struct PathPlan {
+/// The planner: every decision about which configuration of the machine
+/// reaches each CL point (branches, turns, singular runs, folds). `C`: the
+/// commands that stand between the points (comments, tool changes, …),
+/// passed on in their places.
+pub struct Planner<C> {
     trellis: Trellis,
     singularity: Option<Singularity>,
     /// Singular cone half-angle, rad (0: only exactly singular points).
@@ -75,14 +188,16 @@ pub(crate) struct PathPlan {
     /// Free rotary axes with `wrap = "unwind"`.
     unwind: Vec<usize>,
     names: Vec<String>,
+    /// The travel of each axis (NaN: none), for errors.
+    limits: Vec<[f64; 2]>,
     file: String,
     /// The waiting points, in path order. The buffers of the plan keep their
     /// room from one decision to the next: a decision every `lag` points
     /// must not cost fresh pages.
     points: Vec<PlanPoint>,
-    /// NC outputs among the waiting points, each with the number of waiting
+    /// Commands among the waiting points, each with the number of waiting
     /// points before it.
-    outputs: Vec<(usize, Pending)>,
+    outputs: Vec<(usize, C)>,
     /// CL line texts of the waiting points, back to back.
     source: Vec<u8>,
     /// Since the last point in the trellis: tool-axis turn (degrees), the
@@ -115,10 +230,14 @@ pub(crate) struct PathPlan {
     /// The decided nodes of one run of singular points.
     run: Vec<Decided>,
     solutions: Vec<Solution>,
-    pub stretches: Vec<SingularStretch>,
+    stretches: Vec<SingularStretch>,
 }
 
-impl PathPlan {
+impl<C> Planner<C> {
+    /// A planner for `machine` (as the program drives it) with kinematics
+    /// `kin`, deciding with `trellis`, holding the free angle inside the
+    /// singular cone of half-angle `cone_deg`; `file`: the CL file's name,
+    /// for diagnostics.
     pub fn new(
         machine: &Machine,
         kin: &Kinematics,
@@ -127,13 +246,17 @@ impl PathPlan {
         file: &str,
     ) -> Self {
         let axes = &machine.axes;
-        PathPlan {
+        Planner {
             trellis,
             singularity: kin.singularity(),
             cone_rad: cone_deg.to_radians(),
             rotary: machine.free_rotary_axes().collect(),
             unwind: machine.unwinding_axes().collect(),
             names: axes.iter().map(|a| a.name.clone()).collect(),
+            limits: axes
+                .iter()
+                .map(|a| a.limits.unwrap_or([f64::NAN, f64::NAN]))
+                .collect(),
             file: file.to_string(),
             points: Vec::new(),
             outputs: Vec::new(),
@@ -163,9 +286,9 @@ impl PathPlan {
         self.break_pending = true;
     }
 
-    /// An NC output between points, written in its place.
-    pub fn push_output(&mut self, p: Pending) {
-        self.outputs.push((self.points.len(), p));
+    /// A command between points, passed on in its place.
+    pub fn push_command(&mut self, command: C) {
+        self.outputs.push((self.points.len(), command));
     }
 
     /// Whether nothing waits.
@@ -173,19 +296,29 @@ impl PathPlan {
         self.points.is_empty() && self.outputs.is_empty()
     }
 
-    /// Adds a CL point. An error is returned for the point at once when it
-    /// cannot be reached at all (the caller makes the diagnostic).
-    #[allow(clippy::too_many_arguments)]
+    /// The singular runs decided so far.
+    pub fn stretches(&self) -> &[SingularStretch] {
+        &self.stretches
+    }
+
+    /// Adds a CL point, solved through `kin` at the point's pressure;
+    /// `source_line`: the text of its CL line, for diagnostics made when it
+    /// is decided. An error is returned for the point at once when it cannot
+    /// be reached at all (the caller locates it).
     pub fn push_point(
         &mut self,
-        kin: &Kinematics,
-        pose: Pose,
-        motion: Motion,
-        line: usize,
-        feed: Option<f64>,
-        pressure: f64,
+        kin: &mut KinematicsAtPressure,
+        point: PathPoint,
         source_line: &[u8],
-    ) -> Result<(), PointError> {
+    ) -> Result<(), PlanError> {
+        let PathPoint {
+            pose,
+            motion,
+            line,
+            feed,
+            pressure,
+        } = point;
+        kin.select(pressure);
         if motion == Motion::Rapid {
             self.break_pending = true;
         }
@@ -211,8 +344,11 @@ impl PathPlan {
             // inequality): far from the pole that settles it.
             if let (Some(s), Some(a), Some(b)) = (&self.singularity, self.previous_pole, pole) {
                 let cone = self.cone_rad + POLE_SLACK_RAD;
-                if Pole::sum_within(a, b, axis_turn + 2.0 * cone.to_degrees() + 1e-9)
-                    && s.arc_distance(axis, &pose.axis) <= cone
+                if Pole::sum_within(
+                    a,
+                    b,
+                    axis_turn + 2.0 * cone.to_degrees() + ARC_SUM_SLACK_DEG,
+                ) && s.arc_distance(axis, &pose.axis) <= cone
                 {
                     self.across = true;
                 }
@@ -236,12 +372,15 @@ impl PathPlan {
         }
         let n = kin.axis_count();
         kin.ik(&pose, Some(&hint[..n]), &mut self.solutions)
-            .map_err(|e| PointError::Ik(kin.ik_error_text(e, &pose.axis)))?;
+            .map_err(|e| PlanError::Ik {
+                failure: kin.ik_failure(e, &pose.axis),
+                pose: Box::new(pose),
+            })?;
         let in_cone = pole.is_some_and(|p| p.within(self.cone_rad));
         let singular = in_cone || self.solutions.iter().all(|s| s.singular);
         if singular {
             if !self.solutions.iter().any(Solution::is_valid) {
-                return Err(PointError::Rejected(rejection(&self.solutions)));
+                return Err(self.rejected(&pose));
             }
             self.across = true;
         } else {
@@ -280,7 +419,7 @@ impl PathPlan {
                 }
             };
             if !self.trellis.push(&self.solutions, link) {
-                return Err(PointError::Rejected(rejection(&self.solutions)));
+                return Err(self.rejected(&pose));
             }
             self.turn = 0.0;
             self.across = false;
@@ -311,18 +450,31 @@ impl PathPlan {
         self.trellis.is_full() || (self.trellis.len() >= SETTLED_BATCH && self.trellis.is_settled())
     }
 
-    /// Decides the waiting points and writes them, with the outputs among
-    /// them, in path order. Unless `all`, singular points after the last
-    /// planned one (and outputs after it) keep waiting for their next
-    /// neighbour.
-    pub fn flush<W: Write>(
+    /// Why no solution of `pose` in `self.solutions` can be used.
+    fn rejected(&self, pose: &Pose) -> PlanError {
+        match rejection(&self.solutions) {
+            Rejection::OutsideLimits(v) => PlanError::OutsideTravel {
+                axis: self.names[v.axis].clone(),
+                value: v.value,
+                limits: self.limits[v.axis],
+                pose: Box::new(*pose),
+            },
+            Rejection::NoSolution => PlanError::NoSolution {
+                pose: Box::new(*pose),
+            },
+        }
+    }
+
+    /// Decides the waiting points and hands them to `sink`, with the
+    /// commands among them, in path order. Unless `all`, singular points
+    /// after the last planned one (and commands after it) keep waiting for
+    /// their next neighbour.
+    pub fn flush<S: PlanSink<C>>(
         &mut self,
-        machine: &Machine,
-        kin: &mut Kinematics,
-        wheel: &mut Option<Wheel>,
-        emitter: &mut Emitter<W>,
+        kin: &mut KinematicsAtPressure,
+        sink: &mut S,
         all: bool,
-    ) -> Result<(), PostError> {
+    ) -> Result<(), S::Error> {
         self.choices.clear();
         if all || self.trellis.is_full() {
             self.trellis.decide(&mut self.choices);
@@ -351,7 +503,7 @@ impl PathPlan {
         while k < end {
             if !self.points[k].singular {
                 while let Some((_, p)) = pending.next_if(|(at, _)| *at <= k) {
-                    emitter.write_pending(p)?;
+                    sink.command(p)?;
                 }
                 let choice = self.choices[c];
                 c += 1;
@@ -364,7 +516,7 @@ impl PathPlan {
                     },
                     continuous: choice.continuous,
                 };
-                self.write_point(machine, kin, wheel, emitter, k, decided)?;
+                self.write_point(kin, sink, k, decided)?;
                 k += 1;
                 continue;
             }
@@ -374,18 +526,18 @@ impl PathPlan {
                 e += 1;
             }
             let next = self.choices.get(c).copied();
-            self.fill_run(kin, wheel, k..e, next)?;
+            self.fill_run(kin, k..e, next)?;
             for j in k..e {
                 while let Some((_, p)) = pending.next_if(|(at, _)| *at <= j) {
-                    emitter.write_pending(p)?;
+                    sink.command(p)?;
                 }
                 let decided = self.run[j - k];
-                self.write_point(machine, kin, wheel, emitter, j, decided)?;
+                self.write_point(kin, sink, j, decided)?;
             }
             k = e;
         }
         for (_, p) in pending {
-            emitter.write_pending(p)?;
+            sink.command(p)?;
         }
         for o in &mut outputs {
             o.0 -= end;
@@ -410,35 +562,29 @@ impl PathPlan {
         Ok(())
     }
 
-    /// Writes waiting point `k` as decided.
-    fn write_point<W: Write>(
+    /// Hands waiting point `k` to `sink` as decided.
+    fn write_point<S: PlanSink<C>>(
         &mut self,
-        machine: &Machine,
-        kin: &mut Kinematics,
-        wheel: &mut Option<Wheel>,
-        emitter: &mut Emitter<W>,
+        kin: &mut KinematicsAtPressure,
+        sink: &mut S,
         k: usize,
         d: Decided,
-    ) -> Result<(), PostError> {
+    ) -> Result<(), S::Error> {
         let p = &self.points[k];
-        let at = |message: String| self.error_at(p, message);
-        select(kin, wheel, p.pressure);
-        emitter.emit(
-            machine,
+        kin.select(p.pressure);
+        sink.point(
             kin,
-            &Target {
-                node: &d.node,
+            &Planned {
+                node: d.node,
                 motion: p.motion,
-                line: p.line,
                 feed: p.feed,
                 pressure: p.pressure,
                 continuous: d.continuous,
                 cut: !p.starts_segment,
-                at: &at,
+                site: self.site(p),
             },
         )?;
-        let segment = p.segment;
-        self.last = Some((d.node, segment));
+        self.last = Some((d.node, p.segment));
         Ok(())
     }
 
@@ -449,11 +595,10 @@ impl PathPlan {
     /// any.
     fn fill_run(
         &mut self,
-        kin: &mut Kinematics,
-        wheel: &mut Option<Wheel>,
+        kin: &mut KinematicsAtPressure,
         run: Range<usize>,
         next: Option<Choice>,
-    ) -> Result<(), PostError> {
+    ) -> Result<(), Located<PlanError>> {
         let points = &self.points;
         let seg = points[run.start].segment;
         // The decided neighbours in the same segment.
@@ -489,14 +634,7 @@ impl PathPlan {
         // rapid need not swing the free angle for a tool axis that CL
         // rounding put a hair beside the pole.)
         let written = before.or(self.last.map(|(n, _)| n));
-        if self.exact_run(
-            kin,
-            wheel,
-            run.clone(),
-            written.as_ref(),
-            after.as_ref(),
-            &anchor,
-        ) {
+        if self.exact_run(kin, run.clone(), written.as_ref(), after.as_ref(), &anchor) {
             return Ok(());
         }
         // Interpolate by distance along the CL path from the point before
@@ -518,17 +656,17 @@ impl PathPlan {
         self.run.clear();
         for (j, k) in run.clone().enumerate() {
             let p = &self.points[k];
-            let t = if total > 1e-9 {
+            let t = if total > NO_LENGTH_MM {
                 lengths[j] / total
             } else {
                 (j + usize::from(before.is_some())) as f64 / count.max(1) as f64
             };
             let hold = axis.map(|i| Hold {
                 axis: i,
-                value: from + (to - from) * t,
+                value_deg: from + (to - from) * t,
             });
-            select(kin, wheel, p.pressure);
-            let kin = &*kin;
+            kin.select(p.pressure);
+            let kin: &Kinematics = kin;
             // (The branches meet at the pole: any branch.)
             let near = |hold| Near {
                 joints: &guess,
@@ -544,14 +682,12 @@ impl PathPlan {
                         .map(|(pose, s)| (pose, s, None))
                 });
             let Some((pose, sol, hold)) = solved else {
-                return Err(self.error_at(
-                    p,
-                    format!(
-                        "no solution inside the travel for this singular point with {} held at {:.4}°",
-                        axis.map_or("the free axis", |i| self.names[i].as_str()),
-                        hold.map_or(f64::NAN, |h| h.value)
-                    ),
-                ));
+                return Err(self.site(p).locate(PlanError::HeldOutOfReach {
+                    axis: axis
+                        .map_or("the free axis", |i| self.names[i].as_str())
+                        .into(),
+                    held_deg: hold.map_or(f64::NAN, |h| h.value_deg),
+                }));
             };
             guess = sol.joints;
             self.run.push(Decided {
@@ -578,8 +714,7 @@ impl PathPlan {
     /// reported as a stretch held at that angle.
     fn exact_run(
         &mut self,
-        kin: &mut Kinematics,
-        wheel: &mut Option<Wheel>,
+        kin: &mut KinematicsAtPressure,
         run: Range<usize>,
         from: Option<&Node>,
         after: Option<&Node>,
@@ -612,7 +747,7 @@ impl PathPlan {
                 run.start + j
             };
             let p = &self.points[k];
-            select(kin, wheel, p.pressure);
+            kin.select(p.pressure);
             let near = Near {
                 joints: last.as_ref().map_or(anchor, |(j, _)| j),
                 hold: None,
@@ -677,84 +812,13 @@ impl PathPlan {
         });
     }
 
-    /// An error diagnostic at a waiting point's CL line.
-    fn error_at(&self, p: &PlanPoint, message: String) -> PostError {
-        let text = String::from_utf8_lossy(&self.source[p.source.clone()]);
-        let start = text.len() - text.trim_start().len();
-        let column = text[..start].chars().count() + 1;
-        let width = text.trim().chars().count();
-        PostError::Input(Box::new(Diagnostic::error(
-            &self.file, p.line, column, width, text, message,
-        )))
-    }
-}
-
-/// The angle between a tool axis and the singular direction, kept as its
-/// sine and cosine terms ([`Singularity::sin_cos`]): most decisions are
-/// settled by a lower bound, without the `atan2` of
-/// [`Singularity::distance`], which is exact (the same bits) where the
-/// bound does not settle them.
-///
-/// The sine term is kept squared: far from the pole, the tests are settled
-/// without its square root ([`Pole::surely_beyond`]).
-#[derive(Debug, Clone, Copy)]
-struct Pole {
-    /// `|d × a|²` (the square of [`Singularity::sin_cos`]'s first term).
-    sin2: f64,
-    /// `|d · a|`.
-    cos: f64,
-}
-
-impl Pole {
-    /// Relative slack of the lower bound: far above the rounding of the
-    /// bound and of `atan2` (a few ulp each).
-    const SLACK: f64 = 1e-12;
-
-    fn new(s: &Singularity, axis: &Vector3<f64>) -> Pole {
-        Pole {
-            sin2: s.direction.cross(axis).norm_squared(),
-            cos: s.direction.dot(axis).abs(),
+    /// A waiting point's CL statement.
+    fn site<'a>(&'a self, p: &PlanPoint) -> Site<'a> {
+        Site {
+            file: &self.file,
+            line: p.line,
+            text: &self.source[p.source.clone()],
         }
-    }
-
-    /// The sine term, `|d × a|` (the same bits as [`Singularity::sin_cos`]).
-    fn sin(self) -> f64 {
-        self.sin2.sqrt()
-    }
-
-    /// The angle, radians (as [`Singularity::distance`]).
-    fn exact_rad(self) -> f64 {
-        atan2_rad(self.sin(), self.cos)
-    }
-
-    /// A lower bound of the angle, radians: its sine `s / √(s² + c²)` is at
-    /// least `s / max(s² + c², 1)`, and an angle of [0, π/2] is at least its
-    /// sine.
-    fn lower_rad(self) -> f64 {
-        let (s, c) = (self.sin(), self.cos);
-        s / (s * s + c * c).max(1.0) * (1.0 - Self::SLACK)
-    }
-
-    /// The lower bound is surely above `rad`, without a square root: with
-    /// `s² + c² ≤ 1.0001` (a unit tool axis) the bound is at least
-    /// `0.99989·s`, and `s² · 0.9996 > rad²` makes `s` above `rad / 0.9998`.
-    /// (`false` says nothing.)
-    fn surely_beyond(self, rad: f64) -> bool {
-        self.sin2 + self.cos * self.cos <= 1.0001 && self.sin2 * 0.9996 > rad * rad
-    }
-
-    /// Whether the angle is below `cone_rad`.
-    fn within(self, cone_rad: f64) -> bool {
-        !self.surely_beyond(cone_rad) && self.lower_rad() < cone_rad && self.exact_rad() < cone_rad
-    }
-
-    /// Whether the two angles, in degrees, add up to at most `limit`.
-    fn sum_within(a: Pole, b: Pole, limit: f64) -> bool {
-        let limit_rad = limit.to_radians();
-        !a.surely_beyond(limit_rad)
-            && !b.surely_beyond(limit_rad)
-            && (a.lower_rad() + b.lower_rad()).to_degrees() <= limit
-            && a.exact_rad().to_degrees() + b.exact_rad().to_degrees() <= limit
     }
 }
 
@@ -817,51 +881,4 @@ mod tests {
             );
         }
     }
-
-    fn unit(v: [f64; 3]) -> Vector3<f64> {
-        Vector3::from(v).normalize()
-    }
-
-    proptest::proptest! {
-        /// The pole tests decide as the exact angles of
-        /// `Singularity::distance` do, also at their limits (the cone and
-        /// the sum set to the exact values, or an ulp off them).
-        #[test]
-        fn pole_tests_agree_with_the_exact_angles(
-            d in proptest::array::uniform3(-1.0f64..1.0),
-            a in proptest::array::uniform3(-1.0f64..1.0),
-            b in proptest::array::uniform3(-1.0f64..1.0),
-            near in 0.0f64..1e-3,
-            ulps in -2i64..=2,
-        ) {
-            proptest::prop_assume!(Vector3::from(d).norm() > 1e-3);
-            let s = Singularity { axis: 0, direction: unit(d) };
-            // Tool axes anywhere, or within `near` of the pole.
-            let a = unit(a);
-            let b = (s.direction + near * unit(b)).normalize();
-            let nudge = |x: f64| f64::from_bits((x.to_bits() as i64 + ulps) as u64);
-            let (pa, pb) = (Pole::new(&s, &a), Pole::new(&s, &b));
-            proptest::prop_assert_eq!(pa.sin().to_bits(), s.sin_cos(&a).0.to_bits());
-            for (pole, axis) in [(pa, &a), (pb, &b)] {
-                let exact = s.distance(axis);
-                proptest::prop_assert_eq!(pole.exact_rad().to_bits(), exact.to_bits());
-                for cone in [nudge(exact), 1e-3, 0.0, exact * 2.0] {
-                    proptest::prop_assert_eq!(pole.within(cone), exact < cone);
-                }
-            }
-            let sum = s.distance(&a).to_degrees() + s.distance(&b).to_degrees();
-            for limit in [nudge(sum), sum * 0.5, 0.0, f64::INFINITY] {
-                proptest::prop_assert_eq!(Pole::sum_within(pa, pb, limit), sum <= limit);
-            }
-        }
-    }
-}
-
-/// Why a point cannot be added.
-#[derive(Debug)]
-pub(crate) enum PointError {
-    /// The kinematics has no solution (the message says why).
-    Ik(String),
-    /// Every solution is outside the travel.
-    Rejected(kinpost_plan::Rejection),
 }

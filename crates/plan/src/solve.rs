@@ -2,22 +2,23 @@
 //! itself (linearization, retracts) and for points where a singular angle is
 //! held.
 
+use kinpost_machine::tolerance::HELD_SLACK_DEG;
 use kinpost_machine::{Joints, Kinematics, Pose, Solution};
 use nalgebra::{UnitQuaternion, Vector3};
 
 /// A singular angle held at a value.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Hold {
+pub struct Hold {
     /// Index of the axis.
     pub axis: usize,
     /// Its value, degrees (unwrapped).
-    pub value: f64,
+    pub value_deg: f64,
 }
 
 /// The pose at `t` between `a` and `b`: the point linearly, the tool axis
-/// (and reference) by spherical interpolation (DESIGN.md: the tool axis
-/// turns in the plane of the two axes at constant speed).
-pub(crate) fn interpolate(a: &Pose, b: &Pose, t: f64) -> Pose {
+/// (and reference) by spherical interpolation (the tool axis turns in the
+/// plane of the two axes at constant speed, as a CL segment means it).
+pub fn interpolate(a: &Pose, b: &Pose, t: f64) -> Pose {
     Pose {
         point: a.point.lerp(&b.point, t),
         axis: slerp(&a.axis, &b.axis, t),
@@ -40,18 +41,12 @@ fn slerp(a: &Vector3<f64>, b: &Vector3<f64>, t: f64) -> Vector3<f64> {
     }
 }
 
-/// How far a solution's held angle may lie from the value held, degrees.
-/// The tool axis solved is one the machine points with that value, so the
-/// solution has it up to rounding; where that axis lies on a fold (the two
-/// branches meet there, as beside the small hole of a C axis out of
-/// square), the angle is found through a square root of a near-zero term,
-/// and lies up to about 1e-4° off.
-const HELD_SLACK_DEG: f64 = 1e-3;
-
 /// Where to solve a pose near: a configuration, the singular angle held
 /// there if any, and the branch to keep if any.
-pub(crate) struct Near<'a> {
+pub struct Near<'a> {
+    /// The configuration to stay near.
     pub joints: &'a Joints,
+    /// The singular angle to hold, if any.
     pub hold: Option<Hold>,
     /// Solutions of this branch come first (when there are any).
     pub branch: Option<u8>,
@@ -62,7 +57,7 @@ pub(crate) struct Near<'a> {
 /// with the singular angle held if `near` says so: the tool axis is then
 /// the nearest one the machine points with that angle, and the pose solved
 /// is returned with it.
-pub(crate) fn solve_near(
+pub fn solve_near(
     kin: &Kinematics,
     pose: &Pose,
     near: &Near,
@@ -74,8 +69,8 @@ pub(crate) fn solve_near(
     let mut pose = *pose;
     let hold = near.hold;
     if let Some(h) = hold {
-        hint[h.axis] = h.value;
-        if let Some(axis) = kin.held_axis(&pose.axis, h.value) {
+        hint[h.axis] = h.value_deg;
+        if let Some(axis) = kin.held_axis(&pose.axis, h.value_deg) {
             pose.axis = axis;
         }
     }
@@ -83,7 +78,7 @@ pub(crate) fn solve_near(
     let travel =
         |s: &Solution| -> f64 { rotary.iter().map(|&i| (s.joints[i] - hint[i]).abs()).sum() };
     let held =
-        |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value).abs() < HELD_SLACK_DEG);
+        |s: &Solution| hold.is_none_or(|h| (s.joints[h.axis] - h.value_deg).abs() < HELD_SLACK_DEG);
     let other = |s: &Solution| near.branch.is_some_and(|b| b != s.branch);
     let best = scratch
         .iter()

@@ -1,0 +1,51 @@
+//! The NC output of a CL statement other than a point (a comment, a tool
+//! change, …): it passes through every stage in its place among the points
+//! and is written by the block sink.
+
+use kinpost_diag::{Diagnostic, Located};
+use kinpost_nc::{NcError, Spindle};
+
+/// What a CL statement other than a point asks the program to say.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// A comment (`$$ text`, `PPRINT`, an operation's name).
+    Comment(String),
+    /// A tool change: number and name.
+    ToolChange(u32, String),
+    /// Spindle on (speed and direction) or off.
+    Spindle(Spindle),
+    /// Coolant on in a mode (`FLOOD`, `MIST`, …), or off.
+    Coolant(Option<String>),
+    /// Text for the controller, verbatim (`INSERT`).
+    Insert(String),
+}
+
+/// A command with its CL statement: it is written after the reader has
+/// moved on, and a template that fails on it names that statement.
+#[derive(Debug, Clone)]
+pub struct Pending {
+    /// The command.
+    pub command: Command,
+    /// Its CL statement (a diagnostic whose message is filled in when a
+    /// template fails on it).
+    pub at: Box<Diagnostic>,
+}
+
+impl Pending {
+    /// A tool change: the machine goes where it changes tools, and where it
+    /// is after that is not known.
+    pub fn changes_tool(&self) -> bool {
+        matches!(self.command, Command::ToolChange(..))
+    }
+
+    /// `error` of writing this command, at its CL statement.
+    pub fn locate(&self, error: NcError) -> Located<NcError> {
+        Located {
+            diagnostic: Box::new(Diagnostic {
+                message: error.to_string(),
+                ..(*self.at).clone()
+            }),
+            error,
+        }
+    }
+}

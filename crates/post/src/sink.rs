@@ -1,0 +1,193 @@
+//! The end of the pipeline: where checked blocks and commands go
+//! ([`BlockSink`]). The NC writer is one; a test collects them in a
+//! [`Recorded`] list instead.
+
+use std::io::Write;
+
+use kinpost_nc::{AxisSpec, Block, BlockError, Dialect, Motion, NcWriter, ProgramInfo};
+
+use crate::check::BlockSink;
+use crate::command::{Command, Pending};
+use crate::error::PostError;
+
+impl<W: Write> BlockSink for NcWriter<W> {
+    #[inline]
+    fn round(&mut self, values: &[f64], written: &mut [f64]) {
+        self.quantize_axes(values, written);
+    }
+
+    #[inline]
+    fn block(&mut self, block: &Block) -> Result<(), BlockError> {
+        NcWriter::block(self, block)
+    }
+
+    fn command(&mut self, p: Pending) -> Result<(), PostError> {
+        let written = match &p.command {
+            Command::Comment(text) => self.comment(text),
+            Command::ToolChange(number, name) => self.tool_change(*number, name),
+            Command::Spindle(state) => self.spindle(*state),
+            Command::Coolant(mode) => self.coolant(mode.as_deref()),
+            Command::Insert(text) => self.insert(text),
+        };
+        written.map_err(|e| p.locate(e).into())
+    }
+
+    fn inverse_time(&mut self, on: bool) -> Result<(), PostError> {
+        Ok(NcWriter::inverse_time(self, on)?)
+    }
+
+    #[inline]
+    fn feed_rounds_to_zero(&self, word: f64) -> bool {
+        NcWriter::feed_rounds_to_zero(self, word)
+    }
+}
+
+/// What a [`Recorded`] sink received, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// A block: its CL line, motion, values (unrounded) and feed word.
+    Block {
+        /// CL line (`None`: a block the post inserted).
+        cl_line: Option<usize>,
+        /// Rapid or feed.
+        motion: Motion,
+        /// The values as handed over (the pressure last, if any).
+        axes: Vec<f64>,
+        /// The feed word of a feed block.
+        feed: Option<f64>,
+    },
+    /// A command.
+    Command(Command),
+    /// Inverse time on or off.
+    InverseTime(bool),
+}
+
+/// A block sink that keeps everything in a list, for tests of the stages:
+/// values are rounded to `decimals` as a dialect would write them.
+#[derive(Debug, Clone, Default)]
+pub struct Recorded {
+    /// Decimals of every value (a dialect's word format).
+    pub decimals: u32,
+    /// What was received.
+    pub events: Vec<Event>,
+}
+
+impl Recorded {
+    /// An empty list, rounding to `decimals`.
+    pub fn new(decimals: u32) -> Recorded {
+        Recorded {
+            decimals,
+            events: Vec::new(),
+        }
+    }
+
+    /// The blocks received, in order.
+    pub fn blocks(&self) -> impl Iterator<Item = (Option<usize>, Motion, &[f64])> + '_ {
+        self.events.iter().filter_map(|e| match e {
+            Event::Block {
+                cl_line,
+                motion,
+                axes,
+                ..
+            } => Some((*cl_line, *motion, axes.as_slice())),
+            _ => None,
+        })
+    }
+}
+
+impl BlockSink for Recorded {
+    fn round(&mut self, values: &[f64], written: &mut [f64]) {
+        let scale = 10f64.powi(self.decimals as i32);
+        for (w, v) in written.iter_mut().zip(values) {
+            *w = (v * scale).round() / scale;
+        }
+    }
+
+    fn block(&mut self, block: &Block) -> Result<(), BlockError> {
+        self.events.push(Event::Block {
+            cl_line: block.cl_line,
+            motion: block.motion,
+            axes: block.axes.to_vec(),
+            feed: block.feed,
+        });
+        Ok(())
+    }
+
+    fn command(&mut self, pending: Pending) -> Result<(), PostError> {
+        self.events.push(Event::Command(pending.command));
+        Ok(())
+    }
+
+    fn inverse_time(&mut self, on: bool) -> Result<(), PostError> {
+        self.events.push(Event::InverseTime(on));
+        Ok(())
+    }
+
+    fn feed_rounds_to_zero(&self, word: f64) -> bool {
+        word * 10f64.powi(self.decimals as i32) < 0.5
+    }
+}
+
+/// What the pipeline writes a whole program with: a [`BlockSink`] that also
+/// writes the header and footer and switches tool-centre-point control.
+/// The NC writer of a dialect; [`ReadBack`](crate::ReadBack) around one.
+pub trait ProgramWriter: BlockSink + Sized {
+    /// Where the program goes.
+    type Out;
+    /// What [`ProgramWriter::finish`] hands back.
+    type Finished;
+
+    /// The writer of a program in `dialect` for a machine with `axes`.
+    fn open(dialect: &Dialect, axes: &[AxisSpec], out: Self::Out) -> Self;
+
+    /// CSV: a last column says what each feed row's feed is.
+    fn add_feed_mode_column(&mut self);
+
+    /// The header (`template` replaces the dialect's).
+    fn header(&mut self, info: &ProgramInfo, template: Option<&str>) -> Result<(), PostError>;
+
+    /// Tool-centre-point control on or off.
+    fn tcp(&mut self, on: bool) -> Result<(), PostError>;
+
+    /// The footer (`template` replaces the dialect's).
+    fn footer(&mut self, info: &ProgramInfo, template: Option<&str>) -> Result<(), PostError>;
+
+    /// Motion blocks written.
+    fn blocks_written(&self) -> u64;
+
+    /// Flushes and hands the output back.
+    fn finish(self) -> Result<Self::Finished, PostError>;
+}
+
+impl<W: Write> ProgramWriter for NcWriter<W> {
+    type Out = W;
+    type Finished = W;
+
+    fn open(dialect: &Dialect, axes: &[AxisSpec], out: W) -> Self {
+        NcWriter::new(dialect, axes, out)
+    }
+
+    fn add_feed_mode_column(&mut self) {
+        NcWriter::add_feed_mode_column(self);
+    }
+
+    fn header(&mut self, info: &ProgramInfo, template: Option<&str>) -> Result<(), PostError> {
+        Ok(NcWriter::header(self, info, template)?)
+    }
+
+    fn tcp(&mut self, on: bool) -> Result<(), PostError> {
+        Ok(NcWriter::tcp(self, on)?)
+    }
+
+    fn footer(&mut self, info: &ProgramInfo, template: Option<&str>) -> Result<(), PostError> {
+        Ok(NcWriter::footer(self, info, template)?)
+    }
+
+    fn blocks_written(&self) -> u64 {
+        NcWriter::blocks_written(self)
+    }
+
+    fn finish(self) -> Result<W, PostError> {
+        Ok(NcWriter::finish(self)?)
+    }
+}
