@@ -90,10 +90,12 @@
 mod number;
 mod reader;
 mod words;
+mod writer;
 
 pub use kinpost_diag::{Diagnostic, Severity};
 pub use number::parse_number;
 pub use reader::ClReader;
+pub use writer::{ClWriter, WriteError};
 
 /// A point or a direction: `[x, y, z]`.
 pub type Vec3 = [f64; 3];

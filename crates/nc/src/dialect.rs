@@ -9,10 +9,10 @@ use minijinja::Environment;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
 use crate::template::{self, TemplateError, template_span_in_toml};
 use crate::writer::{MAX_LEAD, MAX_SUFFIX};
 use crate::{AxisSpec, Motion, ProgramInfo};
+use kinpost_number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
 
 /// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
 const MAX_PREFIX: usize = 24;
@@ -436,7 +436,7 @@ impl Dialect {
                         .map(|m| m.span())
                         .or_else(|| w.decimals.as_ref().map(|d| d.span()))
                         .unwrap_or(0..0);
-                    err(span, msg);
+                    err(span, msg.to_string());
                     break;
                 }
             }

@@ -22,7 +22,6 @@
 use std::collections::BTreeMap;
 
 mod dialect;
-mod number;
 mod reader;
 mod template;
 mod writer;
@@ -32,8 +31,8 @@ pub use dialect::{
     TemplateKind, WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
+pub use kinpost_number::{FormatError, MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use minijinja::Value;
-pub use number::{MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
 pub use template::{TemplateError, template_span_in_toml};
 pub use writer::{NcWriter, Spindle};

@@ -7,9 +7,9 @@ use std::sync::Arc;
 use minijinja::{Environment, Value};
 
 use crate::dialect::{CommentSyntax, Dialect, DialectKind, Numbering, TemplateKind};
-use crate::number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 use crate::template;
 use crate::{AxisSpec, Block, BlockError, Motion, NcError, ProgramInfo};
+use kinpost_number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 
 /// Spindle state for [`NcWriter::spindle`].
 #[derive(Debug, Clone, Copy, PartialEq)]

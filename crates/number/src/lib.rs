@@ -1,4 +1,5 @@
-//! Allocation-free fixed-point number formatting for NC words.
+//! Decimal numbers as the text of NC and CL words: allocation-free
+//! fixed-point formatting, shared by the NC writers and the CL writer.
 //!
 //! A value is quantized to an integer number of units of `10^-decimals`
 //! (correctly rounded from the exact binary value, ties to even, exactly as
@@ -6,6 +7,8 @@
 //! printed from that integer. [`NumberFormat::quantize`] returns
 //! `units as f64 / 10^decimals`, which is bit for bit the number that
 //! `str::parse::<f64>()` gives for the printed text.
+
+#![deny(missing_docs)]
 
 use serde::Deserialize;
 
@@ -83,9 +86,44 @@ impl std::fmt::Display for NumberError {
     }
 }
 
+/// Why a [`NumberFormat`] cannot be used.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FormatError {
+    /// More decimals than [`MAX_DECIMALS`].
+    Decimals(u8),
+    /// A period that is not a positive number small enough to write.
+    ModuloNotPositive(f64),
+    /// A period that is not a whole number of units of the last decimal.
+    ModuloNotWhole {
+        /// The period.
+        modulo: f64,
+        /// The decimals.
+        decimals: u8,
+    },
+}
+
+impl std::fmt::Display for FormatError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FormatError::Decimals(d) => {
+                write!(f, "decimals must be between 0 and {MAX_DECIMALS}, not {d}")
+            }
+            FormatError::ModuloNotPositive(m) => {
+                write!(f, "`modulo` must be a positive number, not {m}")
+            }
+            FormatError::ModuloNotWhole { modulo, decimals } => write!(
+                f,
+                "`modulo` {modulo} is not a whole number of units of 10^-{decimals} (the axis decimals)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for FormatError {}
+
 /// A [`NumberFormat`] prepared for the hot path.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Formatter {
+pub struct Formatter {
     decimals: u32,
     scale: f64,
     /// Period in units, 0 when there is none.
@@ -107,30 +145,28 @@ pub(crate) struct Formatter {
 }
 
 impl NumberFormat {
-    /// Checks the format; the message names the offending setting.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks the format; the error names the offending setting.
+    pub fn validate(&self) -> Result<(), FormatError> {
         if self.decimals > MAX_DECIMALS {
-            return Err(format!(
-                "decimals must be between 0 and {MAX_DECIMALS}, not {}",
-                self.decimals
-            ));
+            return Err(FormatError::Decimals(self.decimals));
         }
         if let Some(m) = self.modulo {
             let units = m * POW10[self.decimals as usize];
             if !(m > 0.0 && units < UNIT_LIMIT) {
-                return Err(format!("`modulo` must be a positive number, not {m}"));
+                return Err(FormatError::ModuloNotPositive(m));
             }
             if (units - units.round()).abs() > 1e-6 * units.max(1.0) {
-                return Err(format!(
-                    "`modulo` {m} is not a whole number of units of 10^-{} (the axis decimals)",
-                    self.decimals
-                ));
+                return Err(FormatError::ModuloNotWhole {
+                    modulo: m,
+                    decimals: self.decimals,
+                });
             }
         }
         Ok(())
     }
 
-    pub(crate) fn formatter(&self) -> Formatter {
+    /// The format prepared for writing many values.
+    pub fn formatter(&self) -> Formatter {
         let decimals = u32::from(self.decimals.min(MAX_DECIMALS));
         let scale = POW10[decimals as usize];
         Formatter {
@@ -171,7 +207,7 @@ impl NumberFormat {
 impl Formatter {
     /// The value in units of `10^-decimals`, modulo applied.
     #[inline]
-    pub(crate) fn units(&self, value: f64) -> Result<i64, NumberError> {
+    pub fn units(&self, value: f64) -> Result<i64, NumberError> {
         let p = value * self.scale;
         // Below 2^51, adding 1.5 * 2^52 rounds `p` to an integer (to
         // nearest) that the low bits of the sum hold; NaN and larger values
@@ -236,20 +272,22 @@ impl Formatter {
 
     /// `units / 10^decimals`: the value as it is written.
     #[inline]
-    pub(crate) fn value_of_units(&self, n: i64) -> f64 {
+    pub fn value_of_units(&self, n: i64) -> f64 {
         n as f64 / self.scale
     }
 
+    /// The value as it is written (unchanged when it cannot be).
     #[inline]
-    pub(crate) fn quantize(&self, value: f64) -> f64 {
+    pub fn quantize(&self, value: f64) -> f64 {
         match self.units(value) {
             Ok(n) => self.value_of_units(n),
             Err(_) => value,
         }
     }
 
+    /// Appends the value's text to `out`.
     #[inline]
-    pub(crate) fn write(&self, out: &mut Vec<u8>, value: f64) -> Result<(), NumberError> {
+    pub fn write(&self, out: &mut Vec<u8>, value: f64) -> Result<(), NumberError> {
         let n = self.units(value)?;
         self.write_units(out, n);
         Ok(())
@@ -257,7 +295,7 @@ impl Formatter {
 
     /// Writes an integer number of units as a decimal number.
     #[inline]
-    pub(crate) fn write_units(&self, out: &mut Vec<u8>, n: i64) {
+    pub fn write_units(&self, out: &mut Vec<u8>, n: i64) {
         let start = out.len();
         out.resize(start + ENCODE_MAX, 0);
         let end = self.encode_into(n, out, start);
@@ -268,7 +306,7 @@ impl Formatter {
     /// ends. Writes at most [`ENCODE_MAX`] bytes (so `buf` must have that
     /// room; bytes past the returned end may be overwritten too).
     #[inline(always)]
-    pub(crate) fn encode_into(&self, n: i64, buf: &mut [u8], at: usize) -> usize {
+    pub fn encode_into(&self, n: i64, buf: &mut [u8], at: usize) -> usize {
         if self.fast {
             self.encode_fast(n, buf, at)
         } else {
@@ -333,7 +371,7 @@ impl Formatter {
     /// [`Formatter::encode_into`] for any number of decimals, digit pair by
     /// digit pair.
     #[inline(always)]
-    pub(crate) fn encode_general(&self, n: i64, buf: &mut [u8], at: usize) -> usize {
+    pub fn encode_general(&self, n: i64, buf: &mut [u8], at: usize) -> usize {
         let d = self.decimals as usize;
         let mut u = n.unsigned_abs();
         let digits = decimal_digits(u);
@@ -411,7 +449,7 @@ impl Formatter {
 
 /// Longest text of a number: sign, 16 digits (|units| < 2^53), a leading
 /// zero and the point, rounded up.
-pub(crate) const ENCODE_MAX: usize = 24;
+pub const ENCODE_MAX: usize = 24;
 
 /// Correctly rounded (ties to even) `value * 10^decimals` as an integer,
 /// computed from the exact binary value. Only called near ties.
@@ -512,7 +550,7 @@ fn decimal_digits(u: u64) -> usize {
 /// Writes `u` in decimal at `at` and returns where it ends; writes up to
 /// 20 bytes (`buf` must have that room).
 #[inline]
-pub(crate) fn encode_u64(buf: &mut [u8], at: usize, u: u64) -> usize {
+pub fn encode_u64(buf: &mut [u8], at: usize, u: u64) -> usize {
     if u < 100_000_000 {
         let raw = digit_values8(u as u32);
         // Leading zero digits (the last digit always counts).
@@ -536,7 +574,7 @@ pub(crate) fn encode_u64(buf: &mut [u8], at: usize, u: u64) -> usize {
 
 /// Appends an unsigned integer in decimal, at least `min_digits` digits.
 #[inline]
-pub(crate) fn write_u64(out: &mut Vec<u8>, mut u: u64, min_digits: usize) {
+pub fn write_u64(out: &mut Vec<u8>, mut u: u64, min_digits: usize) {
     let mut tmp = [b'0'; 24];
     let mut pos = tmp.len();
     while u >= 10 {
