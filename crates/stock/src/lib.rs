@@ -1,0 +1,16 @@
+//! Material removal on a tri-dexel stock, a belt-grinding process model,
+//! and comparison of the simulated part with the design.
+//!
+//! (Crate doc completed below.)
+
+// `!(a < b)` on floats is deliberate here: it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod dexel;
+pub mod kernel;
+pub mod stock;
+pub mod tolerance;
+pub mod tool;
+
+pub use stock::{CutError, Family, MoveCut, Stock, StockError, default_resolution};
+pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};
