@@ -73,3 +73,28 @@ pub fn contains(ray: &[Segment], t: f64) -> bool {
     let i = ray.partition_point(|s| s.hi < t);
     i < ray.len() && ray[i].lo <= t
 }
+
+/// Adds the closed interval [a, b] of material (ends marked [`UNCUT`]),
+/// merging with what it touches.
+pub fn add(ray: &mut Ray, a: f64, b: f64) {
+    if !(a < b) {
+        return;
+    }
+    let first = ray.partition_point(|s| s.hi < a);
+    let mut last = first;
+    let mut seg = Segment { lo: a, hi: b, lo_move: UNCUT, hi_move: UNCUT };
+    while last < ray.len() && ray[last].lo <= b {
+        let s = ray[last];
+        if s.lo < seg.lo {
+            seg.lo = s.lo;
+            seg.lo_move = s.lo_move;
+        }
+        if s.hi > seg.hi {
+            seg.hi = s.hi;
+            seg.hi_move = s.hi_move;
+        }
+        last += 1;
+    }
+    ray.drain(first..last);
+    ray.insert(first, seg);
+}

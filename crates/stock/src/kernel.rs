@@ -334,3 +334,31 @@ pub fn cylinder_sweep_span(
     }
     span
 }
+
+/// The span of the points within `a` of the triangle (p0, p1, p2): the
+/// triangle grown by a ball is convex, the hull of the capsules of its
+/// edges and of the prism {|n̂·(x − p0)| ≤ a} over the triangle (three edge
+/// planes through n̂).
+pub fn triangle_offset_span(o: &Vector3<f64>, d: &Vector3<f64>, p: [Vector3<f64>; 3], a: f64) -> Option<Span> {
+    let mut span = None;
+    for i in 0..3 {
+        let (s, e) = (p[i], p[(i + 1) % 3]);
+        span = hull(span, capsule_span(o, d, &s, &(e - s), a));
+    }
+    let n = (p[1] - p[0]).cross(&(p[2] - p[0]));
+    let len = n.norm();
+    if len > 0.0 {
+        let n = n / len;
+        let rel = o - p[0];
+        let mut prism = slab(rel.dot(&n), d.dot(&n), -a, a);
+        for i in 0..3 {
+            let (s, e) = (p[i], p[(i + 1) % 3]);
+            // Inward normal of the edge plane (triangle counter-clockwise about n).
+            let m = n.cross(&(e - s));
+            let r = o - s;
+            prism = meet(prism, linear_le0(-r.dot(&m), -d.dot(&m)));
+        }
+        span = hull(span, prism);
+    }
+    span
+}

@@ -6,11 +6,16 @@
 // `!(a < b)` on floats is deliberate here: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod build;
 pub mod dexel;
+pub mod design;
 pub mod kernel;
+pub mod mesh;
 pub mod stock;
 pub mod tolerance;
 pub mod tool;
 
 pub use stock::{CutError, Family, MoveCut, Stock, StockError, default_resolution};
+pub use design::{Comparison, Design, DesignError, Region, Sample, compare};
+pub use mesh::{Mesh, MeshError};
 pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};

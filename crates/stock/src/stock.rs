@@ -32,6 +32,15 @@ pub enum StockError {
     /// The mesh has no triangle or a coordinate that is not finite.
     #[error("the mesh is empty or has a coordinate that is not a finite number")]
     BadMesh,
+    /// Rays cross the mesh an odd number of times: it has holes.
+    #[error("the mesh is not closed: {rays} rays cross it an odd number of times")]
+    OpenMesh {
+        /// How many rays did.
+        rays: usize,
+    },
+    /// The allowance is not a finite number ≥ 0.
+    #[error("the allowance must be a number of mm, 0 or more, not {0}")]
+    Allowance(f64),
 }
 
 /// Why a move cannot be cut.
