@@ -11,11 +11,15 @@ pub mod dexel;
 pub mod design;
 pub mod kernel;
 pub mod mesh;
+pub mod process;
 pub mod stock;
 pub mod tolerance;
 pub mod tool;
 
 pub use stock::{CutError, Family, MoveCut, Stock, StockError, default_resolution};
 pub use design::{Comparison, Design, DesignError, Region, Sample, compare};
+pub use process::{
+    Calibration, Conditions, Contact, GrindStats, ProcessError, ProcessModel, Trace, belt_speed_mm_s, calibrate,
+};
 pub use mesh::{Mesh, MeshError};
 pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};
