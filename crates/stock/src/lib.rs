@@ -7,6 +7,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod build;
+pub mod clip;
 pub mod dexel;
 pub mod contour;
 pub mod design;

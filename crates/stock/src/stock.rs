@@ -3,6 +3,7 @@
 use nalgebra::{Point3, Unit, Vector3};
 use rayon::prelude::*;
 
+use crate::clip::{Aabb, piece_in_box, swept_in_box};
 use crate::dexel::{Ray, Segment, UNCUT, subtract};
 use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
 use crate::tolerance::{DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION};
@@ -135,14 +136,11 @@ impl Bounded {
     }
 }
 
-fn bounds_of(lo: Point3<f64>, hi: Point3<f64>) -> ([f64; 3], [f64; 3]) {
-    ([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z])
-}
-
-fn placed_solids(t: &PlacedTool, out: &mut Vec<Bounded>) {
+fn placed_solids(t: &PlacedTool, boxed: &Aabb, out: &mut Vec<Bounded>) {
     for p in &t.pieces {
-        let (lo, hi) = bounds_of(p.bounds(&t.origin, &t.axis).0, p.bounds(&t.origin, &t.axis).1);
-        out.push(Bounded { solid: Solid::Piece { piece: *p, origin: t.origin.coords, axis: t.axis }, lo, hi });
+        if let Some((lo, hi)) = piece_in_box(p, &t.origin, &t.axis, boxed) {
+            out.push(Bounded { solid: Solid::Piece { piece: *p, origin: t.origin.coords, axis: t.axis }, lo, hi });
+        }
     }
 }
 
@@ -229,6 +227,11 @@ impl Stock {
         self.initial_volume = self.volume_mm3();
     }
 
+    /// The box where material can be: the lattice's cells.
+    fn lattice_box(&self) -> Aabb {
+        (self.origin, std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution))
+    }
+
     /// The ray spacing, mm.
     pub fn resolution_mm(&self) -> f64 {
         self.resolution
@@ -302,7 +305,7 @@ impl Stock {
     pub fn cut_pose(&mut self, tool: &Tool, pose: &ToolPose, move_id: u32) -> Result<(), CutError> {
         let placed = tool.place(pose)?;
         let mut solids = Vec::new();
-        placed_solids(&placed, &mut solids);
+        placed_solids(&placed, &self.lattice_box(), &mut solids);
         self.remove(&solids, move_id);
         self.last = Some((*tool, *pose));
         Ok(())
@@ -335,24 +338,25 @@ impl Stock {
         let step = SAMPLE_STEP_FRACTION * self.resolution;
         let mut solids = Vec::new();
         let mut samples = 0u64;
+        let boxed = self.lattice_box();
         let result = if same_axis {
             let v = p1.origin - p0.origin;
             for piece in &p0.pieces {
                 match *piece {
                     Piece::Sphere { zc, r } => {
                         let c0 = p0.origin.coords + zc * p0.axis;
-                        let (lo, hi) = bounds_of(piece.bounds(&p0.origin, &p0.axis).0, piece.bounds(&p0.origin, &p0.axis).1);
-                        let (lo, hi) = grow_by(lo, hi, &v);
-                        solids.push(Bounded { solid: Solid::Capsule { c0, v, r }, lo, hi });
+                        if let Some((lo, hi)) = swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed) {
+                            solids.push(Bounded { solid: Solid::Capsule { c0, v, r }, lo, hi });
+                        }
                     }
                     Piece::Cylinder { z0, z1, r } => {
-                        let (lo, hi) = bounds_of(piece.bounds(&p0.origin, &p0.axis).0, piece.bounds(&p0.origin, &p0.axis).1);
-                        let (lo, hi) = grow_by(lo, hi, &v);
-                        solids.push(Bounded {
-                            solid: Solid::CylinderSweep { origin: p0.origin.coords, axis: p0.axis, z0, z1, r, v },
-                            lo,
-                            hi,
-                        });
+                        if let Some((lo, hi)) = swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed) {
+                            solids.push(Bounded {
+                                solid: Solid::CylinderSweep { origin: p0.origin.coords, axis: p0.axis, z0, z1, r, v },
+                                lo,
+                                hi,
+                            });
+                        }
                     }
                     Piece::Cone { .. } | Piece::RoundedDisc { .. } => {
                         let n = sample_count(v.norm(), step)?;
@@ -362,8 +366,9 @@ impl Stock {
                                 continue;
                             }
                             let o = p0.origin + v * (i as f64 / n as f64);
-                            let (lo, hi) = bounds_of(piece.bounds(&o, &p0.axis).0, piece.bounds(&o, &p0.axis).1);
-                            solids.push(Bounded { solid: Solid::Piece { piece: *piece, origin: o.coords, axis: p0.axis }, lo, hi });
+                            if let Some((lo, hi)) = piece_in_box(piece, &o, &p0.axis, &boxed) {
+                                solids.push(Bounded { solid: Solid::Piece { piece: *piece, origin: o.coords, axis: p0.axis }, lo, hi });
+                            }
                         }
                     }
                 }
@@ -383,7 +388,7 @@ impl Stock {
                     continue;
                 }
                 let pose = interpolate(from, to, i as f64 / n as f64).ok_or(CutError::HalfTurn)?;
-                placed_solids(&tool.place(&pose)?, &mut solids);
+                placed_solids(&tool.place(&pose)?, &boxed, &mut solids);
             }
             MoveCut { samples: n + 1 - u64::from(start_done), analytic: false }
         };
@@ -488,13 +493,6 @@ fn remove_spans(ray: &mut Ray, spans: &mut [Span], id: u32) {
             subtract(ray, cur.lo, cur.hi, id);
         }
     }
-}
-
-fn grow_by(lo: [f64; 3], hi: [f64; 3], v: &Vector3<f64>) -> ([f64; 3], [f64; 3]) {
-    (
-        std::array::from_fn(|i| lo[i].min(lo[i] + v[i])),
-        std::array::from_fn(|i| hi[i].max(hi[i] + v[i])),
-    )
 }
 
 fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
