@@ -15,7 +15,15 @@ impl Stock {
     pub fn ray_grid(&self, k: usize) -> RayGrid {
         let f = self.family(k);
         let o = self.origin();
-        RayGrid { k, u: f.u, v: f.v, nu: f.nu, nv: f.nv, origin: [o.x, o.y, o.z], h: self.resolution_mm() }
+        RayGrid {
+            k,
+            u: f.u,
+            v: f.v,
+            nu: f.nu,
+            nv: f.nv,
+            origin: [o.x, o.y, o.z],
+            h: self.resolution_mm(),
+        }
     }
 
     /// The solid a closed mesh bounds: along each ray the sorted crossings
@@ -35,7 +43,11 @@ impl Stock {
     /// allowance (exact along each ray: see
     /// [`crate::kernel::triangle_offset_span`]), i.e. all points within the
     /// allowance of the solid.
-    pub fn from_mesh_offset(mesh: &Mesh, allowance_mm: f64, resolution_mm: f64) -> Result<Stock, StockError> {
+    pub fn from_mesh_offset(
+        mesh: &Mesh,
+        allowance_mm: f64,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
         if !(allowance_mm.is_finite() && allowance_mm >= 0.0) {
             return Err(StockError::Allowance(allowance_mm));
         }
@@ -47,9 +59,13 @@ impl Stock {
         if a > 0.0 {
             for (f, g) in stock.families_mut().iter_mut().zip(grids) {
                 let bins = bin_rows(mesh, &g, a);
-                f.rays.par_chunks_mut(g.nu).zip(bins.par_iter()).enumerate().for_each(|(iv, (row, bin))| {
-                    grow_row(mesh, &g, bin, iv, a, row);
-                });
+                f.rays
+                    .par_chunks_mut(g.nu)
+                    .zip(bins.par_iter())
+                    .enumerate()
+                    .for_each(|(iv, (row, bin))| {
+                        grow_row(mesh, &g, bin, iv, a, row);
+                    });
             }
         }
         stock.set_initial_volume();
@@ -57,7 +73,12 @@ impl Stock {
     }
 
     /// [`Stock::from_mesh`] on a lattice over a given box.
-    fn from_mesh_in(mesh: &Mesh, lo: Point3<f64>, hi: Point3<f64>, resolution_mm: f64) -> Result<Stock, StockError> {
+    fn from_mesh_in(
+        mesh: &Mesh,
+        lo: Point3<f64>,
+        hi: Point3<f64>,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
         let mut stock = Stock::empty(lo, hi, resolution_mm)?;
         let grids: Vec<RayGrid> = (0..3).map(|k| stock.ray_grid(k)).collect();
         let mut odd = 0usize;
@@ -96,7 +117,9 @@ fn grow_row(mesh: &Mesh, g: &RayGrid, bin: &[u32], iv: usize, a: f64, row: &mut 
         let lo = p[0][g.u].min(p[1][g.u]).min(p[2][g.u]) - a;
         let hi = p[0][g.u].max(p[1][g.u]).max(p[2][g.u]) + a;
         let i0 = ((lo - g.origin[g.u]) / g.h - 0.5).ceil().max(0.0);
-        let i1 = ((hi - g.origin[g.u]) / g.h - 0.5).floor().min(g.nu as f64 - 1.0);
+        let i1 = ((hi - g.origin[g.u]) / g.h - 0.5)
+            .floor()
+            .min(g.nu as f64 - 1.0);
         if !(i0 <= i1) {
             continue;
         }
@@ -133,5 +156,10 @@ fn push_merged(ray: &mut Ray, a: f64, b: f64) {
         last.hi = last.hi.max(b);
         return;
     }
-    ray.push(Segment { lo: a, hi: b, lo_move: UNCUT, hi_move: UNCUT });
+    ray.push(Segment {
+        lo: a,
+        hi: b,
+        lo_move: UNCUT,
+        hi_move: UNCUT,
+    });
 }

@@ -4,9 +4,9 @@
 //! For a convex piece K and a box B = ∩ slabs S_j, bbox(K ∩ B) ⊆ B ∩
 //! bbox(K) ∩_j bbox(K ∩ S_j). For a cylinder the extreme points of K ∩ S_j
 //! lie on its rim discs clipped to S_j (rim arcs and the chords' ends) or
-//! on the sections of its lateral surface by the slab's planes (ellipses,
-//! bounded here by the whole ellipse of the infinite cylinder): all closed
-//! form. A wheel pressed 0.05 mm into a flat is thus bounded by its 4.5 mm
+//! on the sections of its lateral surface by the slab's planes (ellipse
+//! arcs within the cylinder's length, extreme where a sinusoid is): all
+//! closed form. A wheel pressed 0.05 mm into a flat is thus bounded by its 4.5 mm
 //! contact cap, not by its 100 mm diameter. Other pieces keep their own
 //! bounds, cut to the box.
 
@@ -18,7 +18,10 @@ use crate::tool::Piece;
 pub type Aabb = ([f64; 3], [f64; 3]);
 
 fn meet(a: Aabb, b: Aabb) -> Aabb {
-    (std::array::from_fn(|i| a.0[i].max(b.0[i])), std::array::from_fn(|i| a.1[i].min(b.1[i])))
+    (
+        std::array::from_fn(|i| a.0[i].max(b.0[i])),
+        std::array::from_fn(|i| a.1[i].min(b.1[i])),
+    )
 }
 
 /// Whether the bounds are empty.
@@ -34,7 +37,11 @@ struct Grow {
 
 impl Grow {
     fn new() -> Self {
-        Grow { lo: [f64::INFINITY; 3], hi: [f64::NEG_INFINITY; 3], any: false }
+        Grow {
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
+            any: false,
+        }
     }
     fn add(&mut self, p: [f64; 3]) {
         for i in 0..3 {
@@ -43,15 +50,15 @@ impl Grow {
         }
         self.any = true;
     }
-    fn add_range(&mut self, i: usize, lo: f64, hi: f64) {
-        self.lo[i] = self.lo[i].min(lo);
-        self.hi[i] = self.hi[i].max(hi);
-    }
 }
 
 /// Two unit vectors across the axis.
 fn frame(w: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let a = if w.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let a = if w.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
     let e1 = w.cross(&a).normalize();
     (e1, w.cross(&e1))
 }
@@ -59,7 +66,17 @@ fn frame(w: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 /// Points of the disc (centre c, radius r, in the plane of e1, e2) that can
 /// be extreme in K ∩ {lo ≤ x_j ≤ hi}: the rim's extremes along every axis
 /// when inside the slab, and where the rim crosses the slab's planes.
-fn disc_in_slab(c: &Vector3<f64>, r: f64, e1: &Vector3<f64>, e2: &Vector3<f64>, j: usize, lo: f64, hi: f64, g: &mut Grow) {
+#[allow(clippy::too_many_arguments)]
+fn disc_in_slab(
+    c: &Vector3<f64>,
+    r: f64,
+    e1: &Vector3<f64>,
+    e2: &Vector3<f64>,
+    j: usize,
+    lo: f64,
+    hi: f64,
+    g: &mut Grow,
+) {
     let at = |phi: f64| (c + r * (phi.cos() * e1 + phi.sin() * e2)).into();
     let inside = |p: &[f64; 3]| p[j] >= lo - 1e-12 && p[j] <= hi + 1e-12;
     for i in 0..3 {
@@ -88,7 +105,16 @@ fn disc_in_slab(c: &Vector3<f64>, r: f64, e1: &Vector3<f64>, e2: &Vector3<f64>, 
 
 /// Bounds of a cylinder piece within the slab `lo ≤ x_j ≤ hi`.
 #[allow(clippy::too_many_arguments)]
-fn cylinder_in_slab(o: &Vector3<f64>, w: &Vector3<f64>, z0: f64, z1: f64, r: f64, j: usize, lo: f64, hi: f64) -> Option<Aabb> {
+fn cylinder_in_slab(
+    o: &Vector3<f64>,
+    w: &Vector3<f64>,
+    z0: f64,
+    z1: f64,
+    r: f64,
+    j: usize,
+    lo: f64,
+    hi: f64,
+) -> Option<Aabb> {
     let (e1, e2) = frame(w);
     let mut g = Grow::new();
     for z in [z0, z1] {
@@ -96,20 +122,25 @@ fn cylinder_in_slab(o: &Vector3<f64>, w: &Vector3<f64>, z0: f64, z1: f64, r: f64
     }
     if w[j].abs() > 1e-12 {
         for plane in [lo, hi] {
-            // Where the plane crosses the axis, and the ellipse around it.
-            let s = (plane - o[j]) / w[j];
-            if s < z0 - r * (1.0 - w[j] * w[j]).sqrt() / w[j].abs() - 1e-9
-                || s > z1 + r * (1.0 - w[j] * w[j]).sqrt() / w[j].abs() + 1e-9
-            {
-                continue;
-            }
-            let c = o + s * w;
+            // The plane's section of the lateral surface: the ellipse
+            // φ ↦ O + s(φ)·w + r·(cos φ e1 + sin φ e2) with s(φ) from
+            // x_j = plane, kept where s is within [z0, z1] (where it leaves
+            // that range it meets the rims, whose crossings are added
+            // above). Along axis i it is A + B cos φ + C sin φ, extreme at
+            // φ = atan2(C, B) and its opposite.
+            let base = (plane - o[j]) / w[j];
+            let s_of = |phi: f64| base - r * (phi.cos() * e1[j] + phi.sin() * e2[j]) / w[j];
             for i in 0..3 {
                 let k = w[i] / w[j];
-                let half = r * (e1[i] - e1[j] * k).hypot(e2[i] - e2[j] * k);
-                g.add_range(i, c[i] - half, c[i] + half);
+                let (bi, ci) = (r * (e1[i] - e1[j] * k), r * (e2[i] - e2[j] * k));
+                let phi = ci.atan2(bi);
+                for ph in [phi, phi + std::f64::consts::PI] {
+                    let s = s_of(ph);
+                    if s >= z0 - 1e-12 && s <= z1 + 1e-12 {
+                        g.add((o + s * w + r * (ph.cos() * e1 + ph.sin() * e2)).into());
+                    }
+                }
             }
-            g.any = true;
         }
     }
     if !g.any {
@@ -121,7 +152,12 @@ fn cylinder_in_slab(o: &Vector3<f64>, w: &Vector3<f64>, z0: f64, z1: f64, r: f64
 }
 
 /// Bounds of the piece at `origin` along `axis`, within the box.
-pub fn piece_in_box(piece: &Piece, origin: &Point3<f64>, axis: &Vector3<f64>, boxed: &Aabb) -> Option<Aabb> {
+pub fn piece_in_box(
+    piece: &Piece,
+    origin: &Point3<f64>,
+    axis: &Vector3<f64>,
+    boxed: &Aabb,
+) -> Option<Aabb> {
     let (lo, hi) = piece.bounds(origin, axis);
     let mut b = meet(([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]), *boxed);
     if is_empty(&b) {
@@ -142,7 +178,13 @@ pub fn piece_in_box(piece: &Piece, origin: &Point3<f64>, axis: &Vector3<f64>, bo
 /// Bounds of the piece swept by `v` within the box: the piece within the
 /// box reached back by v, swept forward by v (x in the box and on the
 /// sweep has x − s·v in the piece and in the box − s·v).
-pub fn swept_in_box(piece: &Piece, origin: &Point3<f64>, axis: &Vector3<f64>, v: &Vector3<f64>, boxed: &Aabb) -> Option<Aabb> {
+pub fn swept_in_box(
+    piece: &Piece,
+    origin: &Point3<f64>,
+    axis: &Vector3<f64>,
+    v: &Vector3<f64>,
+    boxed: &Aabb,
+) -> Option<Aabb> {
     let back: Aabb = (
         std::array::from_fn(|i| boxed.0[i] - v[i].max(0.0)),
         std::array::from_fn(|i| boxed.1[i] - v[i].min(0.0)),

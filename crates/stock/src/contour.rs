@@ -39,7 +39,14 @@ pub struct PartMesh {
 
 /// The six tetrahedra of a cell by corner bits (x = 1, y = 2, z = 4), each
 /// along a path 0 → e_a → e_a + e_b → 7.
-const TETS: [[usize; 4]; 6] = [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
+const TETS: [[usize; 4]; 6] = [
+    [0, 1, 3, 7],
+    [0, 1, 5, 7],
+    [0, 2, 3, 7],
+    [0, 2, 6, 7],
+    [0, 4, 5, 7],
+    [0, 4, 6, 7],
+];
 
 struct Lattice<'a> {
     stock: &'a Stock,
@@ -185,12 +192,21 @@ fn same_four(l: &Lattice, i: i64, j: i64) -> bool {
     [(1, 0), (0, 1), (1, 1)].iter().all(|&(di, dj)| {
         let r = l.ray(2, [i + di, j + dj, 0]);
         let k = |t: f64| ((t - l.origin[2]) / l.h - 0.5).floor() as i64;
-        r.len() == r0.len() && r.iter().zip(r0).all(|(a, b)| k(a.lo) == k(b.lo) && k(a.hi) == k(b.hi))
+        r.len() == r0.len()
+            && r.iter()
+                .zip(r0)
+                .all(|(a, b)| k(a.lo) == k(b.lo) && k(a.hi) == k(b.hi))
     })
 }
 
 fn cell(l: &Lattice, base: [i64; 3], ids: &mut HashMap<(u64, u64), u32>, mesh: &mut PartMesh) {
-    let corner = |c: usize| [base[0] + (c & 1) as i64, base[1] + ((c >> 1) & 1) as i64, base[2] + ((c >> 2) & 1) as i64];
+    let corner = |c: usize| {
+        [
+            base[0] + (c & 1) as i64,
+            base[1] + ((c >> 1) & 1) as i64,
+            base[2] + ((c >> 2) & 1) as i64,
+        ]
+    };
     let solid: [bool; 8] = std::array::from_fn(|c| l.solid(corner(c)));
     if solid.iter().all(|&s| s) || solid.iter().all(|&s| !s) {
         return;
@@ -203,8 +219,16 @@ fn cell(l: &Lattice, base: [i64; 3], ids: &mut HashMap<(u64, u64), u32>, mesh: &
         }
         // Faces as triples of corner edges (solid corner, empty corner).
         let faces: Vec<[(usize, usize); 3]> = match (inside.len(), outside.len()) {
-            (1, 3) => vec![[(inside[0], outside[0]), (inside[0], outside[1]), (inside[0], outside[2])]],
-            (3, 1) => vec![[(inside[0], outside[0]), (inside[1], outside[0]), (inside[2], outside[0])]],
+            (1, 3) => vec![[
+                (inside[0], outside[0]),
+                (inside[0], outside[1]),
+                (inside[0], outside[2]),
+            ]],
+            (3, 1) => vec![[
+                (inside[0], outside[0]),
+                (inside[1], outside[0]),
+                (inside[2], outside[0]),
+            ]],
             _ => {
                 let (a, b, c, d) = (inside[0], inside[1], outside[0], outside[1]);
                 vec![[(a, c), (a, d), (b, d)], [(a, c), (b, d), (b, c)]]
@@ -230,13 +254,21 @@ fn cell(l: &Lattice, base: [i64; 3], ids: &mut HashMap<(u64, u64), u32>, mesh: &
                 let (pa, pb) = (corner(a), corner(b));
                 [0, 1, 2].map(|i| 0.5 * (pa[i] + pb[i]) as f64)
             });
-            let f = if normal_dot(&mids, dir) < 0.0 { [f[0], f[2], f[1]] } else { f };
+            let f = if normal_dot(&mids, dir) < 0.0 {
+                [f[0], f[2], f[1]]
+            } else {
+                f
+            };
             let tri = f.map(|(a, b)| {
                 let (pa, pb) = (corner(a), corner(b));
                 let (ia, ib) = (l.id(pa), l.id(pb));
                 let key = (ia.min(ib), ia.max(ib));
                 *ids.entry(key).or_insert_with(|| {
-                    mesh.vertices.push(if ia < ib { l.position(pa, pb) } else { l.position(pb, pa) });
+                    mesh.vertices.push(if ia < ib {
+                        l.position(pa, pb)
+                    } else {
+                        l.position(pb, pa)
+                    });
                     (mesh.vertices.len() - 1) as u32
                 })
             });
@@ -248,6 +280,10 @@ fn cell(l: &Lattice, base: [i64; 3], ids: &mut HashMap<(u64, u64), u32>, mesh: &
 fn normal_dot(p: &[[f64; 3]; 3], dir: [f64; 3]) -> f64 {
     let e1 = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
     let e2 = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
-    let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+    let n = [
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ];
     n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]
 }

@@ -63,11 +63,25 @@ impl Design {
     /// A closed design mesh (an STL of the part). Turned over if its
     /// triangles face inwards (negative enclosed volume).
     pub fn from_mesh(mesh: Mesh) -> Result<Design, DesignError> {
-        let finite = mesh.vertices.iter().all(|p| p.iter().all(|c| c.is_finite()));
-        if mesh.triangles.is_empty() || !finite || mesh.triangles.iter().flatten().any(|&i| i as usize >= mesh.vertices.len()) {
+        let finite = mesh
+            .vertices
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()));
+        if mesh.triangles.is_empty()
+            || !finite
+            || mesh
+                .triangles
+                .iter()
+                .flatten()
+                .any(|&i| i as usize >= mesh.vertices.len())
+        {
             return Err(DesignError::BadMesh);
         }
-        let mesh = if mesh.signed_volume6() < 0.0 { mesh.flipped() } else { mesh };
+        let mesh = if mesh.signed_volume6() < 0.0 {
+            mesh.flipped()
+        } else {
+            mesh
+        };
         Ok(Design { mesh, closed: true })
     }
 
@@ -78,7 +92,11 @@ impl Design {
     /// length… see the code; at least 8, at most 2000 steps per direction).
     /// The surface's normal (S_u × S_v) points out of the material; `flip`
     /// turns it over.
-    pub fn from_surface(surface: &Surface, chord_mm: f64, flip: bool) -> Result<Design, DesignError> {
+    pub fn from_surface(
+        surface: &Surface,
+        chord_mm: f64,
+        flip: bool,
+    ) -> Result<Design, DesignError> {
         if !(chord_mm.is_finite() && chord_mm > 0.0) {
             return Err(DesignError::Tolerance(chord_mm));
         }
@@ -95,7 +113,9 @@ impl Design {
                     kappa = kappa.max(g.k1.abs()).max(g.k2.abs());
                 }
                 if j > 0 {
-                    let p = |a: usize, b: usize| surface.point(at(a, coarse, u0, u1), at(b, coarse, v0, v1));
+                    let p = |a: usize, b: usize| {
+                        surface.point(at(a, coarse, u0, u1), at(b, coarse, v0, v1))
+                    };
                     lv += (p(i, j) - p(i, j - 1)).norm();
                     lu += (p(j, i) - p(j - 1, i)).norm();
                 }
@@ -104,9 +124,15 @@ impl Design {
             len_v = len_v.max(lv);
         }
         if !(kappa.is_finite() && len_u.is_finite() && len_v.is_finite()) {
-            return Err(DesignError::Surface("its points or curvature are not finite"));
+            return Err(DesignError::Surface(
+                "its points or curvature are not finite",
+            ));
         }
-        let step = if kappa > 0.0 { (8.0 * chord_mm / kappa).sqrt() } else { f64::INFINITY };
+        let step = if kappa > 0.0 {
+            (8.0 * chord_mm / kappa).sqrt()
+        } else {
+            f64::INFINITY
+        };
         let count = |len: f64| ((len / step).ceil() as usize).clamp(8, 2000) + 1;
         let (nu, nv) = (count(len_u), count(len_v));
         let mut vertices = Vec::with_capacity(nu * nv);
@@ -134,7 +160,13 @@ impl Design {
         if !vertices.iter().all(|p| p.iter().all(|c| c.is_finite())) {
             return Err(DesignError::Surface("its points are not finite"));
         }
-        Ok(Design { mesh: Mesh { vertices, triangles }, closed: false })
+        Ok(Design {
+            mesh: Mesh {
+                vertices,
+                triangles,
+            },
+            closed: false,
+        })
     }
 
     /// The design's triangles.
@@ -224,12 +256,18 @@ pub struct Comparison {
 impl Comparison {
     /// The deepest gouge (most negative deviation beyond the tolerance).
     pub fn gouge_max(&self) -> Option<&Sample> {
-        self.beyond.iter().filter(|s| s.deviation_mm < 0.0).min_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
+        self.beyond
+            .iter()
+            .filter(|s| s.deviation_mm < 0.0)
+            .min_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
     }
 
     /// The largest residual.
     pub fn residual_max(&self) -> Option<&Sample> {
-        self.beyond.iter().filter(|s| s.deviation_mm > 0.0).max_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
+        self.beyond
+            .iter()
+            .filter(|s| s.deviation_mm > 0.0)
+            .max_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
     }
 }
 
@@ -252,7 +290,11 @@ fn bin_of(dev: f64, tol: f64) -> usize {
 /// Compares the simulated part with the design (see the module doc).
 /// Rows of rays run in parallel; the result does not depend on the thread
 /// count.
-pub fn compare(stock: &Stock, design: &Design, tolerance_mm: f64) -> Result<Comparison, DesignError> {
+pub fn compare(
+    stock: &Stock,
+    design: &Design,
+    tolerance_mm: f64,
+) -> Result<Comparison, DesignError> {
     if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
         return Err(DesignError::Tolerance(tolerance_mm));
     }
@@ -301,8 +343,16 @@ pub fn compare(stock: &Stock, design: &Design, tolerance_mm: f64) -> Result<Comp
     let (gouge_regions, residual_regions) = regions(&total.beyond, h);
     let histogram = (0..9)
         .map(|i| Bin {
-            from_mm: if i == 0 { f64::NEG_INFINITY } else { EDGES[i - 1] * tolerance_mm },
-            to_mm: if i == 8 { f64::INFINITY } else { EDGES[i] * tolerance_mm },
+            from_mm: if i == 0 {
+                f64::NEG_INFINITY
+            } else {
+                EDGES[i - 1] * tolerance_mm
+            },
+            to_mm: if i == 8 {
+                f64::INFINITY
+            } else {
+                EDGES[i] * tolerance_mm
+            },
             samples: total.bins[i].0,
             area_mm2: total.bins[i].1,
         })
@@ -373,7 +423,13 @@ fn measure_ray(
 /// The end of the ray's material nearest to `t` facing the same way
 /// (+1: upper ends, −1: lower ends), with the move that made it.
 pub fn nearest_end(ray: &[Segment], t: f64, orientation: i8) -> Option<(f64, u32)> {
-    let end = |s: &Segment| if orientation > 0 { (s.hi, s.hi_move) } else { (s.lo, s.lo_move) };
+    let end = |s: &Segment| {
+        if orientation > 0 {
+            (s.hi, s.hi_move)
+        } else {
+            (s.lo, s.lo_move)
+        }
+    };
     let i = ray.partition_point(|s| end(s).0 < t);
     let after = ray.get(i).map(end);
     let before = i.checked_sub(1).map(|j| end(&ray[j]));
@@ -429,8 +485,14 @@ fn regions(samples: &[Sample], h: f64) -> (Vec<Region>, Vec<Region>) {
         let k = s.family as usize;
         let t = s.design_point;
         for (du, dv) in [(1i64, 0i64), (0, 1)] {
-            let key = (s.family, (s.iu as i64 + du) as u32, (s.iv as i64 + dv) as u32);
-            let Some(list) = by_ray.get(&key) else { continue };
+            let key = (
+                s.family,
+                (s.iu as i64 + du) as u32,
+                (s.iv as i64 + dv) as u32,
+            );
+            let Some(list) = by_ray.get(&key) else {
+                continue;
+            };
             for &j in list {
                 let o = &samples[j];
                 if o.orientation == s.orientation
@@ -463,8 +525,10 @@ fn regions(samples: &[Sample], h: f64) -> (Vec<Region>, Vec<Region>) {
             reg.move_id = s.move_id;
         }
     }
-    let (mut gouge, mut residual): (Vec<Region>, Vec<Region>) =
-        acc.into_iter().flatten().partition(|r| r.deviation_mm < 0.0);
+    let (mut gouge, mut residual): (Vec<Region>, Vec<Region>) = acc
+        .into_iter()
+        .flatten()
+        .partition(|r| r.deviation_mm < 0.0);
     gouge.sort_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm));
     residual.sort_by(|a, b| b.deviation_mm.total_cmp(&a.deviation_mm));
     (gouge, residual)

@@ -47,7 +47,15 @@ pub fn subtract(ray: &mut Ray, a: f64, b: f64, id: u32) {
             (true, true) => {
                 ray[i].hi = a;
                 ray[i].hi_move = id;
-                ray.insert(i + 1, Segment { lo: b, hi: s.hi, lo_move: id, hi_move: s.hi_move });
+                ray.insert(
+                    i + 1,
+                    Segment {
+                        lo: b,
+                        hi: s.hi,
+                        lo_move: id,
+                        hi_move: s.hi_move,
+                    },
+                );
                 return;
             }
             (true, false) => {
@@ -82,7 +90,12 @@ pub fn add(ray: &mut Ray, a: f64, b: f64) {
     }
     let first = ray.partition_point(|s| s.hi < a);
     let mut last = first;
-    let mut seg = Segment { lo: a, hi: b, lo_move: UNCUT, hi_move: UNCUT };
+    let mut seg = Segment {
+        lo: a,
+        hi: b,
+        lo_move: UNCUT,
+        hi_move: UNCUT,
+    };
     while last < ray.len() && ray[last].lo <= b {
         let s = ray[last];
         if s.lo < seg.lo {

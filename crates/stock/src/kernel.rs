@@ -74,9 +74,15 @@ pub fn hull(a: Option<Span>, b: Option<Span>) -> Option<Span> {
 /// `t` with `a0 + a1·t ≤ 0`.
 fn linear_le0(a0: f64, a1: f64) -> Option<Span> {
     if a1 > 0.0 {
-        Some(Span { lo: f64::NEG_INFINITY, hi: -a0 / a1 })
+        Some(Span {
+            lo: f64::NEG_INFINITY,
+            hi: -a0 / a1,
+        })
     } else if a1 < 0.0 {
-        Some(Span { lo: -a0 / a1, hi: f64::INFINITY })
+        Some(Span {
+            lo: -a0 / a1,
+            hi: f64::INFINITY,
+        })
     } else {
         (a0 <= 0.0).then_some(ALL)
     }
@@ -105,7 +111,10 @@ pub fn quadratic_le0(a: f64, b: f64, c: f64) -> Option<Span> {
         return Some(Span { lo: 0.0, hi: 0.0 });
     }
     let (r1, r2) = (q / a, c / q);
-    Some(Span { lo: r1.min(r2), hi: r1.max(r2) })
+    Some(Span {
+        lo: r1.min(r2),
+        hi: r1.max(r2),
+    })
 }
 
 /// `t` with `a(t) ≤ √(r² − b(t)²)` (and |b(t)| ≤ r), `a = a0 + a1·t`,
@@ -137,13 +146,60 @@ pub struct Local {
 
 impl Local {
     /// The line `o + t·d` seen from the frame at `origin` with unit `axis`.
-    pub fn new(o: &Vector3<f64>, d: &Vector3<f64>, origin: &Vector3<f64>, axis: &Vector3<f64>) -> Local {
+    pub fn new(
+        o: &Vector3<f64>,
+        d: &Vector3<f64>,
+        origin: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> Local {
         let p = o - origin;
         let z0 = p.dot(axis);
         let dz = d.dot(axis);
         let pp = p - z0 * axis;
         let dp = d - dz * axis;
-        Local { z0, dz, a: dp.norm_squared(), b: pp.dot(&dp), c: pp.norm_squared() }
+        Local {
+            z0,
+            dz,
+            a: dp.norm_squared(),
+            b: pp.dot(&dp),
+            c: pp.norm_squared(),
+        }
+    }
+}
+
+impl Local {
+    /// The line along axis `k` of the part frame through the point whose
+    /// `u` and `v` coordinates are `pu`, `pv` (the stock's rays): the same
+    /// as [`Local::new`] with d = e_k, in a third of the arithmetic.
+    #[inline]
+    pub fn along(
+        k: usize,
+        u: usize,
+        v: usize,
+        pu: f64,
+        pv: f64,
+        origin: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> Local {
+        let mut p = [0.0; 3];
+        p[u] = pu - origin[u];
+        p[v] = pv - origin[v];
+        p[k] = -origin[k];
+        let z0 = p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
+        let pp = [
+            p[0] - z0 * axis[0],
+            p[1] - z0 * axis[1],
+            p[2] - z0 * axis[2],
+        ];
+        let dz = axis[k];
+        // d⊥ = e_k − dz·w, and p⊥·w = 0, so p⊥·d⊥ = p⊥_k.
+        Local {
+            z0,
+            dz,
+            a: 1.0 - dz * dz,
+            b: pp[k],
+            c: pp[0] * pp[0] + pp[1] * pp[1] + pp[2] * pp[2],
+        }
     }
 }
 
@@ -216,68 +272,73 @@ fn cone(l: &Local, z0: f64, r0: f64, z1: f64, r1: f64) -> Option<Span> {
     }
     if span.is_none() {
         // A span of zero length (the line touches the rim or the apex).
-        span = cuts.iter().find(|&&t| inside(t)).map(|&t| Span { lo: t, hi: t });
+        span = cuts
+            .iter()
+            .find(|&&t| inside(t))
+            .map(|&t| Span { lo: t, hi: t });
     }
     span
 }
 
 /// Points within `r` of the disc of radius `disc` at axial `zc`. The
-/// squared distance to a convex set is convex along the line, so: the span
-/// of the bounding sphere brackets it, the minimum is found by bisection on
-/// the sign of the derivative, and the two crossings of r² by bisection on
-/// the monotone sides, each to `ROOT_MM`.
+/// squared distance to a convex set, D²(t), is convex and continuously
+/// differentiable along the line, so f = D² − r² is found from each end of
+/// the bounding sphere's span by Newton's method: from outside a convex
+/// function's root, Newton's steps never pass it and converge to it
+/// (quadratically where D² is smooth); a step that would go uphill means
+/// the line misses the piece. Stops at `ROOT_MM`.
 fn rounded_disc(l: &Local, zc: f64, disc: f64, r: f64) -> Option<Span> {
     let zr = l.z0 - zc;
     let big = disc + r;
-    let bound = quadratic_le0(l.a + l.dz * l.dz, l.b + zr * l.dz, l.c + zr * zr - big * big)?;
-    // Exactly the flat part when the line runs along the axis.
-    let f = |t: f64| {
+    let bound = quadratic_le0(
+        l.a + l.dz * l.dz,
+        l.b + zr * l.dz,
+        l.c + zr * zr - big * big,
+    )?;
+    let r2 = r * r;
+    // f and f' at t.
+    let eval = |t: f64| {
         let z = zr + l.dz * t;
         let rho = (l.a * t * t + 2.0 * l.b * t + l.c).max(0.0).sqrt();
         let out = (rho - disc).max(0.0);
-        z * z + out * out
-    };
-    let df = |t: f64| {
-        let z = zr + l.dz * t;
-        let rho2 = (l.a * t * t + 2.0 * l.b * t + l.c).max(0.0);
-        let rho = rho2.sqrt();
-        let mut g = 2.0 * z * l.dz;
-        if rho > disc && rho > 0.0 {
-            g += 2.0 * (rho - disc) * (l.a * t + l.b) / rho;
+        let mut d = 2.0 * z * l.dz;
+        if out > 0.0 && rho > 0.0 {
+            d += 2.0 * out * (l.a * t + l.b) / rho;
         }
-        g
+        (z * z + out * out - r2, d)
     };
-    let (mut a, mut b) = (bound.lo, bound.hi);
-    while b - a > ROOT_MM {
-        let m = 0.5 * (a + b);
-        if df(m) > 0.0 {
-            b = m;
-        } else {
-            a = m;
-        }
-    }
-    let tmin = 0.5 * (a + b);
-    let r2 = r * r;
-    if f(tmin) > r2 {
-        return None;
-    }
-    let cross = |mut inside: f64, mut outside: f64| {
-        while (outside - inside).abs() > ROOT_MM {
-            let m = 0.5 * (inside + outside);
-            if f(m) <= r2 {
-                inside = m;
-            } else {
-                outside = m;
+    let root = |start: f64, dir: f64| -> Option<f64> {
+        let mut t = start;
+        for _ in 0..200 {
+            let (f, d) = eval(t);
+            if f <= 0.0 {
+                return Some(t);
+            }
+            if d * dir >= 0.0 {
+                return None;
+            }
+            let step = -f / d;
+            t += step;
+            if step.abs() <= ROOT_MM {
+                return Some(t);
             }
         }
-        inside
+        Some(t)
     };
-    Some(Span { lo: cross(tmin, bound.lo), hi: cross(tmin, bound.hi) })
+    let lo = root(bound.lo, 1.0)?;
+    let hi = root(bound.hi, -1.0)?;
+    Span::new(lo, hi)
 }
 
 /// The span of the capsule swept by a sphere of radius `r` from `c0` to
 /// `c0 + v`.
-pub fn capsule_span(o: &Vector3<f64>, d: &Vector3<f64>, c0: &Vector3<f64>, v: &Vector3<f64>, r: f64) -> Option<Span> {
+pub fn capsule_span(
+    o: &Vector3<f64>,
+    d: &Vector3<f64>,
+    c0: &Vector3<f64>,
+    v: &Vector3<f64>,
+    r: f64,
+) -> Option<Span> {
     let sphere = |c: &Vector3<f64>| {
         let oc = o - c;
         quadratic_le0(1.0, oc.dot(d), oc.norm_squared() - r * r)
@@ -328,9 +389,15 @@ pub fn cylinder_sweep_span(
         let (for_hi, for_lo) = if va > 0.0 { (z0, z1) } else { (z1, z0) };
         let k = len / va;
         // a = u − L·(w − for_hi)/v_a
-        span = meet(span, half_disc(u0 - k * (w0 - for_hi), u1 - k * w1, e0, e1, r));
+        span = meet(
+            span,
+            half_disc(u0 - k * (w0 - for_hi), u1 - k * w1, e0, e1, r),
+        );
         // a = L·(w − for_lo)/v_a − u
-        span = meet(span, half_disc(k * (w0 - for_lo) - u0, k * w1 - u1, e0, e1, r));
+        span = meet(
+            span,
+            half_disc(k * (w0 - for_lo) - u0, k * w1 - u1, e0, e1, r),
+        );
     }
     span
 }
@@ -339,7 +406,12 @@ pub fn cylinder_sweep_span(
 /// triangle grown by a ball is convex, the hull of the capsules of its
 /// edges and of the prism {|n̂·(x − p0)| ≤ a} over the triangle (three edge
 /// planes through n̂).
-pub fn triangle_offset_span(o: &Vector3<f64>, d: &Vector3<f64>, p: [Vector3<f64>; 3], a: f64) -> Option<Span> {
+pub fn triangle_offset_span(
+    o: &Vector3<f64>,
+    d: &Vector3<f64>,
+    p: [Vector3<f64>; 3],
+    a: f64,
+) -> Option<Span> {
     let mut span = None;
     for i in 0..3 {
         let (s, e) = (p[i], p[(i + 1) % 3]);

@@ -65,24 +65,42 @@ pub enum MeshError {
 impl Mesh {
     /// Reads an ASCII or binary STL (vertices merged where identical).
     pub fn read_stl<R: Read + Seek>(mut reader: R, file: &str) -> Result<Mesh, MeshError> {
-        let m = stl_io::read_stl(&mut reader).map_err(|source| MeshError::Stl { file: file.to_string(), source })?;
+        let m = stl_io::read_stl(&mut reader).map_err(|source| MeshError::Stl {
+            file: file.to_string(),
+            source,
+        })?;
         if m.faces.is_empty() {
-            return Err(MeshError::Empty { file: file.to_string() });
+            return Err(MeshError::Empty {
+                file: file.to_string(),
+            });
         }
         if m.vertices.len() > u32::MAX as usize {
-            return Err(MeshError::TooLarge { file: file.to_string() });
+            return Err(MeshError::TooLarge {
+                file: file.to_string(),
+            });
         }
-        let vertices: Vec<Point3<f64>> =
-            m.vertices.iter().map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect();
+        let vertices: Vec<Point3<f64>> = m
+            .vertices
+            .iter()
+            .map(|v| Point3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+            .collect();
         let mut triangles = Vec::with_capacity(m.faces.len());
         for (i, f) in m.faces.iter().enumerate() {
             let t = f.vertices;
-            if t.iter().any(|&k| k >= vertices.len() || !vertices[k].iter().all(|c| c.is_finite())) {
-                return Err(MeshError::NotFinite { file: file.to_string(), triangle: i + 1 });
+            if t.iter()
+                .any(|&k| k >= vertices.len() || !vertices[k].iter().all(|c| c.is_finite()))
+            {
+                return Err(MeshError::NotFinite {
+                    file: file.to_string(),
+                    triangle: i + 1,
+                });
             }
             triangles.push([t[0] as u32, t[1] as u32, t[2] as u32]);
         }
-        Ok(Mesh { vertices, triangles })
+        Ok(Mesh {
+            vertices,
+            triangles,
+        })
     }
 
     /// The closed mesh of a box (12 triangles, facing out).
@@ -97,14 +115,31 @@ impl Mesh {
             })
             .collect();
         // Corner i has x bit 1, y bit 2, z bit 4; each face counter-clockwise from outside.
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-        Mesh { vertices, triangles }
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let triangles = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        Mesh {
+            vertices,
+            triangles,
+        }
     }
 
     /// Axis-aligned bounds, `None` for a mesh without triangles.
     pub fn bounds(&self) -> Option<(Point3<f64>, Point3<f64>)> {
-        let mut it = self.triangles.iter().flatten().map(|&i| self.vertices[i as usize]);
+        let mut it = self
+            .triangles
+            .iter()
+            .flatten()
+            .map(|&i| self.vertices[i as usize]);
         let first = it.next()?;
         Some(it.fold((first, first), |(lo, hi), p| (lo.inf(&p), hi.sup(&p))))
     }
@@ -122,7 +157,10 @@ impl Mesh {
 
     /// The same mesh with every triangle turned over.
     pub fn flipped(&self) -> Mesh {
-        Mesh { vertices: self.vertices.clone(), triangles: self.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect() }
+        Mesh {
+            vertices: self.vertices.clone(),
+            triangles: self.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
+        }
     }
 }
 
@@ -197,7 +235,9 @@ pub fn bin_rows(mesh: &Mesh, g: &RayGrid, grow: f64) -> Vec<Vec<u32>> {
         let lo = p[0][v].min(p[1][v]).min(p[2][v]) - grow;
         let hi = p[0][v].max(p[1][v]).max(p[2][v]) + grow;
         let a = ((lo - g.origin[v]) / g.h - 0.5).ceil().max(0.0);
-        let b = ((hi - g.origin[v]) / g.h - 0.5).floor().min(g.nv as f64 - 1.0);
+        let b = ((hi - g.origin[v]) / g.h - 0.5)
+            .floor()
+            .min(g.nv as f64 - 1.0);
         if a <= b {
             for bin in &mut bins[a as usize..=b as usize] {
                 bin.push(ti as u32);
@@ -221,11 +261,17 @@ pub fn row_crossings(mesh: &Mesh, g: &RayGrid, bin: &[u32], iv: usize) -> Vec<Ve
         if area == 0.0 || n[k] == 0.0 {
             continue;
         }
-        let (q0, q1, q2) = if area > 0.0 { (q[0], q[1], q[2]) } else { (q[0], q[2], q[1]) };
+        let (q0, q1, q2) = if area > 0.0 {
+            (q[0], q[1], q[2])
+        } else {
+            (q[0], q[2], q[1])
+        };
         let lo = q0[0].min(q1[0]).min(q2[0]);
         let hi = q0[0].max(q1[0]).max(q2[0]);
         let a = ((lo - g.origin[u]) / h - 0.5).ceil().max(0.0);
-        let b = ((hi - g.origin[u]) / h - 0.5).floor().min(g.nu as f64 - 1.0);
+        let b = ((hi - g.origin[u]) / h - 0.5)
+            .floor()
+            .min(g.nu as f64 - 1.0);
         if !(a <= b) {
             continue;
         }
@@ -263,7 +309,10 @@ pub fn row_crossings(mesh: &Mesh, g: &RayGrid, bin: &[u32], iv: usize) -> Vec<Ve
 /// depend on the thread count.
 pub fn crossings(mesh: &Mesh, g: &RayGrid) -> Vec<Vec<Crossing>> {
     let bins = bin_rows(mesh, g, 0.0);
-    let rows: Vec<Vec<Vec<Crossing>>> =
-        bins.par_iter().enumerate().map(|(iv, bin)| row_crossings(mesh, g, bin, iv)).collect();
+    let rows: Vec<Vec<Vec<Crossing>>> = bins
+        .par_iter()
+        .enumerate()
+        .map(|(iv, bin)| row_crossings(mesh, g, bin, iv))
+        .collect();
     rows.into_iter().flatten().collect()
 }

@@ -115,7 +115,12 @@ impl Contact {
     /// ∫ p dx from the leading edge −a to x (N/mm): 0 before the patch, F/W
     /// after it.
     pub fn cumulative(&self, x: f64) -> f64 {
-        let (a, d, r, k) = (self.half_length_mm, self.indentation_mm, self.effective_radius_mm, self.stiffness_n_per_mm3);
+        let (a, d, r, k) = (
+            self.half_length_mm,
+            self.indentation_mm,
+            self.effective_radius_mm,
+            self.stiffness_n_per_mm3,
+        );
         let x = x.clamp(-a, a);
         k * (d * (x + a) - (x * x * x + a * a * a) / (6.0 * r))
     }
@@ -152,23 +157,41 @@ pub enum ProcessError {
 }
 
 fn check(what: &'static str, value: f64, why: &'static str, ok: bool) -> Result<f64, ProcessError> {
-    if ok && value.is_finite() { Ok(value) } else { Err(ProcessError::Value { what, value, why }) }
+    if ok && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ProcessError::Value { what, value, why })
+    }
 }
 
 impl ProcessModel {
     /// Reads a process file (TOML, the form in the module doc).
     pub fn from_toml(src: &str, file: &str) -> Result<ProcessModel, Diagnostic> {
         let m: ProcessModel = toml::from_str(src).map_err(|e| {
-            Diagnostic::at_byte_span(Severity::Error, file, src, e.span().unwrap_or(0..0), e.message().trim_end())
+            Diagnostic::at_byte_span(
+                Severity::Error,
+                file,
+                src,
+                e.span().unwrap_or(0..0),
+                e.message().trim_end(),
+            )
         })?;
         m.validate().map_err(|e| {
             let key = match e {
                 ProcessError::Value { what, .. } if what.starts_with("force") => "newtons",
-                ProcessError::Value { what, .. } if what.starts_with("Preston") => "preston_mm2_per_n",
+                ProcessError::Value { what, .. } if what.starts_with("Preston") => {
+                    "preston_mm2_per_n"
+                }
                 _ => "stiffness_n_per_mm3",
             };
             let start = src.find(key).unwrap_or(0);
-            Diagnostic::at_byte_span(Severity::Error, file, src, start..start + key.len(), e.to_string())
+            Diagnostic::at_byte_span(
+                Severity::Error,
+                file,
+                src,
+                start..start + key.len(),
+                e.to_string(),
+            )
         })?;
         Ok(m)
     }
@@ -176,17 +199,36 @@ impl ProcessModel {
     /// Checks every value.
     pub fn validate(&self) -> Result<(), ProcessError> {
         let w = &self.wheel;
-        check("Preston's coefficient (mm²/N)", w.preston_mm2_per_n, "a number ≥ 0", w.preston_mm2_per_n >= 0.0)?;
-        check("the wheel stiffness (N/mm³)", w.stiffness_n_per_mm3, "a positive number", w.stiffness_n_per_mm3 > 0.0)?;
+        check(
+            "Preston's coefficient (mm²/N)",
+            w.preston_mm2_per_n,
+            "a number ≥ 0",
+            w.preston_mm2_per_n >= 0.0,
+        )?;
+        check(
+            "the wheel stiffness (N/mm³)",
+            w.stiffness_n_per_mm3,
+            "a positive number",
+            w.stiffness_n_per_mm3 > 0.0,
+        )?;
         let t = &self.force.newtons;
         if t.is_empty() {
-            return Err(ProcessError::Value { what: "force table length", value: 0.0, why: "at least one row" });
+            return Err(ProcessError::Value {
+                what: "force table length",
+                value: 0.0,
+                why: "at least one row",
+            });
         }
         for (i, row) in t.iter().enumerate() {
             check("force table axis value", row[0], "finite", true)?;
             check("force (N)", row[1], "a number ≥ 0", row[1] >= 0.0)?;
             if i > 0 {
-                check("force table axis value", row[0], "increasing down the table", row[0] > t[i - 1][0])?;
+                check(
+                    "force table axis value",
+                    row[0],
+                    "increasing down the table",
+                    row[0] > t[i - 1][0],
+                )?;
             }
         }
         Ok(())
@@ -209,12 +251,28 @@ impl ProcessModel {
 
     /// The contact of a wheel of `radius` and `width` pressed with `force_n`
     /// on a part of curvature `curvature_per_mm` along the feed (> 0 convex).
-    pub fn contact(&self, force_n: f64, radius_mm: f64, width_mm: f64, curvature_per_mm: f64) -> Result<Contact, ProcessError> {
+    pub fn contact(
+        &self,
+        force_n: f64,
+        radius_mm: f64,
+        width_mm: f64,
+        curvature_per_mm: f64,
+    ) -> Result<Contact, ProcessError> {
         check("the force (N)", force_n, "a number ≥ 0", force_n >= 0.0)?;
-        check("the wheel radius (mm)", radius_mm, "positive", radius_mm > 0.0)?;
+        check(
+            "the wheel radius (mm)",
+            radius_mm,
+            "positive",
+            radius_mm > 0.0,
+        )?;
         check("the wheel width (mm)", width_mm, "positive", width_mm > 0.0)?;
         let inv = 1.0 / radius_mm + curvature_per_mm;
-        check("1/R + κ (1/mm)", inv, "positive (the part bends away from the wheel less than the wheel)", inv > 0.0)?;
+        check(
+            "1/R + κ (1/mm)",
+            inv,
+            "positive (the part bends away from the wheel less than the wheel)",
+            inv > 0.0,
+        )?;
         let re = 1.0 / inv;
         let k = self.wheel.stiffness_n_per_mm3;
         let d = (3.0 * force_n / (4.0 * k * width_mm * (2.0 * re).sqrt())).powf(2.0 / 3.0);
@@ -230,7 +288,13 @@ impl ProcessModel {
     }
 
     /// Depth ground from a flat part by one pass, mm: K_p·v_belt·F/(v_f·W).
-    pub fn pass_depth_mm(&self, force_n: f64, belt_mm_s: f64, feed_mm_s: f64, width_mm: f64) -> f64 {
+    pub fn pass_depth_mm(
+        &self,
+        force_n: f64,
+        belt_mm_s: f64,
+        feed_mm_s: f64,
+        width_mm: f64,
+    ) -> f64 {
         self.wheel.preston_mm2_per_n * belt_mm_s * force_n / (feed_mm_s * width_mm)
     }
 }
@@ -288,11 +352,29 @@ impl Stock {
         let Tool::ContactWheel { radius, width, .. } = *tool else {
             return Err(ProcessError::NotAWheel(tool.name()));
         };
-        let placed = tool.place(from).map_err(|e| ProcessError::Cut(CutError::Tool(e)))?;
-        tool.place(to).map_err(|e| ProcessError::Cut(CutError::Tool(e)))?;
-        check("the feed (mm/min)", conditions.feed_mm_min, "positive", conditions.feed_mm_min > 0.0)?;
-        check("the spindle speed (rpm)", conditions.spindle_rpm, "a number ≥ 0", conditions.spindle_rpm >= 0.0)?;
-        let contact = model.contact(conditions.force_n, radius, width, conditions.curvature_per_mm)?;
+        let placed = tool
+            .place(from)
+            .map_err(|e| ProcessError::Cut(CutError::Tool(e)))?;
+        tool.place(to)
+            .map_err(|e| ProcessError::Cut(CutError::Tool(e)))?;
+        check(
+            "the feed (mm/min)",
+            conditions.feed_mm_min,
+            "positive",
+            conditions.feed_mm_min > 0.0,
+        )?;
+        check(
+            "the spindle speed (rpm)",
+            conditions.spindle_rpm,
+            "a number ≥ 0",
+            conditions.spindle_rpm >= 0.0,
+        )?;
+        let contact = model.contact(
+            conditions.force_n,
+            radius,
+            width,
+            conditions.curvature_per_mm,
+        )?;
         let belt = belt_speed_mm_s(conditions.spindle_rpm, radius);
         let feed = conditions.feed_mm_min / 60.0;
         let n = from.axis.into_inner();
@@ -316,14 +398,19 @@ impl Stock {
             }
             kp * (contact.cumulative(s) - contact.cumulative(s - len))
         };
-        let k = (0..3).max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs())).unwrap_or(2);
+        let k = (0..3)
+            .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+            .unwrap_or(2);
         let facing: i8 = if n[k] > 0.0 { 1 } else { -1 };
         let a = contact.half_length_mm;
         // Bounds of the patch swept along the move.
         let corners = [-a, len + a].into_iter().flat_map(|s| {
             [-width / 2.0, width / 2.0].map(|y| from.point.coords + s * f + y * wheel_axis)
         });
-        let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+        let (mut lo, mut hi) = (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        );
         for c in corners {
             lo = lo.inf(&c);
             hi = hi.sup(&c);
@@ -333,7 +420,9 @@ impl Stock {
         let (u, v, nu) = (fam.u, fam.v, fam.nu);
         let range = |i: usize| {
             let a0 = ((lo[i] - origin[i]) / h - 0.5).ceil().max(0.0);
-            let b0 = ((hi[i] - origin[i]) / h - 0.5).floor().min(counts[i] as f64 - 1.0);
+            let b0 = ((hi[i] - origin[i]) / h - 0.5)
+                .floor()
+                .min(counts[i] as f64 - 1.0);
             (a0 <= b0).then_some((a0 as usize, b0 as usize))
         };
         let mut stats = GrindStats {
@@ -357,7 +446,9 @@ impl Stock {
                     let pu = origin[u] + ((u0 + ju) as f64 + 0.5) * h;
                     // The contact plane n·(x − p0) = 0 on this ray.
                     let tp = p0[k] - (n[u] * (pu - p0[u]) + n[v] * (pv - p0[v])) / n[k];
-                    let Some((t, _)) = nearest_end(ray, tp, facing) else { continue };
+                    let Some((t, _)) = nearest_end(ray, tp, facing) else {
+                        continue;
+                    };
                     let mut q = Vector3::zeros();
                     q[u] = pu;
                     q[v] = pv;
@@ -383,7 +474,10 @@ impl Stock {
                 stats.depth_range_mm = if stats.rays == 0 {
                     [mn, mx]
                 } else {
-                    [stats.depth_range_mm[0].min(mn), stats.depth_range_mm[1].max(mx)]
+                    [
+                        stats.depth_range_mm[0].min(mn),
+                        stats.depth_range_mm[1].max(mx),
+                    ]
                 };
                 stats.rays += rays;
             }
@@ -442,9 +536,21 @@ pub struct Calibration {
 pub fn calibrate(traces: &[Trace]) -> Result<Calibration, ProcessError> {
     let (mut sxx, mut sxy) = (0.0, 0.0);
     for t in traces {
-        if let Trace::Pass { force_n, belt_mm_s, feed_mm_s, width_mm, depth_mm } = *t {
+        if let Trace::Pass {
+            force_n,
+            belt_mm_s,
+            feed_mm_s,
+            width_mm,
+            depth_mm,
+        } = *t
+        {
             let x = belt_mm_s * force_n / (feed_mm_s * width_mm);
-            check("a pass's v·F/(v_f·W)", x, "a positive finite number", x > 0.0)?;
+            check(
+                "a pass's v·F/(v_f·W)",
+                x,
+                "a positive finite number",
+                x > 0.0,
+            )?;
             check("a measured depth (mm)", depth_mm, "a finite number", true)?;
             sxx += x * x;
             sxy += x * depth_mm;
@@ -456,10 +562,23 @@ pub fn calibrate(traces: &[Trace]) -> Result<Calibration, ProcessError> {
     let kp = sxy / sxx;
     let (mut szz, mut szy) = (0.0, 0.0);
     for t in traces {
-        if let Trace::Dwell { force_n, belt_mm_s, dwell_s, width_mm, radius_mm, depth_mm } = *t {
+        if let Trace::Dwell {
+            force_n,
+            belt_mm_s,
+            dwell_s,
+            width_mm,
+            radius_mm,
+            depth_mm,
+        } = *t
+        {
             let c = (3.0 * force_n / (4.0 * width_mm * (2.0 * radius_mm).sqrt())).powf(2.0 / 3.0);
             let z = kp * belt_mm_s * dwell_s * c;
-            check("a dwell's K_p·v·T·c", z, "a positive finite number", z > 0.0)?;
+            check(
+                "a dwell's K_p·v·T·c",
+                z,
+                "a positive finite number",
+                z > 0.0,
+            )?;
             check("a measured depth (mm)", depth_mm, "a finite number", true)?;
             szz += z * z;
             szy += z * depth_mm;
@@ -469,12 +588,27 @@ pub fn calibrate(traces: &[Trace]) -> Result<Calibration, ProcessError> {
     let mut sq = 0.0;
     for t in traces {
         let (model, measured) = match *t {
-            Trace::Pass { force_n, belt_mm_s, feed_mm_s, width_mm, depth_mm } => {
-                (kp * belt_mm_s * force_n / (feed_mm_s * width_mm), depth_mm)
-            }
-            Trace::Dwell { force_n, belt_mm_s, dwell_s, width_mm, radius_mm, depth_mm } => {
-                let c = (3.0 * force_n / (4.0 * width_mm * (2.0 * radius_mm).sqrt())).powf(2.0 / 3.0);
-                (kp * belt_mm_s * dwell_s * c * stiffness.unwrap_or(0.0).cbrt(), depth_mm)
+            Trace::Pass {
+                force_n,
+                belt_mm_s,
+                feed_mm_s,
+                width_mm,
+                depth_mm,
+            } => (kp * belt_mm_s * force_n / (feed_mm_s * width_mm), depth_mm),
+            Trace::Dwell {
+                force_n,
+                belt_mm_s,
+                dwell_s,
+                width_mm,
+                radius_mm,
+                depth_mm,
+            } => {
+                let c =
+                    (3.0 * force_n / (4.0 * width_mm * (2.0 * radius_mm).sqrt())).powf(2.0 / 3.0);
+                (
+                    kp * belt_mm_s * dwell_s * c * stiffness.unwrap_or(0.0).cbrt(),
+                    depth_mm,
+                )
             }
         };
         sq += (model - measured).powi(2);

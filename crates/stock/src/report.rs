@@ -69,8 +69,17 @@ pub struct Report {
 impl Report {
     /// The report of a stock and its comparison; `blocks[move_id]` names
     /// the block of each move (moves beyond the slice get no block).
-    pub fn new(stock_description: &str, stock: &Stock, cmp: &Comparison, blocks: &[BlockRef]) -> Report {
-        let named = |deviation_mm: f64, area_mm2: f64, samples: usize, at: [f64; 3], move_id: Option<u32>| {
+    pub fn new(
+        stock_description: &str,
+        stock: &Stock,
+        cmp: &Comparison,
+        blocks: &[BlockRef],
+    ) -> Report {
+        let named = |deviation_mm: f64,
+                     area_mm2: f64,
+                     samples: usize,
+                     at: [f64; 3],
+                     move_id: Option<u32>| {
             let b = move_id.and_then(|m| blocks.get(m as usize));
             ReportRegion {
                 deviation_mm,

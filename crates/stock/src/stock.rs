@@ -6,7 +6,9 @@ use rayon::prelude::*;
 use crate::clip::{Aabb, piece_in_box, swept_in_box};
 use crate::dexel::{Ray, Segment, UNCUT, subtract};
 use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
-use crate::tolerance::{DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION};
+use crate::tolerance::{
+    DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION,
+};
 use crate::tool::{Piece, PlacedTool, Tool, ToolError, ToolPose};
 
 /// Why a stock cannot be made.
@@ -51,7 +53,9 @@ pub enum CutError {
     #[error(transparent)]
     Tool(#[from] ToolError),
     /// The tool axis (or reference) turns by half a turn within one move.
-    #[error("the tool axis turns by 180° within one move: the motion between the poses is undefined")]
+    #[error(
+        "the tool axis turns by 180° within one move: the motion between the poses is undefined"
+    )]
     HalfTurn,
     /// The move needs more samples than allowed.
     #[error("the move needs {0} samples at this resolution (more than 10 million): split it")]
@@ -112,9 +116,24 @@ pub struct MoveCut {
 /// A solid the cut removes, with its bounds.
 #[derive(Debug, Clone)]
 enum Solid {
-    Piece { piece: Piece, origin: Vector3<f64>, axis: Vector3<f64> },
-    Capsule { c0: Vector3<f64>, v: Vector3<f64>, r: f64 },
-    CylinderSweep { origin: Vector3<f64>, axis: Vector3<f64>, z0: f64, z1: f64, r: f64, v: Vector3<f64> },
+    Piece {
+        piece: Piece,
+        origin: Vector3<f64>,
+        axis: Vector3<f64>,
+    },
+    Capsule {
+        c0: Vector3<f64>,
+        v: Vector3<f64>,
+        r: f64,
+    },
+    CylinderSweep {
+        origin: Vector3<f64>,
+        axis: Vector3<f64>,
+        z0: f64,
+        z1: f64,
+        r: f64,
+        v: Vector3<f64>,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -125,13 +144,26 @@ struct Bounded {
 }
 
 impl Bounded {
-    fn span(&self, o: &Vector3<f64>, d: &Vector3<f64>) -> Option<Span> {
+    #[inline]
+    fn span(&self, o: &Vector3<f64>, d: &Vector3<f64>, kuv: (usize, usize, usize)) -> Option<Span> {
         match &self.solid {
-            Solid::Piece { piece, origin, axis } => piece_span(piece, &Local::new(o, d, origin, axis)),
-            Solid::Capsule { c0, v, r } => capsule_span(o, d, c0, v, *r),
-            Solid::CylinderSweep { origin, axis, z0, z1, r, v } => {
-                cylinder_sweep_span(o, d, origin, axis, *z0, *z1, *r, v)
+            Solid::Piece {
+                piece,
+                origin,
+                axis,
+            } => {
+                let (k, u, v) = kuv;
+                piece_span(piece, &Local::along(k, u, v, o[u], o[v], origin, axis))
             }
+            Solid::Capsule { c0, v, r } => capsule_span(o, d, c0, v, *r),
+            Solid::CylinderSweep {
+                origin,
+                axis,
+                z0,
+                z1,
+                r,
+                v,
+            } => cylinder_sweep_span(o, d, origin, axis, *z0, *z1, *r, v),
         }
     }
 }
@@ -139,7 +171,15 @@ impl Bounded {
 fn placed_solids(t: &PlacedTool, boxed: &Aabb, out: &mut Vec<Bounded>) {
     for p in &t.pieces {
         if let Some((lo, hi)) = piece_in_box(p, &t.origin, &t.axis, boxed) {
-            out.push(Bounded { solid: Solid::Piece { piece: *p, origin: t.origin.coords, axis: t.axis }, lo, hi });
+            out.push(Bounded {
+                solid: Solid::Piece {
+                    piece: *p,
+                    origin: t.origin.coords,
+                    axis: t.axis,
+                },
+                lo,
+                hi,
+            });
         }
     }
 }
@@ -161,7 +201,11 @@ pub fn default_resolution(min: Point3<f64>, max: Point3<f64>) -> f64 {
 
 impl Stock {
     /// An empty lattice over the box (every ray without material).
-    pub(crate) fn empty(min: Point3<f64>, max: Point3<f64>, resolution_mm: f64) -> Result<Stock, StockError> {
+    pub(crate) fn empty(
+        min: Point3<f64>,
+        max: Point3<f64>,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
         if !(resolution_mm.is_finite() && resolution_mm > 0.0) {
             return Err(StockError::Resolution(resolution_mm));
         }
@@ -174,7 +218,11 @@ impl Stock {
         let rays = nx * ny + ny * nz + nz * nx;
         if !(rays <= MAX_RAYS as f64) {
             return Err(StockError::TooManyRays {
-                rays: if rays.is_finite() { rays as u64 } else { u64::MAX },
+                rays: if rays.is_finite() {
+                    rays as u64
+                } else {
+                    u64::MAX
+                },
                 resolution_mm,
                 max: MAX_RAYS,
             });
@@ -186,7 +234,14 @@ impl Stock {
                 1 => (0, 2),
                 _ => (0, 1),
             };
-            Family { axis, u, v, nu: counts[u], nv: counts[v], rays: vec![Ray::new(); counts[u] * counts[v]] }
+            Family {
+                axis,
+                u,
+                v,
+                nu: counts[u],
+                nv: counts[v],
+                rays: vec![Ray::new(); counts[u] * counts[v]],
+            }
         };
         Ok(Stock {
             origin: [min.x, min.y, min.z],
@@ -199,7 +254,11 @@ impl Stock {
     }
 
     /// A box stock from its low and high corners in the part frame (mm).
-    pub fn from_box(min: Point3<f64>, max: Point3<f64>, resolution_mm: f64) -> Result<Stock, StockError> {
+    pub fn from_box(
+        min: Point3<f64>,
+        max: Point3<f64>,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
         let mut s = Stock::empty(min, max, resolution_mm)?;
         let (lo, hi) = ([min.x, min.y, min.z], [max.x, max.y, max.z]);
         let (origin, h) = (s.origin, s.resolution);
@@ -210,7 +269,12 @@ impl Stock {
                 for (iu, ray) in row.iter_mut().enumerate() {
                     let pu = origin[u] + (iu as f64 + 0.5) * h;
                     if pu <= hi[u] && pv <= hi[v] && pu >= lo[u] && pv >= lo[v] {
-                        ray.push(Segment { lo: lo[k], hi: hi[k], lo_move: UNCUT, hi_move: UNCUT });
+                        ray.push(Segment {
+                            lo: lo[k],
+                            hi: hi[k],
+                            lo_move: UNCUT,
+                            hi_move: UNCUT,
+                        });
                     }
                 }
             });
@@ -229,7 +293,10 @@ impl Stock {
 
     /// The box where material can be: the lattice's cells.
     fn lattice_box(&self) -> Aabb {
-        (self.origin, std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution))
+        (
+            self.origin,
+            std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution),
+        )
     }
 
     /// The ray spacing, mm.
@@ -249,7 +316,9 @@ impl Stock {
 
     /// The lattice's high corner.
     pub fn max_corner(&self) -> Point3<f64> {
-        Point3::from(std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution))
+        Point3::from(std::array::from_fn(|i| {
+            self.origin[i] + self.counts[i] as f64 * self.resolution
+        }))
     }
 
     /// The rays along axis `k` (0 = X, 1 = Y, 2 = Z).
@@ -269,7 +338,10 @@ impl Stock {
 
     /// Number of solid intervals held.
     pub fn interval_count(&self) -> usize {
-        self.families.iter().map(|f| f.rays.iter().map(|r| r.len()).sum::<usize>()).sum()
+        self.families
+            .iter()
+            .map(|f| f.rays.iter().map(|r| r.len()).sum::<usize>())
+            .sum()
     }
 
     /// Bytes of the interval storage.
@@ -278,7 +350,11 @@ impl Stock {
             .iter()
             .map(|f| {
                 f.rays.capacity() * std::mem::size_of::<Ray>()
-                    + f.rays.iter().filter(|r| r.spilled()).map(|r| r.capacity() * std::mem::size_of::<Segment>()).sum::<usize>()
+                    + f.rays
+                        .iter()
+                        .filter(|r| r.spilled())
+                        .map(|r| r.capacity() * std::mem::size_of::<Segment>())
+                        .sum::<usize>()
             })
             .sum()
     }
@@ -291,7 +367,12 @@ impl Stock {
         let sum: f64 = self
             .families
             .iter()
-            .map(|f| f.rays.iter().map(|r| r.iter().map(|s| s.hi - s.lo).sum::<f64>()).sum::<f64>())
+            .map(|f| {
+                f.rays
+                    .iter()
+                    .map(|r| r.iter().map(|s| s.hi - s.lo).sum::<f64>())
+                    .sum::<f64>()
+            })
             .sum();
         sum * h2 / 3.0
     }
@@ -316,25 +397,37 @@ impl Stock {
     /// * A pure translation (same axis and reference, to `SAME_AXIS`) is
     ///   swept exactly for cylinders and spheres (see [`crate::kernel`]); cone
     ///   and rounded-disc pieces are sampled along it.
+    ///   The solid translates when its axis of revolution stays (for the
+    ///   contact wheel reference × tool axis: a lead-angle change turns the
+    ///   wheel about its own axis); its frame origin then moves on the
+    ///   chord between the poses' (for a wheel whose tool axis turns by θ,
+    ///   R·θ²/8 from the arc the interpolated poses' centres follow).
     /// * Otherwise the pose is interpolated (point linearly, axis and
     ///   reference along great circles) at n + 1 samples, n the smallest
     ///   count with (|Δpoint| + ρ·(θ_axis + θ_reference)) / n ≤
-    ///   `SAMPLE_STEP_FRACTION` · resolution, ρ the largest distance of a
-    ///   tool point from the tool point: no point of the tool moves more
-    ///   than a quarter of the ray spacing between two samples.
+    ///   `SAMPLE_STEP_FRACTION` · resolution, ρ the largest distance from
+    ///   the tool point of a tool point that can reach the stock's box: no
+    ///   such point moves more than one ray spacing between two samples.
     ///
     /// The start pose is not cut again when it is the last pose cut with
     /// the same tool (a continuous program).
-    pub fn cut_move(&mut self, tool: &Tool, from: &ToolPose, to: &ToolPose, move_id: u32) -> Result<MoveCut, CutError> {
+    pub fn cut_move(
+        &mut self,
+        tool: &Tool,
+        from: &ToolPose,
+        to: &ToolPose,
+        move_id: u32,
+    ) -> Result<MoveCut, CutError> {
         let p0 = tool.place(from)?;
         let p1 = tool.place(to)?;
-        let start_done = self.last.as_ref().is_some_and(|(t, p)| t == tool && p == from);
-        let same_axis = (p0.axis - p1.axis).norm() <= SAME_AXIS
-            && match (from.reference, to.reference) {
-                (Some(a), Some(b)) => (a.into_inner() - b.into_inner()).norm() <= SAME_AXIS,
-                (None, None) => true,
-                _ => false,
-            };
+        let start_done = self
+            .last
+            .as_ref()
+            .is_some_and(|(t, p)| t == tool && p == from);
+        // The solid only translates when its axis of revolution stays: a
+        // wheel whose tool axis turns about the wheel's own axis (a lead
+        // angle change) still translates.
+        let same_axis = (p0.axis - p1.axis).norm() <= SAME_AXIS;
         let step = SAMPLE_STEP_FRACTION * self.resolution;
         let mut solids = Vec::new();
         let mut samples = 0u64;
@@ -345,14 +438,29 @@ impl Stock {
                 match *piece {
                     Piece::Sphere { zc, r } => {
                         let c0 = p0.origin.coords + zc * p0.axis;
-                        if let Some((lo, hi)) = swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed) {
-                            solids.push(Bounded { solid: Solid::Capsule { c0, v, r }, lo, hi });
+                        if let Some((lo, hi)) =
+                            swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed)
+                        {
+                            solids.push(Bounded {
+                                solid: Solid::Capsule { c0, v, r },
+                                lo,
+                                hi,
+                            });
                         }
                     }
                     Piece::Cylinder { z0, z1, r } => {
-                        if let Some((lo, hi)) = swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed) {
+                        if let Some((lo, hi)) =
+                            swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed)
+                        {
                             solids.push(Bounded {
-                                solid: Solid::CylinderSweep { origin: p0.origin.coords, axis: p0.axis, z0, z1, r, v },
+                                solid: Solid::CylinderSweep {
+                                    origin: p0.origin.coords,
+                                    axis: p0.axis,
+                                    z0,
+                                    z1,
+                                    r,
+                                    v,
+                                },
                                 lo,
                                 hi,
                             });
@@ -367,13 +475,24 @@ impl Stock {
                             }
                             let o = p0.origin + v * (i as f64 / n as f64);
                             if let Some((lo, hi)) = piece_in_box(piece, &o, &p0.axis, &boxed) {
-                                solids.push(Bounded { solid: Solid::Piece { piece: *piece, origin: o.coords, axis: p0.axis }, lo, hi });
+                                solids.push(Bounded {
+                                    solid: Solid::Piece {
+                                        piece: *piece,
+                                        origin: o.coords,
+                                        axis: p0.axis,
+                                    },
+                                    lo,
+                                    hi,
+                                });
                             }
                         }
                     }
                 }
             }
-            MoveCut { samples, analytic: true }
+            MoveCut {
+                samples,
+                analytic: true,
+            }
         } else {
             let angle = |a: &Unit<Vector3<f64>>, b: &Unit<Vector3<f64>>| a.angle(b);
             let theta = angle(&from.axis, &to.axis)
@@ -381,8 +500,28 @@ impl Stock {
                     (Some(a), Some(b)) => angle(&a, &b),
                     _ => 0.0,
                 };
-            let rho = p0.reach() + (p0.origin - from.point).norm();
-            let n = sample_count((to.point - from.point).norm() + rho * theta, step)?;
+            let travel = (to.point - from.point).norm();
+            let naive = travel + (p0.reach() + (p0.origin - from.point).norm()) * theta;
+            // Only tool points that can reach the stock's box matter: those
+            // within the box grown by the naive bound at either end.
+            let grown: Aabb = (boxed.0.map(|c| c - naive), boxed.1.map(|c| c + naive));
+            let mut rho: f64 = 0.0;
+            for (placed, pose) in [(&p0, from), (&p1, to)] {
+                for piece in &placed.pieces {
+                    if let Some((lo, hi)) =
+                        piece_in_box(piece, &placed.origin, &placed.axis, &grown)
+                    {
+                        for c in 0..8 {
+                            let corner =
+                                Vector3::from_fn(
+                                    |i, _| if c >> i & 1 == 0 { lo[i] } else { hi[i] },
+                                );
+                            rho = rho.max((corner - pose.point.coords).norm());
+                        }
+                    }
+                }
+            }
+            let n = sample_count(travel + rho * theta, step)?;
             for i in 0..=n {
                 if i == 0 && start_done {
                     continue;
@@ -390,7 +529,10 @@ impl Stock {
                 let pose = interpolate(from, to, i as f64 / n as f64).ok_or(CutError::HalfTurn)?;
                 placed_solids(&tool.place(&pose)?, &boxed, &mut solids);
             }
-            MoveCut { samples: n + 1 - u64::from(start_done), analytic: false }
+            MoveCut {
+                samples: n + 1 - u64::from(start_done),
+                analytic: false,
+            }
         };
         self.remove(&solids, move_id);
         self.last = Some((*tool, *to));
@@ -432,7 +574,9 @@ impl Stock {
         // Index range of the rays whose coordinate along axis i is in [lo, hi].
         let range = |i: usize| -> Option<(usize, usize)> {
             let a = ((lo[i] - origin[i]) / h - 0.5).ceil().max(0.0);
-            let b = ((hi[i] - origin[i]) / h - 0.5).floor().min(counts[i] as f64 - 1.0);
+            let b = ((hi[i] - origin[i]) / h - 0.5)
+                .floor()
+                .min(counts[i] as f64 - 1.0);
             (a <= b).then_some((a as usize, b as usize))
         };
         for f in &mut self.families {
@@ -446,30 +590,39 @@ impl Stock {
             }
             let mut d = Vector3::zeros();
             d[k] = 1.0;
-            f.rays[v0 * nu..(v1 + 1) * nu].par_chunks_mut(nu).enumerate().for_each(|(jv, row)| {
-                let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
-                let mut spans: Vec<Span> = Vec::with_capacity(8);
-                for (ju, ray) in row[u0..=u1].iter_mut().enumerate() {
-                    if ray.is_empty() {
-                        continue;
-                    }
-                    let pu = origin[u] + ((u0 + ju) as f64 + 0.5) * h;
-                    let mut o = Vector3::zeros();
-                    o[u] = pu;
-                    o[v] = pv;
-                    spans.clear();
-                    let (first, last) = (ray[0].lo, ray[ray.len() - 1].hi);
-                    for s in solids {
-                        if pu < s.lo[u] || pu > s.hi[u] || pv < s.lo[v] || pv > s.hi[v] || s.hi[k] <= first || s.lo[k] >= last {
+            f.rays[v0 * nu..(v1 + 1) * nu]
+                .par_chunks_mut(nu)
+                .enumerate()
+                .for_each(|(jv, row)| {
+                    let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
+                    let mut spans: Vec<Span> = Vec::with_capacity(8);
+                    for (ju, ray) in row[u0..=u1].iter_mut().enumerate() {
+                        if ray.is_empty() {
                             continue;
                         }
-                        if let Some(sp) = s.span(&o, &d) {
-                            spans.push(sp);
+                        let pu = origin[u] + ((u0 + ju) as f64 + 0.5) * h;
+                        let mut o = Vector3::zeros();
+                        o[u] = pu;
+                        o[v] = pv;
+                        spans.clear();
+                        let (first, last) = (ray[0].lo, ray[ray.len() - 1].hi);
+                        for s in solids {
+                            if pu < s.lo[u]
+                                || pu > s.hi[u]
+                                || pv < s.lo[v]
+                                || pv > s.hi[v]
+                                || s.hi[k] <= first
+                                || s.lo[k] >= last
+                            {
+                                continue;
+                            }
+                            if let Some(sp) = s.span(&o, &d, (k, u, v)) {
+                                spans.push(sp);
+                            }
                         }
+                        remove_spans(ray, &mut spans, id);
                     }
-                    remove_spans(ray, &mut spans, id);
-                }
-            });
+                });
         }
     }
 }
@@ -498,7 +651,11 @@ fn remove_spans(ray: &mut Ray, spans: &mut [Span], id: u32) {
 fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
     let n = (distance / step).ceil().max(1.0);
     if !(n <= 1.0e7) {
-        return Err(CutError::TooManySamples(if n.is_finite() { n as u64 } else { u64::MAX }));
+        return Err(CutError::TooManySamples(if n.is_finite() {
+            n as u64
+        } else {
+            u64::MAX
+        }));
     }
     Ok(n as u64)
 }
@@ -517,5 +674,9 @@ fn interpolate(a: &ToolPose, b: &ToolPose, s: f64) -> Option<ToolPose> {
         (Some(x), Some(y)) => Some(slerp(&x, &y)?),
         (x, _) => x,
     };
-    Some(ToolPose { point: a.point + (b.point - a.point) * s, axis, reference })
+    Some(ToolPose {
+        point: a.point + (b.point - a.point) * s,
+        axis,
+        reference,
+    })
 }

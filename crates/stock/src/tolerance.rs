@@ -1,12 +1,16 @@
 //! Every tolerance of the crate, in one place, with its reason.
 
 /// Largest distance, as a fraction of the resolution, that any point of a
-/// tool moves between two consecutive sampled poses of a move that is not a
-/// pure translation (or of a piece without an analytic sweep). A quarter of
-/// the ray spacing keeps the cusp left between two samples of a tool of
-/// local radius ρ at (h/4)²/(8ρ): 2·10⁻⁵ mm for h = 0.05 mm and ρ = 1 mm,
-/// far below what the rays resolve across them.
-pub const SAMPLE_STEP_FRACTION: f64 = 0.25;
+/// tool within reach of the stock moves between two consecutive sampled
+/// poses of a move that is not a pure translation (or of a piece without an
+/// analytic sweep). Across the rays, one spacing is what the stock
+/// resolves. Along a ray, the spans of consecutive samples overlap and are
+/// united, so what a sampled move leaves is the cusp between two positions
+/// of the tool's surface, δ²/(8ρ) for δ ≤ h and a surface of radius ρ:
+/// 6·10⁻⁶ mm for a 50 mm wheel and 1·10⁻⁴ mm for a 6 mm ball at h =
+/// 0.05 mm, far below a comparison tolerance (0.01 mm). Only at a sharp
+/// edge (a wheel's side) may the uncut sliver reach one ray spacing.
+pub const SAMPLE_STEP_FRACTION: f64 = 1.0;
 
 /// Two tool axes (unit vectors) whose difference is below this are the same
 /// axis: the move is a pure translation and is swept analytically. 1e-12 is

@@ -191,7 +191,9 @@ pub enum ToolError {
         tool: &'static str,
     },
     /// The reference is (nearly) parallel to the tool axis.
-    #[error("the reference direction is parallel to the tool axis: the {tool}'s orientation is undefined")]
+    #[error(
+        "the reference direction is parallel to the tool axis: the {tool}'s orientation is undefined"
+    )]
     ReferenceAlongAxis {
         /// The tool's name.
         tool: &'static str,
@@ -229,23 +231,36 @@ impl Tool {
     /// Checks the dimensions and returns the pieces in the tool's own
     /// axial coordinate (see [`PlacedTool`] for where z = 0 is).
     pub fn pieces(&self) -> Result<Vec<Piece>, ToolError> {
-        let shank = |pieces: &mut Vec<Piece>, flute: f64, s: &Option<Shank>| -> Result<(), ToolError> {
-            if let Some(s) = s {
-                let r = positive("shank diameter", s.diameter)? / 2.0;
-                let len = positive("shank length", s.length)?;
-                pieces.push(Piece::Cylinder { z0: flute, z1: flute + len, r });
-            }
-            Ok(())
-        };
+        let shank =
+            |pieces: &mut Vec<Piece>, flute: f64, s: &Option<Shank>| -> Result<(), ToolError> {
+                if let Some(s) = s {
+                    let r = positive("shank diameter", s.diameter)? / 2.0;
+                    let len = positive("shank length", s.length)?;
+                    pieces.push(Piece::Cylinder {
+                        z0: flute,
+                        z1: flute + len,
+                        r,
+                    });
+                }
+                Ok(())
+            };
         let mut p = Vec::new();
         match *self {
-            Tool::FlatEnd { diameter, flute_length, shank: ref s } => {
+            Tool::FlatEnd {
+                diameter,
+                flute_length,
+                shank: ref s,
+            } => {
                 let r = positive("diameter", diameter)? / 2.0;
                 let l = positive("flute length", flute_length)?;
                 p.push(Piece::Cylinder { z0: 0.0, z1: l, r });
                 shank(&mut p, l, s)?;
             }
-            Tool::BallEnd { diameter, flute_length, shank: ref s } => {
+            Tool::BallEnd {
+                diameter,
+                flute_length,
+                shank: ref s,
+            } => {
                 let r = positive("diameter", diameter)? / 2.0;
                 let l = positive("flute length", flute_length)?;
                 p.push(Piece::Sphere { zc: r, r });
@@ -254,7 +269,12 @@ impl Tool {
                 }
                 shank(&mut p, l.max(r), s)?;
             }
-            Tool::BullNose { diameter, corner_radius, flute_length, shank: ref s } => {
+            Tool::BullNose {
+                diameter,
+                corner_radius,
+                flute_length,
+                shank: ref s,
+            } => {
                 let r = positive("diameter", diameter)? / 2.0;
                 let rc = positive("corner radius", corner_radius)?;
                 let l = positive("flute length", flute_length)?;
@@ -265,16 +285,27 @@ impl Tool {
                         why: "must not exceed half the diameter",
                     });
                 }
-                p.push(Piece::RoundedDisc { zc: rc, disc: r - rc, r: rc });
+                p.push(Piece::RoundedDisc {
+                    zc: rc,
+                    disc: r - rc,
+                    r: rc,
+                });
                 if l > rc {
                     p.push(Piece::Cylinder { z0: rc, z1: l, r });
                 }
                 shank(&mut p, l.max(2.0 * rc), s)?;
             }
-            Tool::Drill { diameter, point_angle_deg, flute_length } => {
+            Tool::Drill {
+                diameter,
+                point_angle_deg,
+                flute_length,
+            } => {
                 let r = positive("diameter", diameter)? / 2.0;
                 let l = positive("flute length", flute_length)?;
-                if !(point_angle_deg.is_finite() && point_angle_deg > 0.0 && point_angle_deg < 180.0) {
+                if !(point_angle_deg.is_finite()
+                    && point_angle_deg > 0.0
+                    && point_angle_deg < 180.0)
+                {
                     return Err(ToolError::Dimension {
                         name: "point angle",
                         value: point_angle_deg,
@@ -282,15 +313,28 @@ impl Tool {
                     });
                 }
                 let tip = r / (point_angle_deg.to_radians() / 2.0).tan();
-                p.push(Piece::Cone { z0: 0.0, r0: 0.0, z1: tip, r1: r });
+                p.push(Piece::Cone {
+                    z0: 0.0,
+                    r0: 0.0,
+                    z1: tip,
+                    r1: r,
+                });
                 if l > tip {
                     p.push(Piece::Cylinder { z0: tip, z1: l, r });
                 }
             }
-            Tool::ContactWheel { radius, width, edge_radius } => {
+            Tool::ContactWheel {
+                radius,
+                width,
+                edge_radius,
+            } => {
                 let r = positive("wheel radius", radius)?;
                 let w = positive("wheel width", width)?;
-                if !(edge_radius.is_finite() && edge_radius >= 0.0 && edge_radius <= w / 2.0 && edge_radius < r) {
+                if !(edge_radius.is_finite()
+                    && edge_radius >= 0.0
+                    && edge_radius <= w / 2.0
+                    && edge_radius < r)
+                {
                     return Err(ToolError::Dimension {
                         name: "edge radius",
                         value: edge_radius,
@@ -298,11 +342,23 @@ impl Tool {
                     });
                 }
                 if edge_radius == 0.0 {
-                    p.push(Piece::Cylinder { z0: -w / 2.0, z1: w / 2.0, r });
+                    p.push(Piece::Cylinder {
+                        z0: -w / 2.0,
+                        z1: w / 2.0,
+                        r,
+                    });
                 } else {
                     let zc = w / 2.0 - edge_radius;
-                    p.push(Piece::RoundedDisc { zc: -zc, disc: r - edge_radius, r: edge_radius });
-                    p.push(Piece::RoundedDisc { zc, disc: r - edge_radius, r: edge_radius });
+                    p.push(Piece::RoundedDisc {
+                        zc: -zc,
+                        disc: r - edge_radius,
+                        r: edge_radius,
+                    });
+                    p.push(Piece::RoundedDisc {
+                        zc,
+                        disc: r - edge_radius,
+                        r: edge_radius,
+                    });
                     if zc > 0.0 {
                         p.push(Piece::Cylinder { z0: -zc, z1: zc, r });
                     }
@@ -319,8 +375,14 @@ impl Tool {
 
     /// Places the tool at a pose: the origin and axis of its pieces.
     pub fn place(&self, pose: &ToolPose) -> Result<PlacedTool, ToolError> {
-        let finite = pose.point.iter().chain(pose.axis.iter()).all(|v| v.is_finite())
-            && pose.reference.is_none_or(|r| r.iter().all(|v| v.is_finite()));
+        let finite = pose
+            .point
+            .iter()
+            .chain(pose.axis.iter())
+            .all(|v| v.is_finite())
+            && pose
+                .reference
+                .is_none_or(|r| r.iter().all(|v| v.is_finite()));
         if !finite {
             return Err(ToolError::NotFinite);
         }
@@ -328,7 +390,9 @@ impl Tool {
         let axis = pose.axis.into_inner();
         let (origin, axis) = match *self {
             Tool::ContactWheel { radius, .. } => {
-                let reference = pose.reference.ok_or(ToolError::MissingReference { tool: self.name() })?;
+                let reference = pose
+                    .reference
+                    .ok_or(ToolError::MissingReference { tool: self.name() })?;
                 let rotation = reference.cross(&axis);
                 let n = rotation.norm();
                 if n < 1e-9 {
@@ -337,7 +401,9 @@ impl Tool {
                 (pose.point + radius * axis, rotation / n)
             }
             Tool::DiscWheel { radius, .. } => {
-                let reference = pose.reference.ok_or(ToolError::MissingReference { tool: self.name() })?;
+                let reference = pose
+                    .reference
+                    .ok_or(ToolError::MissingReference { tool: self.name() })?;
                 let inward = reference.into_inner() - reference.dot(&axis) * axis;
                 let n = inward.norm();
                 if n < 1e-9 {
@@ -347,7 +413,11 @@ impl Tool {
             }
             _ => (pose.point, axis),
         };
-        Ok(PlacedTool { origin, axis, pieces })
+        Ok(PlacedTool {
+            origin,
+            axis,
+            pieces,
+        })
     }
 }
 

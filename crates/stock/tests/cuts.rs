@@ -6,7 +6,12 @@ use kinpost_stock::{Stock, Tool, ToolPose};
 use nalgebra::{Point3, Vector3};
 
 fn boxed(h: f64) -> Stock {
-    Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(100.0, 50.0, 20.0), h).unwrap()
+    Stock::from_box(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(100.0, 50.0, 20.0),
+        h,
+    )
+    .unwrap()
 }
 
 /// Index of the lattice node nearest to `c` along axis `i`.
@@ -17,7 +22,11 @@ fn node(s: &Stock, i: usize, c: f64) -> usize {
 #[test]
 fn flat_end_slot_has_its_depth_along_the_rays_and_its_width() {
     let mut s = boxed(0.1);
-    let tool = Tool::FlatEnd { diameter: 10.0, flute_length: 30.0, shank: None };
+    let tool = Tool::FlatEnd {
+        diameter: 10.0,
+        flute_length: 30.0,
+        shank: None,
+    };
     let d = 2.5;
     let a = ToolPose::new(Point3::new(10.0, 25.0, 20.0 - d), Vector3::z());
     let b = ToolPose::new(Point3::new(90.0, 25.0, 20.0 - d), Vector3::z());
@@ -32,10 +41,20 @@ fn flat_end_slot_has_its_depth_along_the_rays_and_its_width() {
             let ray = f.ray(iu, iv);
             assert_eq!(ray.len(), 1);
             // Distance from (x, y) to the segment of tool centres.
-            let dx = if x < 10.0 { 10.0 - x } else if x > 90.0 { x - 90.0 } else { 0.0 };
+            let dx = if x < 10.0 {
+                10.0 - x
+            } else if x > 90.0 {
+                x - 90.0
+            } else {
+                0.0
+            };
             let dist = dx.hypot(y - 25.0);
             if dist < 5.0 - 1e-9 {
-                assert!((ray[0].hi - (20.0 - d)).abs() < 1e-6, "floor at ({x}, {y}): {}", ray[0].hi);
+                assert!(
+                    (ray[0].hi - (20.0 - d)).abs() < 1e-6,
+                    "floor at ({x}, {y}): {}",
+                    ray[0].hi
+                );
                 assert_eq!(ray[0].hi_move, 7);
                 inside += 1;
             } else if dist > 5.0 + 1e-9 {
@@ -65,7 +84,11 @@ fn flat_end_slot_has_its_depth_along_the_rays_and_its_width() {
 #[test]
 fn ball_end_groove_has_the_circular_profile() {
     let mut s = boxed(0.1);
-    let tool = Tool::BallEnd { diameter: 10.0, flute_length: 25.0, shank: None };
+    let tool = Tool::BallEnd {
+        diameter: 10.0,
+        flute_length: 25.0,
+        shank: None,
+    };
     let tip = 17.0; // 3 mm deep; the ball's centre at z = 22
     let a = ToolPose::new(Point3::new(-10.0, 25.0, tip), Vector3::z());
     let b = ToolPose::new(Point3::new(110.0, 25.0, tip), Vector3::z());
@@ -76,8 +99,15 @@ fn ball_end_groove_has_the_circular_profile() {
         let y = s.coordinate(1, iv);
         let dy = y - 25.0;
         let top = f.ray(ix, iv)[0].hi;
-        let expected = if dy.abs() < 5.0 { (22.0 - (25.0 - dy * dy).sqrt()).min(20.0) } else { 20.0 };
-        assert!((top - expected).abs() < 1e-6, "y = {y}: {top} vs {expected}");
+        let expected = if dy.abs() < 5.0 {
+            (22.0 - (25.0 - dy * dy).sqrt()).min(20.0)
+        } else {
+            20.0
+        };
+        assert!(
+            (top - expected).abs() < 1e-6,
+            "y = {y}: {top} vs {expected}"
+        );
     }
     // Y rays at heights 17.5 .. 19.5: the groove's sides at 25 ± √(25 − (z − 22)²).
     let fy = s.family(1);
@@ -93,9 +123,18 @@ fn ball_end_groove_has_the_circular_profile() {
 
 #[test]
 fn tilted_wheel_pressed_into_a_plane_leaves_the_elliptical_footprint() {
-    let mut s = Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(100.0, 60.0, 40.0), 0.1).unwrap();
+    let mut s = Stock::from_box(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(100.0, 60.0, 40.0),
+        0.1,
+    )
+    .unwrap();
     let (r, width) = (20.0, 30.0);
-    let tool = Tool::ContactWheel { radius: r, width, edge_radius: 0.0 };
+    let tool = Tool::ContactWheel {
+        radius: r,
+        width,
+        edge_radius: 0.0,
+    };
     let theta = 30f64.to_radians();
     // Rotation axis tilted 30° from Z in the XZ plane; the plane z = H
     // through the wheel centre cuts the cylinder in an ellipse of semi-axes
@@ -118,7 +157,12 @@ fn tilted_wheel_pressed_into_a_plane_leaves_the_elliptical_footprint() {
         if q > 1e-9 {
             let half = a * q.sqrt();
             assert_eq!(ray.len(), 2, "y = {y}");
-            assert!((ray[0].hi - (50.0 - half)).abs() < 1e-6, "y = {y}: {} vs {}", ray[0].hi, 50.0 - half);
+            assert!(
+                (ray[0].hi - (50.0 - half)).abs() < 1e-6,
+                "y = {y}: {} vs {}",
+                ray[0].hi,
+                50.0 - half
+            );
             assert!((ray[1].lo - (50.0 + half)).abs() < 1e-6);
             rows += 1;
         } else if q < -1e-9 {

@@ -20,13 +20,24 @@ fn inside(piece: &Piece, origin: &Vector3<f64>, axis: &Vector3<f64>, x: &Vector3
     match *piece {
         Piece::Cylinder { z0, z1, r } => z >= z0 && z <= z1 && rho <= r,
         Piece::Sphere { zc, r } => (p - zc * axis).norm() <= r,
-        Piece::Cone { z0, r0, z1, r1 } => z >= z0 && z <= z1 && rho <= r0 + (r1 - r0) * (z - z0) / (z1 - z0),
-        Piece::RoundedDisc { zc, disc, r } => ((z - zc).powi(2) + (rho - disc).max(0.0).powi(2)).sqrt() <= r,
+        Piece::Cone { z0, r0, z1, r1 } => {
+            z >= z0 && z <= z1 && rho <= r0 + (r1 - r0) * (z - z0) / (z1 - z0)
+        }
+        Piece::RoundedDisc { zc, disc, r } => {
+            ((z - zc).powi(2) + (rho - disc).max(0.0).powi(2)).sqrt() <= r
+        }
     }
 }
 
 /// The hull of the points of the line inside the piece, sampled.
-fn sampled(piece: &Piece, origin: &Vector3<f64>, axis: &Vector3<f64>, o: &Vector3<f64>, d: &Vector3<f64>, n: usize) -> Option<(f64, f64)> {
+fn sampled(
+    piece: &Piece,
+    origin: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    o: &Vector3<f64>,
+    d: &Vector3<f64>,
+    n: usize,
+) -> Option<(f64, f64)> {
     let mut out: Option<(f64, f64)> = None;
     for i in 0..=n {
         let t = -40.0 + 80.0 * i as f64 / n as f64;
@@ -39,15 +50,28 @@ fn sampled(piece: &Piece, origin: &Vector3<f64>, axis: &Vector3<f64>, o: &Vector
 
 fn piece_strategy() -> impl Strategy<Value = Piece> {
     prop_oneof![
-        (0.1f64..5.0, 0.1f64..5.0, 0.2f64..6.0).prop_map(|(a, l, r)| Piece::Cylinder { z0: -a, z1: l, r }),
+        (0.1f64..5.0, 0.1f64..5.0, 0.2f64..6.0).prop_map(|(a, l, r)| Piece::Cylinder {
+            z0: -a,
+            z1: l,
+            r
+        }),
         (-3.0f64..3.0, 0.2f64..6.0).prop_map(|(zc, r)| Piece::Sphere { zc, r }),
-        (0.0f64..3.0, 0.2f64..6.0, 0.1f64..5.0).prop_map(|(r0, r1, l)| Piece::Cone { z0: -1.0, r0, z1: l, r1 }),
-        (-2.0f64..2.0, 0.0f64..5.0, 0.1f64..2.0).prop_map(|(zc, disc, r)| Piece::RoundedDisc { zc, disc, r }),
+        (0.0f64..3.0, 0.2f64..6.0, 0.1f64..5.0).prop_map(|(r0, r1, l)| Piece::Cone {
+            z0: -1.0,
+            r0,
+            z1: l,
+            r1
+        }),
+        (-2.0f64..2.0, 0.0f64..5.0, 0.1f64..2.0).prop_map(|(zc, disc, r)| Piece::RoundedDisc {
+            zc,
+            disc,
+            r
+        }),
     ]
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(300))]
+    #![proptest_config(ProptestConfig::with_cases(1000))]
 
     #[test]
     fn piece_spans_match_point_membership(
@@ -72,6 +96,30 @@ proptest! {
             (Some(s), None) => prop_assert!(s.hi - s.lo <= step + 1e-7, "{s:?} but no sample inside"),
             (None, Some((lo, hi))) => prop_assert!(false, "missed {lo}..{hi}"),
             (None, None) => {}
+        }
+    }
+
+    #[test]
+    fn the_stock_rays_fast_frame_gives_the_same_spans(
+        piece in piece_strategy(),
+        (a, b) in (0.0f64..6.3, 0.0f64..3.15),
+        k in 0usize..3,
+        (pu, pv) in (-6.0f64..6.0, -6.0f64..6.0),
+    ) {
+        let axis = unit(a, b);
+        let origin = Vector3::new(0.3, -0.2, 0.1);
+        let (u, v) = match k { 0 => (1, 2), 1 => (0, 2), _ => (0, 1) };
+        let mut o = Vector3::zeros();
+        o[u] = pu;
+        o[v] = pv;
+        let mut d = Vector3::zeros();
+        d[k] = 1.0;
+        let slow = piece_span(&piece, &Local::new(&o, &d, &origin, &axis));
+        let fast = piece_span(&piece, &Local::along(k, u, v, pu, pv, &origin, &axis));
+        match (slow, fast) {
+            (Some(s), Some(f)) => prop_assert!((s.lo - f.lo).abs() < 1e-7 && (s.hi - f.hi).abs() < 1e-7, "{s:?} {f:?}"),
+            (None, None) => {}
+            (s, f) => prop_assert!(s.or(f).unwrap().hi - s.or(f).unwrap().lo < 1e-6, "{s:?} {f:?}"),
         }
     }
 
@@ -136,7 +184,7 @@ proptest! {
         let mut state = seed | 1;
         let mut next = || { state ^= state << 13; state ^= state >> 7; state ^= state << 17; (state >> 11) as f64 / (1u64 << 53) as f64 };
         for _ in 0..4000 {
-            let (s, rho, phi) = (z0 + (z1 - z0) * next(), r * next().sqrt(), 6.2832 * next());
+            let (s, rho, phi) = (z0 + (z1 - z0) * next(), r * next().sqrt(), std::f64::consts::TAU * next());
             let p = origin.coords + s * axis + rho * (phi.cos() * e1 + phi.sin() * e2);
             if (0..3).all(|i| p[i] >= lo[i] && p[i] <= hi[i]) {
                 let Some((blo, bhi)) = bounds else { return Err(TestCaseError::fail(format!("{p:?} in the box but no bounds"))) };

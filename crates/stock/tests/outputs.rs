@@ -3,18 +3,27 @@
 use std::collections::HashMap;
 
 use kinpost_stock::{
-    BlockRef, Design, Mesh, PartMesh, Report, Stock, Tool, ToolPose, compare, contour, write_ply, write_stl,
-    write_svg,
+    BlockRef, Design, Mesh, PartMesh, Report, Stock, Tool, ToolPose, compare, contour, write_ply,
+    write_stl, write_svg,
 };
 use nalgebra::{Point3, Vector3};
 
 fn cut_part(h: f64) -> Stock {
-    let mut s = Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(20.0, 12.0, 6.0), h).unwrap();
-    let ball = Tool::BallEnd { diameter: 4.0, flute_length: 10.0, shank: None };
+    let mut s =
+        Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(20.0, 12.0, 6.0), h).unwrap();
+    let ball = Tool::BallEnd {
+        diameter: 4.0,
+        flute_length: 10.0,
+        shank: None,
+    };
     let a = ToolPose::new(Point3::new(2.0, 4.0, 4.5), Vector3::z());
     let b = ToolPose::new(Point3::new(18.0, 8.0, 4.5), Vector3::z());
     s.cut_move(&ball, &a, &b, 0).unwrap();
-    let wheel = Tool::ContactWheel { radius: 30.0, width: 8.0, edge_radius: 1.0 };
+    let wheel = Tool::ContactWheel {
+        radius: 30.0,
+        width: 8.0,
+        edge_radius: 1.0,
+    };
     let axis = Vector3::new(0.2, 0.0, 1.0).normalize();
     let p = ToolPose::new(Point3::new(10.0, 3.0, 5.7), axis).with_reference(Vector3::x());
     let q = ToolPose::new(Point3::new(12.0, 3.5, 5.6), Vector3::z()).with_reference(Vector3::x());
@@ -33,7 +42,11 @@ fn assert_watertight(m: &PartMesh) {
     }
     for (&(a, b), &n) in &directed {
         assert_eq!(n, 1, "directed edge {a}->{b} used {n} times");
-        assert_eq!(directed.get(&(b, a)), Some(&1), "edge {a}-{b} not shared by exactly two triangles");
+        assert_eq!(
+            directed.get(&(b, a)),
+            Some(&1),
+            "edge {a}-{b} not shared by exactly two triangles"
+        );
     }
 }
 
@@ -55,7 +68,10 @@ fn part_mesh_is_watertight_and_encloses_the_dexel_volume() {
     assert_watertight(&m);
     let (v, expected) = (volume(&m), s.volume_mm3());
     // Within a layer of half a ray spacing over the surface (area ≈ 900 mm²).
-    assert!((v - expected).abs() < 0.5 * 0.1 * 900.0, "{v} vs {expected}");
+    assert!(
+        (v - expected).abs() < 0.5 * 0.1 * 900.0,
+        "{v} vs {expected}"
+    );
     // Every vertex within √3·h of the lattice box.
     for p in &m.vertices {
         for i in 0..3 {
@@ -73,9 +89,15 @@ fn a_box_meshes_to_its_exact_faces() {
     let on_face = m
         .vertices
         .iter()
-        .filter(|p| p[0] == 0.0 || p[0] == 3.0 || p[1] == 0.0 || p[1] == 2.0 || p[2] == 0.0 || p[2] == 1.0)
+        .filter(|p| {
+            p[0] == 0.0 || p[0] == 3.0 || p[1] == 0.0 || p[1] == 2.0 || p[2] == 0.0 || p[2] == 1.0
+        })
         .count();
-    assert!(on_face * 2 > m.vertices.len(), "{on_face} of {}", m.vertices.len());
+    assert!(
+        on_face * 2 > m.vertices.len(),
+        "{on_face} of {}",
+        m.vertices.len()
+    );
 }
 
 #[test]
@@ -90,14 +112,21 @@ fn files_read_back() {
     let again = Stock::from_mesh(&back, 0.2).unwrap();
     assert!((again.volume_mm3() - s.volume_mm3()).abs() < 0.05 * s.volume_mm3());
 
-    let design = Design::from_mesh(Mesh::cuboid(Point3::new(0.0, 0.0, 0.0), Point3::new(20.0, 12.0, 5.5))).unwrap();
+    let design = Design::from_mesh(Mesh::cuboid(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(20.0, 12.0, 5.5),
+    ))
+    .unwrap();
     let cmp = compare(&s, &design, 0.01).unwrap();
     let mut ply = Vec::new();
     write_ply(&m, &cmp, 0.2, &mut ply).unwrap();
     let header_end = ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
     let header = std::str::from_utf8(&ply[..header_end]).unwrap();
     assert!(header.contains(&format!("element vertex {}", m.vertices.len())));
-    assert_eq!(ply.len() - header_end, m.vertices.len() * 19 + m.triangles.len() * 13);
+    assert_eq!(
+        ply.len() - header_end,
+        m.vertices.len() * 19 + m.triangles.len() * 13
+    );
 
     let mut svg = Vec::new();
     write_svg(&s, &cmp, &mut svg).unwrap();
@@ -105,7 +134,16 @@ fn files_read_back() {
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.contains("gouge") && svg.contains("residual"));
 
-    let blocks = vec![BlockRef { block: Some("N10".into()), line: 3 }, BlockRef { block: Some("N20".into()), line: 4 }];
+    let blocks = vec![
+        BlockRef {
+            block: Some("N10".into()),
+            line: 3,
+        },
+        BlockRef {
+            block: Some("N20".into()),
+            line: 4,
+        },
+    ];
     let r = Report::new("box 0,0,0 20,12,6", &s, &cmp, &blocks);
     assert!(r.gouge_max_mm > 0.4 && r.residual_max_mm > 0.4, "{r:?}");
     assert!(r.gouge_regions.iter().all(|g| g.line.is_some()));

@@ -21,11 +21,27 @@ fn model() -> ProcessModel {
 
 /// Depth at the middle of a pass over a flat, read from the Z ray there.
 fn ground_depth(force_n: f64, rpm: f64, feed_mm_min: f64) -> f64 {
-    let mut s = Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(100.0, 40.0, 10.0), 0.1).unwrap();
-    let tool = Tool::ContactWheel { radius: 50.0, width: 25.0, edge_radius: 0.0 };
-    let a = ToolPose::new(Point3::new(10.0, 20.05, 10.0), Vector3::z()).with_reference(Vector3::x());
-    let b = ToolPose::new(Point3::new(90.0, 20.05, 10.0), Vector3::z()).with_reference(Vector3::x());
-    let c = Conditions { force_n, spindle_rpm: rpm, feed_mm_min, curvature_per_mm: 0.0 };
+    let mut s = Stock::from_box(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(100.0, 40.0, 10.0),
+        0.1,
+    )
+    .unwrap();
+    let tool = Tool::ContactWheel {
+        radius: 50.0,
+        width: 25.0,
+        edge_radius: 0.0,
+    };
+    let a =
+        ToolPose::new(Point3::new(10.0, 20.05, 10.0), Vector3::z()).with_reference(Vector3::x());
+    let b =
+        ToolPose::new(Point3::new(90.0, 20.05, 10.0), Vector3::z()).with_reference(Vector3::x());
+    let c = Conditions {
+        force_n,
+        spindle_rpm: rpm,
+        feed_mm_min,
+        curvature_per_mm: 0.0,
+    };
     let stats = s.grind_move(&model(), &tool, &a, &b, &c, 5).unwrap();
     assert!(stats.rays > 0);
     let f = s.family(2);
@@ -38,11 +54,19 @@ fn ground_depth(force_n: f64, rpm: f64, feed_mm_min: f64) -> f64 {
 
 #[test]
 fn preston_removal_on_a_flat_is_the_closed_form() {
-    for (force, rpm, feed) in [(200.0, 1000.0, 600.0), (400.0, 1000.0, 600.0), (200.0, 2000.0, 600.0), (200.0, 1000.0, 1200.0)] {
+    for (force, rpm, feed) in [
+        (200.0, 1000.0, 600.0),
+        (400.0, 1000.0, 600.0),
+        (200.0, 2000.0, 600.0),
+        (200.0, 1000.0, 1200.0),
+    ] {
         let belt = 2.0 * PI * rpm / 60.0 * 50.0;
         let expected = 1.0e-6 * belt * force / (feed / 60.0 * 25.0);
         let got = ground_depth(force, rpm, feed);
-        assert!((got - expected).abs() < 1e-9 * expected.max(1.0), "F {force} rpm {rpm} feed {feed}: {got} vs {expected}");
+        assert!(
+            (got - expected).abs() < 1e-9 * expected.max(1.0),
+            "F {force} rpm {rpm} feed {feed}: {got} vs {expected}"
+        );
     }
     // Linear in force and belt speed, inverse in feed.
     let base = ground_depth(200.0, 1000.0, 600.0);
@@ -87,7 +111,11 @@ fn indentation(force: f64, k: f64, r: f64, w: f64) -> f64 {
 fn winkler_contact_carries_the_force() {
     let c = model().contact(250.0, 50.0, 25.0, 0.0).unwrap();
     let d = indentation(250.0, 3.0, 50.0, 25.0);
-    assert!((c.indentation_mm - d).abs() < 1e-9 * d.max(1e-3), "{} vs {d}", c.indentation_mm);
+    assert!(
+        (c.indentation_mm - d).abs() < 1e-9 * d.max(1e-3),
+        "{} vs {d}",
+        c.indentation_mm
+    );
     assert!((c.half_length_mm - (2.0 * 50.0 * d).sqrt()).abs() < 1e-6);
     assert!((c.cumulative(c.half_length_mm) * 25.0 - 250.0).abs() < 1e-9);
 }
@@ -96,16 +124,36 @@ fn winkler_contact_carries_the_force() {
 fn calibration_recovers_preston_and_stiffness() {
     let (kp, k) = (2.5e-6, 4.0);
     let mut traces = Vec::new();
-    for (force, belt, feed) in [(100.0, 3000.0, 5.0), (250.0, 4000.0, 10.0), (300.0, 5000.0, 20.0)] {
-        traces.push(Trace::Pass { force_n: force, belt_mm_s: belt, feed_mm_s: feed, width_mm: 25.0, depth_mm: kp * belt * force / (feed * 25.0) });
+    for (force, belt, feed) in [
+        (100.0, 3000.0, 5.0),
+        (250.0, 4000.0, 10.0),
+        (300.0, 5000.0, 20.0),
+    ] {
+        traces.push(Trace::Pass {
+            force_n: force,
+            belt_mm_s: belt,
+            feed_mm_s: feed,
+            width_mm: 25.0,
+            depth_mm: kp * belt * force / (feed * 25.0),
+        });
     }
     for (force, dwell) in [(150.0, 2.0), (300.0, 1.0)] {
         let peak = kp * 3000.0 * dwell * k * indentation(force, k, 50.0, 25.0);
-        traces.push(Trace::Dwell { force_n: force, belt_mm_s: 3000.0, dwell_s: dwell, width_mm: 25.0, radius_mm: 50.0, depth_mm: peak });
+        traces.push(Trace::Dwell {
+            force_n: force,
+            belt_mm_s: 3000.0,
+            dwell_s: dwell,
+            width_mm: 25.0,
+            radius_mm: 50.0,
+            depth_mm: peak,
+        });
     }
     let c = calibrate(&traces).unwrap();
     assert!((c.preston_mm2_per_n / kp - 1.0).abs() < 1e-9);
-    assert!((c.stiffness_n_per_mm3.unwrap() / k - 1.0).abs() < 1e-6, "{c:?}");
+    assert!(
+        (c.stiffness_n_per_mm3.unwrap() / k - 1.0).abs() < 1e-6,
+        "{c:?}"
+    );
     assert!(c.rms_mm < 1e-9);
     // Without dwells the stiffness is not identified.
     assert_eq!(calibrate(&traces[..3]).unwrap().stiffness_n_per_mm3, None);
@@ -117,6 +165,10 @@ fn a_bad_process_file_is_located() {
     let bad = FILE.replace("stiffness_n_per_mm3 = 3.0", "stiffness_n_per_mm3 = -3.0");
     let e = ProcessModel::from_toml(&bad, "p.toml").unwrap_err();
     assert_eq!((e.file.as_str(), e.line), ("p.toml", 8));
-    let e = ProcessModel::from_toml("[force]\naxis = \"H1\"\nnewtons = [[1, 2]]\n[wheel]\npreston = 1\n", "q.toml").unwrap_err();
+    let e = ProcessModel::from_toml(
+        "[force]\naxis = \"H1\"\nnewtons = [[1, 2]]\n[wheel]\npreston = 1\n",
+        "q.toml",
+    )
+    .unwrap_err();
     assert_eq!(e.line, 5, "{e:?}");
 }
