@@ -86,12 +86,12 @@ impl Design {
     }
 
     /// An open design surface: a B-spline surface tessellated into a grid of
-    /// triangles whose chords stay within `chord_mm` of the surface (the
-    /// spacing √(8·chord/κ) for the largest principal curvature κ found on a
-    /// 33 × 33 grid, at most 256 steps per unit of the coarse polygon's
-    /// length… see the code; at least 8, at most 2000 steps per direction).
-    /// The surface's normal (S_u × S_v) points out of the material; `flip`
-    /// turns it over.
+    /// triangles whose chords stay within `chord_mm` of the surface: the
+    /// step √(8·chord/κ), κ the largest principal curvature found on a
+    /// 33 × 33 grid of parameters, over the longest parameter line of that
+    /// grid (its polygon length), with 8 to 2000 steps per direction. The
+    /// surface's normal (S_u × S_v) points out of the material; `flip` turns
+    /// it over. Pass a chord a tenth of the comparison tolerance or less.
     pub fn from_surface(
         surface: &Surface,
         chord_mm: f64,

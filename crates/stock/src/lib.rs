@@ -97,6 +97,6 @@ pub use process::{
     Calibration, Conditions, Contact, GrindStats, ProcessError, ProcessModel, Trace,
     belt_speed_mm_s, calibrate,
 };
-pub use report::{BlockRef, Report, ReportRegion};
+pub use report::{BlockRef, GrindBlock, GrindingSummary, Report, ReportRegion};
 pub use stock::{CutError, Family, MoveCut, Stock, StockError, default_resolution};
 pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};

@@ -64,6 +64,8 @@ pub struct Report {
     pub gouge_volume_mm3: f64,
     /// Material outside a closed design, mm³.
     pub residual_volume_mm3: f64,
+    /// The process model's prediction, when the program was ground with it.
+    pub grinding: Option<GrindingSummary>,
 }
 
 impl Report {
@@ -108,6 +110,69 @@ impl Report {
             measured: cmp.measured,
             gouge_volume_mm3: cmp.gouge_volume_mm3,
             residual_volume_mm3: cmp.residual_volume_mm3,
+            grinding: None,
+        }
+    }
+}
+
+/// What the process model predicts a block grinds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrindBlock {
+    /// The move.
+    pub move_id: u32,
+    /// Its block, if named.
+    pub block: Option<String>,
+    /// Its line.
+    pub line: Option<usize>,
+    /// Normal force, N.
+    pub force_n: f64,
+    /// Peak contact pressure, N/mm².
+    pub peak_pressure_mpa: f64,
+    /// Depth of a full pass on a flat at this force and feed, mm.
+    pub pass_depth_mm: f64,
+    /// Smallest and largest depth removed at a ray, mm.
+    pub depth_range_mm: [f64; 2],
+}
+
+/// The process model's prediction over a program.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GrindingSummary {
+    /// Smallest and largest depth removed at a ray over all blocks, mm.
+    pub depth_range_mm: [f64; 2],
+    /// Per block that ground something.
+    pub blocks: Vec<GrindBlock>,
+}
+
+impl GrindingSummary {
+    /// Summarises the [`crate::GrindStats`] of the moves, in program order.
+    pub fn new(moves: &[(u32, crate::GrindStats)], blocks: &[BlockRef]) -> GrindingSummary {
+        let mut range = [f64::INFINITY, 0.0f64];
+        let mut out = Vec::new();
+        for (id, s) in moves {
+            if s.rays == 0 {
+                continue;
+            }
+            range = [
+                range[0].min(s.depth_range_mm[0]),
+                range[1].max(s.depth_range_mm[1]),
+            ];
+            let b = blocks.get(*id as usize);
+            out.push(GrindBlock {
+                move_id: *id,
+                block: b.and_then(|b| b.block.clone()),
+                line: b.map(|b| b.line),
+                force_n: s.contact.force_n,
+                peak_pressure_mpa: s.contact.peak_pressure_mpa,
+                pass_depth_mm: s.pass_depth_mm,
+                depth_range_mm: s.depth_range_mm,
+            });
+        }
+        if out.is_empty() {
+            range = [0.0, 0.0];
+        }
+        GrindingSummary {
+            depth_range_mm: range,
+            blocks: out,
         }
     }
 }

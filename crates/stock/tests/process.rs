@@ -172,3 +172,62 @@ fn a_bad_process_file_is_located() {
     .unwrap_err();
     assert_eq!(e.line, 5, "{e:?}");
 }
+
+#[test]
+fn the_shipped_mts1600_process_file_loads() {
+    let src = include_str!("../process/mts1600.toml");
+    let m = ProcessModel::from_toml(src, "mts1600.toml").unwrap();
+    assert_eq!(m.force.axis, "H1");
+    assert_eq!(m.force_n(3000.0), 300.0);
+    // The comment's claim: 0.02 mm a pass at 100 N, 20 m/s, 10 mm/s, 25 mm.
+    assert!((m.pass_depth_mm(100.0, 20_000.0, 10.0, 25.0) - 0.02).abs() < 1e-12);
+}
+
+#[test]
+fn the_grinding_summary_names_blocks_and_the_depth_range() {
+    use kinpost_stock::{BlockRef, GrindingSummary};
+    let mut s = Stock::from_box(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(60.0, 40.0, 10.0),
+        0.2,
+    )
+    .unwrap();
+    let tool = Tool::ContactWheel {
+        radius: 50.0,
+        width: 25.0,
+        edge_radius: 0.0,
+    };
+    let m = model();
+    let mut stats = Vec::new();
+    for (id, h1) in [(0u32, 3000.0), (1, 3300.0)] {
+        let y = 10.0 + 20.0 * id as f64;
+        let a = ToolPose::new(Point3::new(5.0, y, 10.0), Vector3::z()).with_reference(Vector3::x());
+        let b =
+            ToolPose::new(Point3::new(55.0, y, 10.0), Vector3::z()).with_reference(Vector3::x());
+        let c = Conditions {
+            force_n: m.force_n(h1),
+            spindle_rpm: 1000.0,
+            feed_mm_min: 600.0,
+            curvature_per_mm: 0.0,
+        };
+        stats.push((id, s.grind_move(&m, &tool, &a, &b, &c, id).unwrap()));
+    }
+    let blocks = vec![
+        BlockRef {
+            block: Some("N10".into()),
+            line: 2,
+        },
+        BlockRef {
+            block: Some("N20".into()),
+            line: 3,
+        },
+    ];
+    let g = GrindingSummary::new(&stats, &blocks);
+    assert_eq!(g.blocks.len(), 2);
+    assert_eq!(g.blocks[1].line, Some(3));
+    // The deeper block is the one at the higher force (H1 = 3000: 300 N).
+    let full = |f: f64| 1.0e-6 * 2.0 * PI * 1000.0 / 60.0 * 50.0 * f / (10.0 * 25.0);
+    assert!((g.depth_range_mm[1] - full(300.0)).abs() < 1e-12);
+    assert!((g.blocks[1].pass_depth_mm - full(150.0)).abs() < 1e-12);
+    assert!(g.depth_range_mm[0] > 0.0 && g.depth_range_mm[0] < full(150.0));
+}
