@@ -151,6 +151,24 @@ fn cylinder_in_slab(
     Some((g.lo, g.hi))
 }
 
+/// Bounds of a sphere within the slab `lo ≤ x_j ≤ hi`: its own extent
+/// where its extreme points are inside, else the circle of the nearer
+/// plane.
+fn sphere_in_slab(c: &Vector3<f64>, r: f64, j: usize, lo: f64, hi: f64) -> Option<Aabb> {
+    let (a, b) = ((c[j] - r).max(lo), (c[j] + r).min(hi));
+    if a > b {
+        return None;
+    }
+    // Across j, the widest section is at the slab point nearest the centre.
+    let near = c[j].clamp(a, b);
+    let half = (r * r - (near - c[j]).powi(2)).max(0.0).sqrt();
+    let mut out = (c.map(|x| x - half).into(), c.map(|x| x + half).into());
+    let (lo_b, hi_b): &mut ([f64; 3], [f64; 3]) = &mut out;
+    lo_b[j] = a;
+    hi_b[j] = b;
+    Some(out)
+}
+
 /// Bounds of the piece at `origin` along `axis`, within the box.
 pub fn piece_in_box(
     piece: &Piece,
@@ -163,13 +181,37 @@ pub fn piece_in_box(
     if is_empty(&b) {
         return None;
     }
-    if let Piece::Cylinder { z0, z1, r } = *piece {
-        for j in 0..3 {
-            let s = cylinder_in_slab(&origin.coords, axis, z0, z1, r, j, boxed.0[j], boxed.1[j])?;
-            b = meet(b, s);
-            if is_empty(&b) {
-                return None;
+    for j in 0..3 {
+        let (lo, hi) = (boxed.0[j], boxed.1[j]);
+        let s = match *piece {
+            Piece::Cylinder { z0, z1, r } => {
+                cylinder_in_slab(&origin.coords, axis, z0, z1, r, j, lo, hi)?
             }
+            Piece::Sphere { zc, r } => sphere_in_slab(&(origin.coords + zc * axis), r, j, lo, hi)?,
+            Piece::RoundedDisc { zc, disc, r } => {
+                // (disc ⊕ ball) ∩ slab ⊆ (disc ∩ slab grown by r) ⊕ ball.
+                let (e1, e2) = frame(axis);
+                let mut g = Grow::new();
+                disc_in_slab(
+                    &(origin.coords + zc * axis),
+                    disc,
+                    &e1,
+                    &e2,
+                    j,
+                    lo - r,
+                    hi + r,
+                    &mut g,
+                );
+                if !g.any {
+                    return None;
+                }
+                (g.lo.map(|c| c - r), g.hi.map(|c| c + r))
+            }
+            Piece::Cone { .. } => continue,
+        };
+        b = meet(b, s);
+        if is_empty(&b) {
+            return None;
         }
     }
     Some(b)

@@ -166,8 +166,8 @@ proptest! {
     }
 
     #[test]
-    fn clipped_bounds_hold_every_point_of_the_cylinder_in_the_box(
-        (z0, z1, r) in (-3.0f64..0.0, 0.1f64..4.0, 0.3f64..4.0),
+    fn clipped_bounds_hold_every_point_of_the_piece_in_the_box(
+        piece in piece_strategy(),
         (a, b) in (0.0f64..6.3, 0.0f64..3.15),
         lo in prop::array::uniform3(-4.0f64..0.0),
         size in prop::array::uniform3(0.01f64..5.0),
@@ -176,18 +176,14 @@ proptest! {
         let axis = unit(a, b);
         let origin = Point3::new(0.2, -0.1, 0.3);
         let hi: [f64; 3] = std::array::from_fn(|i| lo[i] + size[i]);
-        let piece = Piece::Cylinder { z0, z1, r };
         let bounds = piece_in_box(&piece, &origin, &axis, &(lo, hi));
-        let a1 = if axis.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
-        let e1 = axis.cross(&a1).normalize();
-        let e2 = axis.cross(&e1);
         let mut state = seed | 1;
         let mut next = || { state ^= state << 13; state ^= state >> 7; state ^= state << 17; (state >> 11) as f64 / (1u64 << 53) as f64 };
-        for _ in 0..4000 {
-            let (s, rho, phi) = (z0 + (z1 - z0) * next(), r * next().sqrt(), std::f64::consts::TAU * next());
-            let p = origin.coords + s * axis + rho * (phi.cos() * e1 + phi.sin() * e2);
-            if (0..3).all(|i| p[i] >= lo[i] && p[i] <= hi[i]) {
-                let Some((blo, bhi)) = bounds else { return Err(TestCaseError::fail(format!("{p:?} in the box but no bounds"))) };
+        // Random points of the piece's bounding cube, kept when inside it.
+        for _ in 0..20000 {
+            let p = Vector3::new(lo[0] + size[0] * next(), lo[1] + size[1] * next(), lo[2] + size[2] * next());
+            if inside(&piece, &origin.coords, &axis, &p) {
+                let Some((blo, bhi)) = bounds else { return Err(TestCaseError::fail(format!("{p:?} in the piece and the box but no bounds"))) };
                 for i in 0..3 {
                     prop_assert!(p[i] >= blo[i] - 1e-9 && p[i] <= bhi[i] + 1e-9, "{p:?} outside {blo:?}..{bhi:?}");
                 }
