@@ -1,6 +1,6 @@
 //! Fuzz target: any bytes fed to the STL loader must give a mesh or an
 //! error, never a panic; what loads becomes a stock (a lattice of 16 rays
-//! across its longest extent), is cut, compared with itself as the design,
+//! across its longest extent, at least 1 µm apart), is cut, compared with itself as the design,
 //! meshed, and grown by an allowance. The same bytes, as text, go to the
 //! process-file reader. Run with `cargo +nightly fuzz run stock_stl` from
 //! the repository root.
@@ -20,8 +20,9 @@ fuzz_target!(|data: &[u8]| {
     }
     let Ok(mesh) = Mesh::read_stl(Cursor::new(data), "fuzz.stl") else { return };
     let Some((lo, hi)) = mesh.bounds() else { return };
+    // 16 rays across the longest extent, and no finer than a micrometre.
     let extent = (hi - lo).amax();
-    let h = if extent > 0.0 && extent.is_finite() { extent / 16.0 } else { 1.0 };
+    let h = if extent.is_finite() { (extent / 16.0).max(1e-3) } else { 1.0 };
     if let Ok(mut s) = Stock::from_mesh(&mesh, h) {
         let tool = Tool::BullNose { diameter: 4.0 * h, corner_radius: h, flute_length: 8.0 * h, shank: None };
         let mid = lo + (hi - lo) / 2.0;

@@ -140,7 +140,13 @@ fn mesh_box(mesh: &Mesh) -> Result<(Point3<f64>, Point3<f64>), StockError> {
         return Err(StockError::BadMesh);
     }
     // A flat mesh still gets a lattice one cell thick.
-    let pad = Vector3::from_fn(|i, _| if hi[i] > lo[i] { 0.0 } else { 1e-6 });
+    let pad = Vector3::from_fn(|i, _| {
+        if hi[i] > lo[i] {
+            0.0
+        } else {
+            1e-6 * lo[i].abs().max(1.0)
+        }
+    });
     Ok((lo - pad, hi + pad))
 }
 

@@ -40,7 +40,8 @@ pub const NICE_RESOLUTIONS_MM: [f64; 12] = [
     0.005, 0.01, 0.02, 0.025, 0.05, 0.1, 0.2, 0.25, 0.5, 1.0, 2.0, 5.0,
 ];
 
-/// The largest number of rays a stock may have: 2³² would overflow the ray
-/// indices, and 400 million rays (about 13 GiB) is beyond any machine this
-/// runs on; a finer resolution is an error, not an allocation failure.
-pub const MAX_RAYS: u64 = 400_000_000;
+/// The largest number of rays a stock may have: 100 million rays hold
+/// about 3 GiB of intervals, six times the brief's largest stock (the
+/// 250 × 80 × 40 mm block at 0.05 mm: 13 million); a finer lattice on a
+/// shared 24 GiB machine is an error to report, not an allocation to try.
+pub const MAX_RAYS: u64 = 100_000_000;

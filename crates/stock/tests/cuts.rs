@@ -171,3 +171,27 @@ fn tilted_wheel_pressed_into_a_plane_leaves_the_elliptical_footprint() {
     }
     assert!(rows > 300);
 }
+
+#[test]
+fn bad_stocks_are_errors_not_allocations() {
+    use kinpost_stock::StockError;
+    let (lo, hi) = (Point3::new(0.0, 0.0, 0.0), Point3::new(250.0, 80.0, 40.0));
+    assert!(matches!(
+        Stock::from_box(lo, hi, 0.001),
+        Err(StockError::TooManyRays { .. })
+    ));
+    assert!(matches!(
+        Stock::from_box(lo, hi, 0.0),
+        Err(StockError::Resolution(_))
+    ));
+    assert!(matches!(
+        Stock::from_box(hi, lo, 0.1),
+        Err(StockError::EmptyBox)
+    ));
+    assert!(matches!(
+        Stock::from_box(lo, Point3::new(f64::NAN, 1.0, 1.0), 0.1),
+        Err(StockError::EmptyBox)
+    ));
+    // The default resolution of the brief's block: 0.05 mm.
+    assert_eq!(kinpost_stock::default_resolution(lo, hi), 0.05);
+}

@@ -18,9 +18,10 @@ fn exercise(bytes: &[u8]) {
     let Some((lo, hi)) = mesh.bounds() else {
         return;
     };
+    // 16 rays across the longest extent, and no finer than a micrometre.
     let extent = (hi - lo).amax();
-    let h = if extent > 0.0 && extent.is_finite() {
-        extent / 16.0
+    let h = if extent.is_finite() {
+        (extent / 16.0).max(1e-3)
     } else {
         1.0
     };
