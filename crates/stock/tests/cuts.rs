@@ -195,3 +195,30 @@ fn bad_stocks_are_errors_not_allocations() {
     // The default resolution of the brief's block: 0.05 mm.
     assert_eq!(kinpost_stock::default_resolution(lo, hi), 0.05);
 }
+
+#[test]
+fn the_disc_wheel_grinds_with_its_face_around_its_centre() {
+    // Li (B-spline grinding), §5: the face normal is the tool axis, the
+    // contact point on the face's rim; the reference points to the centre.
+    let mut s = Stock::from_box(
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(60.0, 60.0, 10.0),
+        0.1,
+    )
+    .unwrap();
+    let tool: Tool =
+        toml::from_str("kind = \"disc-wheel\"\nradius = 20.0\nthickness = 5.0").unwrap();
+    let pose =
+        ToolPose::new(Point3::new(10.05, 30.05, 9.9), Vector3::z()).with_reference(Vector3::x());
+    s.cut_pose(&tool, &pose, 2).unwrap();
+    let f = s.family(2);
+    // The face centre at (30.05, 30.05): the top lowered to the face.
+    let centre = f.ray(300, 300);
+    assert!((centre[0].hi - 9.9).abs() < 1e-12 && centre[0].hi_move == 2);
+    // 19.9 mm from the centre still under the face, 20.1 mm outside it.
+    assert!((f.ray(300 + 199, 300)[0].hi - 9.9).abs() < 1e-12);
+    assert_eq!(f.ray(300 + 201, 300)[0].hi, 10.0);
+    // Without a reference the disc's place is unknown: an error, not a guess.
+    let bare = ToolPose::new(Point3::new(10.0, 30.0, 9.9), Vector3::z());
+    assert!(s.cut_pose(&tool, &bare, 3).is_err());
+}
