@@ -18,13 +18,26 @@ fuzz_target!(|data: &[u8]| {
     if let Err(d) = ProcessModel::from_toml(&text, "fuzz.toml") {
         assert!(d.line <= text.split('\n').count());
     }
-    let Ok(mesh) = Mesh::read_stl(Cursor::new(data), "fuzz.stl") else { return };
-    let Some((lo, hi)) = mesh.bounds() else { return };
+    let Ok(mesh) = Mesh::read_stl(Cursor::new(data), "fuzz.stl") else {
+        return;
+    };
+    let Some((lo, hi)) = mesh.bounds() else {
+        return;
+    };
     // 16 rays across the longest extent, and no finer than a micrometre.
     let extent = (hi - lo).amax();
-    let h = if extent.is_finite() { (extent / 16.0).max(1e-3) } else { 1.0 };
+    let h = if extent.is_finite() {
+        (extent / 16.0).max(1e-3)
+    } else {
+        1.0
+    };
     if let Ok(mut s) = Stock::from_mesh(&mesh, h) {
-        let tool = Tool::BullNose { diameter: 4.0 * h, corner_radius: h, flute_length: 8.0 * h, shank: None };
+        let tool = Tool::BullNose {
+            diameter: 4.0 * h,
+            corner_radius: h,
+            flute_length: 8.0 * h,
+            shank: None,
+        };
         let mid = lo + (hi - lo) / 2.0;
         let a = ToolPose::new(mid, Vector3::z());
         let b = ToolPose::new(mid + Vector3::new(h, h, -h), Vector3::new(0.1, 0.0, 1.0));
