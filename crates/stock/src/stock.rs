@@ -1,0 +1,682 @@
+//! The tri-dexel stock and material removal.
+
+use nalgebra::{Point3, Unit, Vector3};
+use rayon::prelude::*;
+
+use crate::clip::{Aabb, piece_in_box, swept_in_box};
+use crate::dexel::{Ray, Segment, UNCUT, subtract};
+use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
+use crate::tolerance::{
+    DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION,
+};
+use crate::tool::{Piece, PlacedTool, Tool, ToolError, ToolPose};
+
+/// Why a stock cannot be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StockError {
+    /// The resolution is not a positive finite number.
+    #[error("the resolution must be a positive number of mm, not {0}")]
+    Resolution(f64),
+    /// The box has a coordinate that is not finite or an empty extent.
+    #[error("the stock box must have finite corners with min < max on every axis")]
+    EmptyBox,
+    /// Too many rays for the machine.
+    #[error(
+        "{rays} rays at {resolution_mm} mm is more than the {max} a stock may have: choose a coarser resolution"
+    )]
+    TooManyRays {
+        /// Rays the resolution asks for.
+        rays: u64,
+        /// The resolution.
+        resolution_mm: f64,
+        /// The limit.
+        max: u64,
+    },
+    /// The mesh has no triangle or a coordinate that is not finite.
+    #[error("the mesh is empty or has a coordinate that is not a finite number")]
+    BadMesh,
+    /// Rays cross the mesh an odd number of times: it has holes.
+    #[error("the mesh is not closed: {rays} rays cross it an odd number of times")]
+    OpenMesh {
+        /// How many rays did.
+        rays: usize,
+    },
+    /// The allowance is not a finite number ≥ 0.
+    #[error("the allowance must be a number of mm, 0 or more, not {0}")]
+    Allowance(f64),
+}
+
+/// Why a move cannot be cut.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CutError {
+    /// The tool or a pose is invalid.
+    #[error(transparent)]
+    Tool(#[from] ToolError),
+    /// The tool axis (or reference) turns by half a turn within one move.
+    #[error(
+        "the tool axis turns by 180° within one move: the motion between the poses is undefined"
+    )]
+    HalfTurn,
+    /// The move needs more samples than allowed.
+    #[error("the move needs {0} samples at this resolution (more than 10 million): split it")]
+    TooManySamples(u64),
+}
+
+/// The rays along one axis of the part frame.
+#[derive(Debug, Clone)]
+pub struct Family {
+    /// The axis the rays run along (0 = X, 1 = Y, 2 = Z).
+    pub axis: usize,
+    /// The first of the other two axes (the faster-varying index).
+    pub u: usize,
+    /// The second of the other two axes.
+    pub v: usize,
+    /// Ray count along `u`.
+    pub nu: usize,
+    /// Ray count along `v`.
+    pub nv: usize,
+    /// Rays, row-major: ray (iu, iv) at `iv * nu + iu`.
+    pub rays: Vec<Ray>,
+}
+
+impl Family {
+    /// The ray at (iu, iv).
+    pub fn ray(&self, iu: usize, iv: usize) -> &[Segment] {
+        &self.rays[iv * self.nu + iu]
+    }
+}
+
+/// A stock as three orthogonal grids of rays (tri-dexel), each ray a sorted
+/// list of solid intervals exact along the ray.
+///
+/// The lattice: `origin` is the low corner; ray positions are cell centres,
+/// coordinate `origin[i] + (n + 0.5)·resolution` for n in 0..counts[i].
+/// The three families share this lattice: the ray along X at (y_j, z_k),
+/// along Y at (x_i, z_k) and along Z at (x_i, y_j) all pass through the
+/// lattice node (x_i, y_j, z_k).
+#[derive(Debug, Clone)]
+pub struct Stock {
+    origin: [f64; 3],
+    resolution: f64,
+    counts: [usize; 3],
+    families: [Family; 3],
+    initial_volume: f64,
+    last: Option<(Tool, ToolPose)>,
+}
+
+/// How a move was cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MoveCut {
+    /// Poses cut (0 for an analytic sweep only).
+    pub samples: u64,
+    /// Whether the move was swept analytically (a pure translation).
+    pub analytic: bool,
+}
+
+/// A solid the cut removes, with its bounds.
+#[derive(Debug, Clone)]
+enum Solid {
+    Piece {
+        piece: Piece,
+        origin: Vector3<f64>,
+        axis: Vector3<f64>,
+    },
+    Capsule {
+        c0: Vector3<f64>,
+        v: Vector3<f64>,
+        r: f64,
+    },
+    CylinderSweep {
+        origin: Vector3<f64>,
+        axis: Vector3<f64>,
+        z0: f64,
+        z1: f64,
+        r: f64,
+        v: Vector3<f64>,
+    },
+}
+
+#[derive(Debug, Clone)]
+struct Bounded {
+    solid: Solid,
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+impl Bounded {
+    #[inline]
+    fn span(&self, o: &Vector3<f64>, d: &Vector3<f64>, kuv: (usize, usize, usize)) -> Option<Span> {
+        match &self.solid {
+            Solid::Piece {
+                piece,
+                origin,
+                axis,
+            } => {
+                let (k, u, v) = kuv;
+                piece_span(piece, &Local::along(k, u, v, o[u], o[v], origin, axis))
+            }
+            Solid::Capsule { c0, v, r } => capsule_span(o, d, c0, v, *r),
+            Solid::CylinderSweep {
+                origin,
+                axis,
+                z0,
+                z1,
+                r,
+                v,
+            } => cylinder_sweep_span(o, d, origin, axis, *z0, *z1, *r, v),
+        }
+    }
+}
+
+fn placed_solids(t: &PlacedTool, boxed: &Aabb, out: &mut Vec<Bounded>) {
+    for p in &t.pieces {
+        if let Some((lo, hi)) = piece_in_box(p, &t.origin, &t.axis, boxed) {
+            out.push(Bounded {
+                solid: Solid::Piece {
+                    piece: *p,
+                    origin: t.origin.coords,
+                    axis: t.axis,
+                },
+                lo,
+                hi,
+            });
+        }
+    }
+}
+
+/// The default resolution for a stock of this extent: the spacing that
+/// gives about `DEFAULT_RAY_BUDGET` (16 million) rays, rounded up to the next
+/// of 0.005, 0.01, 0.02, 0.025, 0.05, 0.1, 0.2, 0.25, 0.5, 1, 2, 5 mm.
+/// (The three families hold (XY + YZ + ZX)/h² rays.)
+pub fn default_resolution(min: Point3<f64>, max: Point3<f64>) -> f64 {
+    let e = max - min;
+    let area = e.x * e.y + e.y * e.z + e.z * e.x;
+    let h = (area / DEFAULT_RAY_BUDGET).sqrt();
+    NICE_RESOLUTIONS_MM
+        .iter()
+        .copied()
+        .find(|&n| n >= h)
+        .unwrap_or(NICE_RESOLUTIONS_MM[NICE_RESOLUTIONS_MM.len() - 1])
+}
+
+impl Stock {
+    /// An empty lattice over the box (every ray without material).
+    pub(crate) fn empty(
+        min: Point3<f64>,
+        max: Point3<f64>,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
+        if !(resolution_mm.is_finite() && resolution_mm > 0.0) {
+            return Err(StockError::Resolution(resolution_mm));
+        }
+        let ok = (0..3).all(|i| min[i].is_finite() && max[i].is_finite() && min[i] < max[i]);
+        if !ok {
+            return Err(StockError::EmptyBox);
+        }
+        let n = |i: usize| ((max[i] - min[i]) / resolution_mm).ceil().max(1.0);
+        let (nx, ny, nz) = (n(0), n(1), n(2));
+        let rays = nx * ny + ny * nz + nz * nx;
+        if !(rays <= MAX_RAYS as f64) {
+            return Err(StockError::TooManyRays {
+                rays: if rays.is_finite() {
+                    rays as u64
+                } else {
+                    u64::MAX
+                },
+                resolution_mm,
+                max: MAX_RAYS,
+            });
+        }
+        let counts = [nx as usize, ny as usize, nz as usize];
+        let family = |axis: usize| {
+            let (u, v) = match axis {
+                0 => (1, 2),
+                1 => (0, 2),
+                _ => (0, 1),
+            };
+            Family {
+                axis,
+                u,
+                v,
+                nu: counts[u],
+                nv: counts[v],
+                rays: vec![Ray::new(); counts[u] * counts[v]],
+            }
+        };
+        Ok(Stock {
+            origin: [min.x, min.y, min.z],
+            resolution: resolution_mm,
+            counts,
+            families: [family(0), family(1), family(2)],
+            initial_volume: 0.0,
+            last: None,
+        })
+    }
+
+    /// A box stock from its low and high corners in the part frame (mm).
+    pub fn from_box(
+        min: Point3<f64>,
+        max: Point3<f64>,
+        resolution_mm: f64,
+    ) -> Result<Stock, StockError> {
+        let mut s = Stock::empty(min, max, resolution_mm)?;
+        let (lo, hi) = ([min.x, min.y, min.z], [max.x, max.y, max.z]);
+        let (origin, h) = (s.origin, s.resolution);
+        for f in &mut s.families {
+            let (k, u, v, nu) = (f.axis, f.u, f.v, f.nu);
+            f.rays.par_chunks_mut(nu).enumerate().for_each(|(iv, row)| {
+                let pv = origin[v] + (iv as f64 + 0.5) * h;
+                for (iu, ray) in row.iter_mut().enumerate() {
+                    let pu = origin[u] + (iu as f64 + 0.5) * h;
+                    if pu <= hi[u] && pv <= hi[v] && pu >= lo[u] && pv >= lo[v] {
+                        ray.push(Segment {
+                            lo: lo[k],
+                            hi: hi[k],
+                            lo_move: UNCUT,
+                            hi_move: UNCUT,
+                        });
+                    }
+                }
+            });
+        }
+        s.initial_volume = s.volume_mm3();
+        Ok(s)
+    }
+
+    pub(crate) fn families_mut(&mut self) -> &mut [Family; 3] {
+        &mut self.families
+    }
+
+    pub(crate) fn set_initial_volume(&mut self) {
+        self.initial_volume = self.volume_mm3();
+    }
+
+    /// The box where material can be: the lattice's cells.
+    fn lattice_box(&self) -> Aabb {
+        (
+            self.origin,
+            std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution),
+        )
+    }
+
+    /// The ray spacing, mm.
+    pub fn resolution_mm(&self) -> f64 {
+        self.resolution
+    }
+
+    /// The lattice's low corner.
+    pub fn origin(&self) -> Point3<f64> {
+        Point3::from(self.origin)
+    }
+
+    /// Lattice nodes along X, Y, Z.
+    pub fn counts(&self) -> [usize; 3] {
+        self.counts
+    }
+
+    /// The lattice's high corner.
+    pub fn max_corner(&self) -> Point3<f64> {
+        Point3::from(std::array::from_fn(|i| {
+            self.origin[i] + self.counts[i] as f64 * self.resolution
+        }))
+    }
+
+    /// The rays along axis `k` (0 = X, 1 = Y, 2 = Z).
+    pub fn family(&self, k: usize) -> &Family {
+        &self.families[k]
+    }
+
+    /// Coordinate of lattice index `n` along axis `i`.
+    pub fn coordinate(&self, i: usize, n: usize) -> f64 {
+        self.origin[i] + (n as f64 + 0.5) * self.resolution
+    }
+
+    /// Number of rays of the three families.
+    pub fn ray_count(&self) -> usize {
+        self.families.iter().map(|f| f.rays.len()).sum()
+    }
+
+    /// Number of solid intervals held.
+    pub fn interval_count(&self) -> usize {
+        self.families
+            .iter()
+            .map(|f| f.rays.iter().map(|r| r.len()).sum::<usize>())
+            .sum()
+    }
+
+    /// Bytes of the interval storage.
+    pub fn memory_bytes(&self) -> usize {
+        self.families
+            .iter()
+            .map(|f| {
+                f.rays.capacity() * std::mem::size_of::<Ray>()
+                    + f.rays
+                        .iter()
+                        .filter(|r| r.spilled())
+                        .map(|r| r.capacity() * std::mem::size_of::<Segment>())
+                        .sum::<usize>()
+            })
+            .sum()
+    }
+
+    /// The material volume, mm³: the mean over the three families of the
+    /// summed interval lengths times the cell area (each family alone
+    /// integrates the volume by the midpoint rule).
+    pub fn volume_mm3(&self) -> f64 {
+        let h2 = self.resolution * self.resolution;
+        let sum: f64 = self
+            .families
+            .iter()
+            .map(|f| {
+                f.rays
+                    .iter()
+                    .map(|r| r.iter().map(|s| s.hi - s.lo).sum::<f64>())
+                    .sum::<f64>()
+            })
+            .sum();
+        sum * h2 / 3.0
+    }
+
+    /// Volume removed since the stock was made, mm³.
+    pub fn removed_volume_mm3(&self) -> f64 {
+        self.initial_volume - self.volume_mm3()
+    }
+
+    /// Removes the tool at one pose.
+    pub fn cut_pose(&mut self, tool: &Tool, pose: &ToolPose, move_id: u32) -> Result<(), CutError> {
+        let placed = tool.place(pose)?;
+        let mut solids = Vec::new();
+        placed_solids(&placed, &self.lattice_box(), &mut solids);
+        self.remove(&solids, move_id);
+        self.last = Some((*tool, *pose));
+        Ok(())
+    }
+
+    /// Removes what the tool sweeps moving from one pose to the next.
+    ///
+    /// * A pure translation (same axis and reference, to `SAME_AXIS`) is
+    ///   swept exactly for cylinders and spheres (see [`crate::kernel`]); cone
+    ///   and rounded-disc pieces are sampled along it.
+    ///   The solid translates when its axis of revolution stays (for the
+    ///   contact wheel reference × tool axis: a lead-angle change turns the
+    ///   wheel about its own axis); its frame origin then moves on the
+    ///   chord between the poses' (for a wheel whose tool axis turns by θ,
+    ///   R·θ²/8 from the arc the interpolated poses' centres follow).
+    /// * Otherwise the pose is interpolated (point linearly, axis and
+    ///   reference along great circles) at n + 1 samples, n the smallest
+    ///   count with (|Δpoint| + ρ·(θ_axis + θ_reference)) / n ≤
+    ///   `SAMPLE_STEP_FRACTION` · resolution, ρ the largest distance from
+    ///   the tool point of a tool point that can reach the stock's box: no
+    ///   such point moves more than one ray spacing between two samples.
+    ///
+    /// The start pose is not cut again when it is the last pose cut with
+    /// the same tool (a continuous program).
+    pub fn cut_move(
+        &mut self,
+        tool: &Tool,
+        from: &ToolPose,
+        to: &ToolPose,
+        move_id: u32,
+    ) -> Result<MoveCut, CutError> {
+        let p0 = tool.place(from)?;
+        let p1 = tool.place(to)?;
+        let start_done = self
+            .last
+            .as_ref()
+            .is_some_and(|(t, p)| t == tool && p == from);
+        // The solid only translates when its axis of revolution stays: a
+        // wheel whose tool axis turns about the wheel's own axis (a lead
+        // angle change) still translates.
+        let same_axis = (p0.axis - p1.axis).norm() <= SAME_AXIS;
+        let step = SAMPLE_STEP_FRACTION * self.resolution;
+        let mut solids = Vec::new();
+        let mut samples = 0u64;
+        let boxed = self.lattice_box();
+        let result = if same_axis {
+            let v = p1.origin - p0.origin;
+            for piece in &p0.pieces {
+                match *piece {
+                    Piece::Sphere { zc, r } => {
+                        let c0 = p0.origin.coords + zc * p0.axis;
+                        if let Some((lo, hi)) =
+                            swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed)
+                        {
+                            solids.push(Bounded {
+                                solid: Solid::Capsule { c0, v, r },
+                                lo,
+                                hi,
+                            });
+                        }
+                    }
+                    Piece::Cylinder { z0, z1, r } => {
+                        if let Some((lo, hi)) =
+                            swept_in_box(piece, &p0.origin, &p0.axis, &v, &boxed)
+                        {
+                            solids.push(Bounded {
+                                solid: Solid::CylinderSweep {
+                                    origin: p0.origin.coords,
+                                    axis: p0.axis,
+                                    z0,
+                                    z1,
+                                    r,
+                                    v,
+                                },
+                                lo,
+                                hi,
+                            });
+                        }
+                    }
+                    Piece::Cone { .. } | Piece::RoundedDisc { .. } => {
+                        let n = sample_count(v.norm(), step)?;
+                        samples = samples.max(n + 1);
+                        for i in 0..=n {
+                            if i == 0 && start_done {
+                                continue;
+                            }
+                            let o = p0.origin + v * (i as f64 / n as f64);
+                            if let Some((lo, hi)) = piece_in_box(piece, &o, &p0.axis, &boxed) {
+                                solids.push(Bounded {
+                                    solid: Solid::Piece {
+                                        piece: *piece,
+                                        origin: o.coords,
+                                        axis: p0.axis,
+                                    },
+                                    lo,
+                                    hi,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+            MoveCut {
+                samples,
+                analytic: true,
+            }
+        } else {
+            let angle = |a: &Unit<Vector3<f64>>, b: &Unit<Vector3<f64>>| a.angle(b);
+            let theta = angle(&from.axis, &to.axis)
+                + match (from.reference, to.reference) {
+                    (Some(a), Some(b)) => angle(&a, &b),
+                    _ => 0.0,
+                };
+            let travel = (to.point - from.point).norm();
+            let naive = travel + (p0.reach() + (p0.origin - from.point).norm()) * theta;
+            // Only tool points that can reach the stock's box matter: those
+            // within the box grown by the naive bound at either end.
+            let grown: Aabb = (boxed.0.map(|c| c - naive), boxed.1.map(|c| c + naive));
+            let mut rho: f64 = 0.0;
+            for (placed, pose) in [(&p0, from), (&p1, to)] {
+                for piece in &placed.pieces {
+                    if let Some((lo, hi)) =
+                        piece_in_box(piece, &placed.origin, &placed.axis, &grown)
+                    {
+                        for c in 0..8 {
+                            let corner =
+                                Vector3::from_fn(
+                                    |i, _| if c >> i & 1 == 0 { lo[i] } else { hi[i] },
+                                );
+                            rho = rho.max((corner - pose.point.coords).norm());
+                        }
+                    }
+                }
+            }
+            let n = sample_count(travel + rho * theta, step)?;
+            for i in 0..=n {
+                if i == 0 && start_done {
+                    continue;
+                }
+                let pose = interpolate(from, to, i as f64 / n as f64).ok_or(CutError::HalfTurn)?;
+                placed_solids(&tool.place(&pose)?, &boxed, &mut solids);
+            }
+            MoveCut {
+                samples: n + 1 - u64::from(start_done),
+                analytic: false,
+            }
+        };
+        self.remove(&solids, move_id);
+        self.last = Some((*tool, *to));
+        Ok(result)
+    }
+
+    /// Cuts the poses of one move in order: each consecutive pair as
+    /// [`Stock::cut_move`] (a single pose as [`Stock::cut_pose`]).
+    pub fn cut(&mut self, tool: &Tool, poses: &[ToolPose], move_id: u32) -> Result<(), CutError> {
+        match poses {
+            [] => Ok(()),
+            [p] => self.cut_pose(tool, p, move_id),
+            _ => {
+                for w in poses.windows(2) {
+                    self.cut_move(tool, &w[0], &w[1], move_id)?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Subtracts the union of the solids from every ray that crosses their
+    /// bounds. Rows of rays run in parallel; every ray is handled alone, so
+    /// the result does not depend on the thread count.
+    fn remove(&mut self, solids: &[Bounded], id: u32) {
+        if solids.is_empty() {
+            return;
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for s in solids {
+            for i in 0..3 {
+                lo[i] = lo[i].min(s.lo[i]);
+                hi[i] = hi[i].max(s.hi[i]);
+            }
+        }
+        let (origin, h) = (self.origin, self.resolution);
+        let counts = self.counts;
+        // Index range of the rays whose coordinate along axis i is in [lo, hi].
+        let range = |i: usize| -> Option<(usize, usize)> {
+            let a = ((lo[i] - origin[i]) / h - 0.5).ceil().max(0.0);
+            let b = ((hi[i] - origin[i]) / h - 0.5)
+                .floor()
+                .min(counts[i] as f64 - 1.0);
+            (a <= b).then_some((a as usize, b as usize))
+        };
+        for f in &mut self.families {
+            let (k, u, v, nu) = (f.axis, f.u, f.v, f.nu);
+            let (Some((u0, u1)), Some((v0, v1))) = (range(u), range(v)) else {
+                continue;
+            };
+            // Along the ray, only the solids' extent matters.
+            if hi[k] < origin[k] || lo[k] > origin[k] + counts[k] as f64 * h {
+                continue;
+            }
+            let mut d = Vector3::zeros();
+            d[k] = 1.0;
+            f.rays[v0 * nu..(v1 + 1) * nu]
+                .par_chunks_mut(nu)
+                .enumerate()
+                .for_each(|(jv, row)| {
+                    let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
+                    let mut spans: Vec<Span> = Vec::with_capacity(8);
+                    for (ju, ray) in row[u0..=u1].iter_mut().enumerate() {
+                        if ray.is_empty() {
+                            continue;
+                        }
+                        let pu = origin[u] + ((u0 + ju) as f64 + 0.5) * h;
+                        let mut o = Vector3::zeros();
+                        o[u] = pu;
+                        o[v] = pv;
+                        spans.clear();
+                        let (first, last) = (ray[0].lo, ray[ray.len() - 1].hi);
+                        for s in solids {
+                            if pu < s.lo[u]
+                                || pu > s.hi[u]
+                                || pv < s.lo[v]
+                                || pv > s.hi[v]
+                                || s.hi[k] <= first
+                                || s.lo[k] >= last
+                            {
+                                continue;
+                            }
+                            if let Some(sp) = s.span(&o, &d, (k, u, v)) {
+                                spans.push(sp);
+                            }
+                        }
+                        remove_spans(ray, &mut spans, id);
+                    }
+                });
+        }
+    }
+}
+
+/// Subtracts the union of the spans from the ray.
+fn remove_spans(ray: &mut Ray, spans: &mut [Span], id: u32) {
+    match spans.len() {
+        0 => {}
+        1 => subtract(ray, spans[0].lo, spans[0].hi, id),
+        _ => {
+            spans.sort_by(|a, b| a.lo.total_cmp(&b.lo));
+            let mut cur = spans[0];
+            for s in &spans[1..] {
+                if s.lo <= cur.hi {
+                    cur.hi = cur.hi.max(s.hi);
+                } else {
+                    subtract(ray, cur.lo, cur.hi, id);
+                    cur = *s;
+                }
+            }
+            subtract(ray, cur.lo, cur.hi, id);
+        }
+    }
+}
+
+fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
+    let n = (distance / step).ceil().max(1.0);
+    if !(n <= 1.0e7) {
+        return Err(CutError::TooManySamples(if n.is_finite() {
+            n as u64
+        } else {
+            u64::MAX
+        }));
+    }
+    Ok(n as u64)
+}
+
+/// The pose a fraction `s` of the way: point linearly, axis and reference
+/// along great circles; `None` for a half turn.
+fn interpolate(a: &ToolPose, b: &ToolPose, s: f64) -> Option<ToolPose> {
+    let slerp = |x: &Unit<Vector3<f64>>, y: &Unit<Vector3<f64>>| -> Option<Unit<Vector3<f64>>> {
+        if (x.into_inner() - y.into_inner()).norm() <= SAME_AXIS {
+            return Some(*x);
+        }
+        x.try_slerp(y, s, 1e-9)
+    };
+    let axis = slerp(&a.axis, &b.axis)?;
+    let reference = match (a.reference, b.reference) {
+        (Some(x), Some(y)) => Some(slerp(&x, &y)?),
+        (x, _) => x,
+    };
+    Some(ToolPose {
+        point: a.point + (b.point - a.point) * s,
+        axis,
+        reference,
+    })
+}

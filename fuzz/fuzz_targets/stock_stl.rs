@@ -1,0 +1,51 @@
+//! Fuzz target: any bytes fed to the STL loader must give a mesh or an
+//! error, never a panic; what loads becomes a stock (a lattice of 16 rays
+//! across its longest extent, at least 1 µm apart), is cut, compared with itself as the design,
+//! meshed, and grown by an allowance. The same bytes, as text, go to the
+//! process-file reader. Run with `cargo +nightly fuzz run stock_stl` from
+//! the repository root.
+
+#![no_main]
+
+use std::io::Cursor;
+
+use kinpost_stock::{Design, Mesh, ProcessModel, Stock, Tool, ToolPose, compare, contour};
+use libfuzzer_sys::fuzz_target;
+use nalgebra::Vector3;
+
+fuzz_target!(|data: &[u8]| {
+    let text = String::from_utf8_lossy(data);
+    if let Err(d) = ProcessModel::from_toml(&text, "fuzz.toml") {
+        assert!(d.line <= text.split('\n').count());
+    }
+    let Ok(mesh) = Mesh::read_stl(Cursor::new(data), "fuzz.stl") else {
+        return;
+    };
+    let Some((lo, hi)) = mesh.bounds() else {
+        return;
+    };
+    // 16 rays across the longest extent, and no finer than a micrometre.
+    let extent = (hi - lo).amax();
+    let h = if extent.is_finite() {
+        (extent / 16.0).max(1e-3)
+    } else {
+        1.0
+    };
+    if let Ok(mut s) = Stock::from_mesh(&mesh, h) {
+        let tool = Tool::BullNose {
+            diameter: 4.0 * h,
+            corner_radius: h,
+            flute_length: 8.0 * h,
+            shank: None,
+        };
+        let mid = lo + (hi - lo) / 2.0;
+        let a = ToolPose::new(mid, Vector3::z());
+        let b = ToolPose::new(mid + Vector3::new(h, h, -h), Vector3::new(0.1, 0.0, 1.0));
+        let _ = s.cut_move(&tool, &a, &b, 1);
+        let _ = contour(&s);
+        if let Ok(d) = Design::from_mesh(mesh.clone()) {
+            let _ = compare(&s, &d, 0.01);
+        }
+    }
+    let _ = Stock::from_mesh_offset(&mesh, h, h);
+});
