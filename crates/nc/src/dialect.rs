@@ -10,12 +10,15 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::template::{self, TemplateError, template_span_in_toml};
-use crate::writer::{MAX_LEAD, MAX_SUFFIX};
 use crate::{AxisSpec, Motion, ProgramInfo};
 use kinpost_number::{MAX_DECIMALS, NumberFormat, TrailingZeros};
 
 /// Longest prefix of a word, in bytes (words are copied in fixed-size moves).
 const MAX_PREFIX: usize = 24;
+/// Longest separator + prefix of a word (the writer's fixed room).
+pub(crate) const MAX_LEAD: usize = 32;
+/// Longest suffix of a word (the writer's fixed room).
+pub(crate) const MAX_SUFFIX: usize = 16;
 /// Most digits a block number is padded to (the writer's number buffer).
 const MAX_NUMBER_DIGITS: usize = 24;
 

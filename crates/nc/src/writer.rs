@@ -6,7 +6,9 @@ use std::sync::Arc;
 
 use minijinja::{Environment, Value};
 
-use crate::dialect::{CommentSyntax, Dialect, DialectKind, Numbering, TemplateKind};
+use crate::dialect::{
+    CommentSyntax, Dialect, DialectKind, MAX_LEAD, MAX_SUFFIX, Numbering, TemplateKind,
+};
 use crate::template;
 use crate::{AxisSpec, Block, BlockError, Motion, NcError, ProgramInfo};
 use kinpost_number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
@@ -21,11 +23,6 @@ pub enum Spindle {
     /// Counter-clockwise at this speed (1/min).
     Ccw(f64),
 }
-
-/// Longest separator + prefix of a word (checked when a dialect is loaded).
-pub(crate) const MAX_LEAD: usize = 32;
-/// Longest suffix of a word (checked when a dialect is loaded).
-pub(crate) const MAX_SUFFIX: usize = 16;
 
 /// One word (axis or feed), resolved for the hot path: prefix and suffix
 /// padded to fixed sizes so that they are copied with fixed-size moves.
