@@ -22,6 +22,7 @@
 use std::collections::BTreeMap;
 
 mod dialect;
+pub mod interp;
 mod number;
 mod reader;
 mod template;
