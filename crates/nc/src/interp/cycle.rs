@@ -43,6 +43,9 @@ pub(crate) struct Hole {
     /// First move up to the R plane when the tool is below it (G-code
     /// cycles); otherwise the tool goes to the R plane from where it is.
     pub up_to_r_first: bool,
+    /// Level the tool travels to the hole at (from where it is, in one
+    /// rapid move); `None`: the level it is at.
+    pub travel_level: Option<f64>,
     /// The cycle from the R plane on.
     pub ops: Vec<Op>,
 }
@@ -68,8 +71,9 @@ pub(crate) fn drill(m: &mut Machine<'_>, hole: &Hole) {
         m.move_xyz(true, p[0], p[1], p[2]);
     }
     let cur = m.xyz_pos();
-    if cur[a] != hole.at[0] || cur[b] != hole.at[1] {
-        let p = at(m, Some(hole.at[0]), Some(hole.at[1]), None);
+    let travel = hole.travel_level.filter(|l| *l != cur[n]);
+    if cur[a] != hole.at[0] || cur[b] != hole.at[1] || travel.is_some() {
+        let p = at(m, Some(hole.at[0]), Some(hole.at[1]), travel);
         m.move_xyz(true, p[0], p[1], p[2]);
     }
     if level(m) != hole.r {

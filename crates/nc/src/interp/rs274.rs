@@ -703,6 +703,9 @@ impl<'a, 's> Interp<'a, 's> {
                 }
             }
             Param::Named(name) => {
+                if self.predefined(name).is_some() {
+                    return fail(at, 1, format!("#<{name}> is read-only"));
+                }
                 if name.starts_with('_') {
                     self.globals.insert(name.clone(), v);
                 } else {

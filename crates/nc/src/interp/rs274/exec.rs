@@ -37,6 +37,12 @@ impl Interp<'_, '_> {
         if let Some(msg) = &b.message {
             self.m.emit(Event::Message(msg.clone()));
         }
+        // Units first: every length and feed word of the block is in them.
+        if b.has_g(200).is_some() {
+            self.m.set_units(true);
+        } else if b.has_g(210).is_some() {
+            self.m.set_units(false);
+        }
         self.feed_words(b)?;
         self.m_words_before_motion(b, line)?;
         self.dwell(b)?;

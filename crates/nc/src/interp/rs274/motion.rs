@@ -25,9 +25,8 @@ impl Interp<'_, '_> {
                     if matches!(c, 87 | 88) || self.flavour == Flavour::LinuxCnc && matches!(c, 74 | 76) {
                         return fail(at, 3, format!("canned cycle G{c} is not supported by the interpreter"));
                     }
-                    if self.motion != Motion::Cycle(c) {
-                        self.cycle_initial = None;
-                    }
+                    // The initial level stays from one cycle code to the
+                    // next (rs274ngc's cycle_il): only G80 and G0..G3 end it.
                     self.motion = Motion::Cycle(c);
                     self.m.emit(Event::Cycle { code: c });
                 }
@@ -241,6 +240,9 @@ impl Interp<'_, '_> {
                 at: [a, bb],
                 r,
                 up_to_r_first: k == 0,
+                // rs274ngc: under G98 the tool travels to the hole at the
+                // initial level (checked with rs274).
+                travel_level: (k == 0 && self.retract_initial).then(|| init.max(self.m.pos[inn])),
                 ops: ops.clone(),
             };
             cycle::drill(&mut self.m, &hole);
