@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use kinpost_nc::AxisSpec;
-use kinpost_nc::interp::{Event, MotionKind, Options, Plane, read_all, Family};
+use kinpost_nc::interp::{Event, Family, MotionKind, Options, Plane, read_all};
 
 fn rs274() -> Option<PathBuf> {
     if let Some(p) = std::env::var_os("RS274") {
@@ -72,7 +72,10 @@ fn run_rs274(rs274: &Path, program: &str, label: &str) -> Vec<Motion> {
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        out.status.success() && stderr.lines().all(|l| l.trim().is_empty() || l.trim() == "executing"),
+        out.status.success()
+            && stderr
+                .lines()
+                .all(|l| l.trim().is_empty() || l.trim() == "executing"),
         "{label}: rs274 rejected the program: {stderr}"
     );
     let mut moves = Vec::new();
@@ -81,9 +84,13 @@ fn run_rs274(rs274: &Path, program: &str, label: &str) -> Vec<Motion> {
     // rs274 prints program units: inch after G20.
     let mut unit = 1.0;
     for line in stdout.lines() {
-        let Some(call) = line.split_whitespace().nth(2) else { continue };
+        let Some(call) = line.split_whitespace().nth(2) else {
+            continue;
+        };
         let call = &line[line.find(call).unwrap()..];
-        let Some((name, args)) = call.split_once('(') else { continue };
+        let Some((name, args)) = call.split_once('(') else {
+            continue;
+        };
         let args = args.trim_end_matches(')');
         let nums = || -> Vec<f64> { args.split(',').map(|v| v.trim().parse().unwrap()).collect() };
         match name {
@@ -167,7 +174,11 @@ fn ours(program: &str, options: &Options, label: &str) -> Vec<Motion> {
                     MotionKind::Linear => ('F', None, 0),
                     MotionKind::Arc(a) => {
                         let turns = a.turns as i32 + 1;
-                        ('A', Some(a.centre_mm), if a.clockwise { -turns } else { turns })
+                        (
+                            'A',
+                            Some(a.centre_mm),
+                            if a.clockwise { -turns } else { turns },
+                        )
                     }
                 };
                 Some(Motion {
@@ -205,7 +216,13 @@ fn collapse(moves: Vec<Motion>) -> Vec<Motion> {
 /// rs274 prints 4 decimals.
 const PRINTED: f64 = 0.5e-4 + 1e-9;
 
-fn compare(rs274: &Path, program: &str, ngc_for_rs274: &str, options: &Options, label: &str) -> usize {
+fn compare(
+    rs274: &Path,
+    program: &str,
+    ngc_for_rs274: &str,
+    options: &Options,
+    label: &str,
+) -> usize {
     let want = collapse(run_rs274(rs274, ngc_for_rs274, label));
     let got = collapse(ours(program, options, label));
     let mut prev = [0.0; 6];
@@ -213,7 +230,9 @@ fn compare(rs274: &Path, program: &str, ngc_for_rs274: &str, options: &Options, 
         // Inverse time: rs274 turns F into the rate of this move (its XYZ
         // length, or its ABC length for a rotary move, times F).
         let feed = if g.inverse_time && g.kind != 'A' {
-            let d = |r: std::ops::Range<usize>| r.map(|i| (g.at[i] - prev[i]).powi(2)).sum::<f64>().sqrt();
+            let d = |r: std::ops::Range<usize>| {
+                r.map(|i| (g.at[i] - prev[i]).powi(2)).sum::<f64>().sqrt()
+            };
             let xyz = d(0..3);
             g.feed * if xyz > 1e-6 { xyz } else { d(3..6) }
         } else {
@@ -221,7 +240,10 @@ fn compare(rs274: &Path, program: &str, ngc_for_rs274: &str, options: &Options, 
         };
         prev = g.at;
         let ok = w.kind == g.kind
-            && w.at.iter().zip(&g.at).all(|(a, b)| (a - b).abs() <= PRINTED * a.abs().max(1.0))
+            && w.at
+                .iter()
+                .zip(&g.at)
+                .all(|(a, b)| (a - b).abs() <= PRINTED * a.abs().max(1.0))
             && w.rotation == g.rotation
             && match (w.centre, g.centre) {
                 // rs274 gives the centre in the plane only (NaN elsewhere).
@@ -230,8 +252,14 @@ fn compare(rs274: &Path, program: &str, ngc_for_rs274: &str, options: &Options, 
                 (None, None) => true,
                 _ => false,
             }
-            && (w.kind == 'R' || (g.inverse_time && g.kind == 'A') || (w.feed - feed).abs() <= 1e-3 * w.feed.max(1.0));
-        assert!(ok, "{label}: move {k} differs:\n  rs274 {w:?}\n  ours  {g:?} (line {})", g.line);
+            && (w.kind == 'R'
+                || (g.inverse_time && g.kind == 'A')
+                || (w.feed - feed).abs() <= 1e-3 * w.feed.max(1.0));
+        assert!(
+            ok,
+            "{label}: move {k} differs:\n  rs274 {w:?}\n  ours  {g:?} (line {})",
+            g.line
+        );
     }
     assert_eq!(
         want.len(),
@@ -246,7 +274,9 @@ fn compare(rs274: &Path, program: &str, ngc_for_rs274: &str, options: &Options, 
 }
 
 fn data(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/linuxcnc").join(name);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/linuxcnc")
+        .join(name);
     std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
@@ -257,7 +287,11 @@ fn strip_remaps(text: &str) -> String {
     text.lines()
         .map(|l| {
             let t = l.trim_start().to_ascii_lowercase();
-            if t.starts_with("m428") || t.starts_with("m429") { "" } else { l }
+            if t.starts_with("m428") || t.starts_with("m429") {
+                ""
+            } else {
+                l
+            }
         })
         .collect::<Vec<_>>()
         .join("\n")
@@ -266,8 +300,13 @@ fn strip_remaps(text: &str) -> String {
 
 #[test]
 fn linuxcnc_sample_programs() {
-    let Some(rs274) = interpreter("linuxcnc_sample_programs") else { return };
-    let mut options = Options { tcp_mcodes: Some((428, 429)), ..Options::default() };
+    let Some(rs274) = interpreter("linuxcnc_sample_programs") else {
+        return;
+    };
+    let mut options = Options {
+        tcp_mcodes: Some((428, 429)),
+        ..Options::default()
+    };
     for name in ["boat-xyzac.ngc", "boat-xyzbc.ngc", "impeller-7bl-xyzac.ngc"] {
         let text = data(name);
         let n = compare(&rs274, &text, &strip_remaps(&text), &options, name);
@@ -286,7 +325,9 @@ fn linuxcnc_sample_programs() {
     let mut for_rs274 = strip_remaps(&text);
     for (pin, v) in pins {
         for_rs274 = for_rs274.replace(&format!("#<_hal[{pin}]>"), &format!("[{v}]"));
-        options.inputs.insert(format!("_HAL[{}]", pin.to_uppercase()), v);
+        options
+            .inputs
+            .insert(format!("_HAL[{}]", pin.to_uppercase()), v);
     }
     let n = compare(&rs274, &text, &for_rs274, &options, "xyzab-tdr-demo.ngc");
     assert!(n > 20);
@@ -348,7 +389,9 @@ const PROGRAMS: &[(&str, &str)] = &[
 
 #[test]
 fn hand_written_programs() {
-    let Some(rs274) = interpreter("hand_written_programs") else { return };
+    let Some(rs274) = interpreter("hand_written_programs") else {
+        return;
+    };
     for (label, program) in PROGRAMS {
         let n = compare(&rs274, program, program, &Options::default(), label);
         assert!(n > 3, "{label}");

@@ -150,6 +150,27 @@ pub(crate) fn circle_through(s: [f64; 2], m: [f64; 2], e: [f64; 2]) -> Option<([
     Some(([s[0] + cx, s[1] + cy], d < 0.0))
 }
 
+/// The centre of the circle that leaves `s` along the direction `t` and
+/// reaches `e` (Sinumerik `CT`), and whether it turns clockwise; `None`
+/// when `e` lies on the tangent.
+pub(crate) fn tangent_centre(s: [f64; 2], t: [f64; 2], e: [f64; 2]) -> Option<([f64; 2], bool)> {
+    let (dx, dy) = (e[0] - s[0], e[1] - s[1]);
+    let tn = t[0].hypot(t[1]);
+    if tn == 0.0 {
+        return None;
+    }
+    // Left of the tangent.
+    let (nx, ny) = (-t[1] / tn, t[0] / tn);
+    let dn = dx * nx + dy * ny;
+    let d2 = dx * dx + dy * dy;
+    if dn.abs() <= 1e-12 * d2.sqrt().max(1e-300) {
+        return None;
+    }
+    // |c - s| = |c - e| with c = s + λ n: λ = |d|² / (2 d·n).
+    let lambda = d2 / (2.0 * dn);
+    Some(([s[0] + lambda * nx, s[1] + lambda * ny], lambda < 0.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,8 +199,41 @@ mod tests {
         let full = arc(Plane::Xy, true, s, s, Centre::At([0.0, 0.0]), 2, &tol()).unwrap();
         assert!((full.sweep_deg - 3.0 * 360.0).abs() < 1e-9);
         assert!(arc(Plane::Xy, true, s, s, Centre::Radius(1.0), 0, &tol()).is_err());
-        assert!(arc(Plane::Xy, true, s, [5.0, 0.0, 0.0], Centre::Radius(1.0), 0, &tol()).is_err());
-        assert!(arc(Plane::Xy, true, s, [0.0, 2.0, 0.0], Centre::At([0.0, 0.0]), 0, &tol()).is_err());
+        assert!(
+            arc(
+                Plane::Xy,
+                true,
+                s,
+                [5.0, 0.0, 0.0],
+                Centre::Radius(1.0),
+                0,
+                &tol()
+            )
+            .is_err()
+        );
+        assert!(
+            arc(
+                Plane::Xy,
+                true,
+                s,
+                [0.0, 2.0, 0.0],
+                Centre::At([0.0, 0.0]),
+                0,
+                &tol()
+            )
+            .is_err()
+        );
+    }
+
+    /// Leaving (0, 0) along +X towards (1, 1): the quarter circle about
+    /// (0, 1), counter-clockwise.
+    #[test]
+    fn tangent_circle() {
+        let (c, cw) = tangent_centre([0.0, 0.0], [1.0, 0.0], [1.0, 1.0]).unwrap();
+        assert!((c[0]).abs() < 1e-12 && (c[1] - 1.0).abs() < 1e-12 && !cw);
+        let (c, cw) = tangent_centre([0.0, 0.0], [1.0, 0.0], [1.0, -1.0]).unwrap();
+        assert!((c[1] + 1.0).abs() < 1e-12 && cw);
+        assert!(tangent_centre([0.0, 0.0], [1.0, 0.0], [5.0, 0.0]).is_none());
     }
 
     #[test]

@@ -85,7 +85,9 @@ impl<'a> Cursor<'a> {
     pub fn eat_kw(&mut self, s: &str, word: bool) -> bool {
         self.skip_ws();
         let n = s.len();
-        if self.i + n > self.b.len() || !self.b[self.i..self.i + n].eq_ignore_ascii_case(s.as_bytes()) {
+        if self.i + n > self.b.len()
+            || !self.b[self.i..self.i + n].eq_ignore_ascii_case(s.as_bytes())
+        {
             return false;
         }
         if word
@@ -108,7 +110,9 @@ impl<'a> Cursor<'a> {
         if !(first.is_ascii_alphabetic() || first == b'_') {
             return None;
         }
-        while self.i < self.b.len() && (self.b[self.i].is_ascii_alphanumeric() || self.b[self.i] == b'_') {
+        while self.i < self.b.len()
+            && (self.b[self.i].is_ascii_alphanumeric() || self.b[self.i] == b'_')
+        {
             self.i += 1;
         }
         std::str::from_utf8(&self.b[s..self.i]).ok()
@@ -155,7 +159,13 @@ pub(crate) fn eval(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands) -> Re
 /// overflow is not an error message).
 const MAX_DEPTH: usize = 200;
 
-fn binary(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, min: u8, depth: usize) -> Result<f64, Fail> {
+fn binary(
+    c: &mut Cursor<'_>,
+    lang: Lang,
+    ops: &mut dyn Operands,
+    min: u8,
+    depth: usize,
+) -> Result<f64, Fail> {
     if depth > MAX_DEPTH {
         return fail(c.i, 1, format!("expression nested deeper than {MAX_DEPTH}"));
     }
@@ -413,7 +423,10 @@ fn apply(op: Op, a: f64, b: f64, lang: Lang) -> Result<f64, String> {
         Or => bool_of(truth(a) || truth(b)),
         Xor => bool_of(truth(a) != truth(b)),
         BAnd | BOr | BXor => {
-            let (x, y) = (int_of(a, "B_AND/B_OR/B_XOR")?, int_of(b, "B_AND/B_OR/B_XOR")?);
+            let (x, y) = (
+                int_of(a, "B_AND/B_OR/B_XOR")?,
+                int_of(b, "B_AND/B_OR/B_XOR")?,
+            );
             (match op {
                 BAnd => x & y,
                 BOr => x | y,
@@ -451,7 +464,12 @@ fn close_bracket(lang: Lang) -> u8 {
     }
 }
 
-fn unary(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize) -> Result<f64, Fail> {
+fn unary(
+    c: &mut Cursor<'_>,
+    lang: Lang,
+    ops: &mut dyn Operands,
+    depth: usize,
+) -> Result<f64, Fail> {
     c.skip_ws();
     let start = c.i;
     let Some(ch) = c.peek() else {
@@ -485,7 +503,11 @@ fn unary(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize) -
         c.i += 1;
         let v = binary(c, lang, ops, 0, depth + 1)?;
         if !c.eat(close_bracket(lang)) {
-            return fail(c.i, 1, format!("`{}` expected", close_bracket(lang) as char));
+            return fail(
+                c.i,
+                1,
+                format!("`{}` expected", close_bracket(lang) as char),
+            );
         }
         return Ok(v);
     }
@@ -516,7 +538,12 @@ fn unary(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize) -
 }
 
 /// A function call, or `None` when the text is not a function name.
-fn function(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize) -> Result<Option<f64>, Fail> {
+fn function(
+    c: &mut Cursor<'_>,
+    lang: Lang,
+    ops: &mut dyn Operands,
+    depth: usize,
+) -> Result<Option<f64>, Fail> {
     let save = c.i;
     let Some(name) = c.ident() else {
         return Ok(None);
@@ -539,7 +566,11 @@ fn function(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize
         second = Some(binary(c, lang, ops, 0, depth + 1)?);
     }
     if !c.eat(close_bracket(lang)) {
-        return fail(c.i, 1, format!("`{}` expected", close_bracket(lang) as char));
+        return fail(
+            c.i,
+            1,
+            format!("`{}` expected", close_bracket(lang) as char),
+        );
     }
     // rs274: ATAN[y]/[x].
     if name == "ATAN" && second.is_none() && matches!(lang, Lang::LinuxCnc | Lang::Fanuc) {
@@ -559,7 +590,11 @@ fn function(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize
     }
     let x0 = if is_vacant(x) { 0.0 } else { x };
     let len = c.i - at;
-    let bad = |m: String| Fail { at, len, message: m };
+    let bad = |m: String| Fail {
+        at,
+        len,
+        message: m,
+    };
     let v = match (name.as_str(), second) {
         ("SIN", None) => x0.to_radians().sin(),
         ("COS", None) => x0.to_radians().cos(),
@@ -598,7 +633,11 @@ fn function(c: &mut Cursor<'_>, lang: Lang, ops: &mut dyn Operands, depth: usize
         ("NEG", None) => -x0,
         ("MINVAL", Some(y)) => x0.min(y),
         ("MAXVAL", Some(y)) => x0.max(y),
-        _ => return Err(bad(format!("unknown function `{name}` (or wrong number of arguments)"))),
+        _ => {
+            return Err(bad(format!(
+                "unknown function `{name}` (or wrong number of arguments)"
+            )));
+        }
     };
     if v.is_nan() {
         return Err(bad(format!("{name} of {x0} is not a number")));

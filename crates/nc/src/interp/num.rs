@@ -119,8 +119,18 @@ mod tests {
     #[test]
     fn same_bits_as_std() {
         for s in [
-            "0", "-0.5", "459.000", "8.807", "-93.25", "1200", "0.5", "5.0", "+3.25",
-            "0.000001", "123456789.123456789", "-0.0000000000000000000001234",
+            "0",
+            "-0.5",
+            "459.000",
+            "8.807",
+            "-93.25",
+            "1200",
+            "0.5",
+            "5.0",
+            "+3.25",
+            "0.000001",
+            "123456789.123456789",
+            "-0.0000000000000000000001234",
         ] {
             let n = read_number(s.as_bytes()).unwrap();
             let want: f64 = s.parse().unwrap();
@@ -143,7 +153,11 @@ mod tests {
             for d in 0..7 {
                 let s = format!("{:.*}", d, k as f64 / 7.0);
                 let n = read_number(s.as_bytes()).unwrap();
-                assert_eq!(n.value.to_bits(), s.parse::<f64>().unwrap().to_bits(), "{s}");
+                assert_eq!(
+                    n.value.to_bits(),
+                    s.parse::<f64>().unwrap().to_bits(),
+                    "{s}"
+                );
             }
         }
     }

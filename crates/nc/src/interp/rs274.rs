@@ -287,7 +287,11 @@ impl<'a, 's> Interp<'a, 's> {
             }
         }
         if !self.calls.is_empty() && !self.ended {
-            let name = self.calls.last().map(|c| c.name.clone()).unwrap_or_default();
+            let name = self
+                .calls
+                .last()
+                .map(|c| c.name.clone())
+                .unwrap_or_default();
             return Err(kinpost_diag::Diagnostic::error(
                 self.file,
                 0,
@@ -347,7 +351,9 @@ impl<'a, 's> Interp<'a, 's> {
         }
         self.block.clear();
         let mut block = std::mem::replace(&mut self.block, Block::new());
-        let r = self.read_block(b, c, &mut block).and_then(|()| self.execute(&block, line));
+        let r = self
+            .read_block(b, c, &mut block)
+            .and_then(|()| self.execute(&block, line));
         self.block = block;
         r
     }
@@ -368,7 +374,11 @@ impl<'a, 's> Interp<'a, 's> {
                     };
                     let text = &b[start + 1..start + end];
                     if self.flavour == Flavour::LinuxCnc && text.contains(&b'(') {
-                        return fail(start, end + 1, "nested comment (LinuxCNC does not allow `(` inside a comment)");
+                        return fail(
+                            start,
+                            end + 1,
+                            "nested comment (LinuxCNC does not allow `(` inside a comment)",
+                        );
                     }
                     self.comment(text, block);
                     c.i = start + end + 1;
@@ -389,7 +399,11 @@ impl<'a, 's> Interp<'a, 's> {
                 }
                 _ if ch.is_ascii_alphabetic() => self.word(&mut c, block)?,
                 _ => {
-                    return fail(c.i, 1, format!("`{}` is not the start of a word", char::from(ch)));
+                    return fail(
+                        c.i,
+                        1,
+                        format!("`{}` is not the start of a word", char::from(ch)),
+                    );
                 }
             }
         }
@@ -400,7 +414,11 @@ impl<'a, 's> Interp<'a, 's> {
     fn comment(&mut self, text: &[u8], block: &mut Block) {
         let t = String::from_utf8_lossy(text);
         let trimmed = t.trim_start();
-        let upper: String = trimmed.chars().take(6).collect::<String>().to_ascii_uppercase();
+        let upper: String = trimmed
+            .chars()
+            .take(6)
+            .collect::<String>()
+            .to_ascii_uppercase();
         for kw in ["MSG,", "PRINT,", "DEBUG,"] {
             if upper.starts_with(kw) {
                 let body = trimmed[kw.len()..].to_string();
@@ -436,7 +454,11 @@ impl<'a, 's> Interp<'a, 's> {
             }
             _ => {
                 if block.has & (1 << k) != 0 {
-                    return fail(start, c.i - start, format!("two {} words in one block", char::from(letter)));
+                    return fail(
+                        start,
+                        c.i - start,
+                        format!("two {} words in one block", char::from(letter)),
+                    );
                 }
                 block.has |= 1 << k;
                 block.v[k] = v;
@@ -493,7 +515,11 @@ impl<'a, 's> Interp<'a, 's> {
                 let mut d = Cursor::new(&c.b[..end], c.i);
                 let v = expr::eval(&mut d, lang, self)?;
                 if d.i != end {
-                    return fail(start, end - start, "a number, parameter or expression was expected");
+                    return fail(
+                        start,
+                        end - start,
+                        "a number, parameter or expression was expected",
+                    );
                 }
                 c.i = end;
                 v
@@ -600,7 +626,13 @@ impl<'a, 's> Interp<'a, 's> {
                 if self.m.options.inputs.contains_key(&key) || (1000..1100).contains(&n) {
                     return Ok(self.m.input(&key));
                 }
-                fail(at, 1, format!("system variable #{n} is not modelled (give it as an input `#{n}=VALUE`)"))
+                fail(
+                    at,
+                    1,
+                    format!(
+                        "system variable #{n} is not modelled (give it as an input `#{n}=VALUE`)"
+                    ),
+                )
             }
         }
     }
@@ -617,7 +649,12 @@ impl<'a, 's> Interp<'a, 's> {
             return None;
         }
         let axis = self.letter_axis[k]?;
-        Some(self.m.offsets.get(&(system as u16)).map_or(0.0, |o| o[axis]))
+        Some(
+            self.m
+                .offsets
+                .get(&(system as u16))
+                .map_or(0.0, |o| o[axis]),
+        )
     }
 
     fn letter_pos(&self, k: usize) -> f64 {
@@ -767,7 +804,9 @@ impl Operands for Interp<'_, '_> {
                     }
                     let exists = match &p {
                         Param::Named(n) => {
-                            self.named.contains_key(n) || self.globals.contains_key(n) || self.predefined(n).is_some()
+                            self.named.contains_key(n)
+                                || self.globals.contains_key(n)
+                                || self.predefined(n).is_some()
                         }
                         Param::Numbered(_) => true,
                     };

@@ -7,7 +7,21 @@ use super::*;
 /// Modal groups of G-codes (× 10) that may appear once per block.
 fn g_group(code: u16) -> Option<u8> {
     Some(match code {
-        0 | 10 | 20 | 30 | 50 | 51 | 52 | 53 | 330 | 331 | 382..=385 | 730 | 740 | 760 | 800..=890 => 1,
+        0
+        | 10
+        | 20
+        | 30
+        | 50
+        | 51
+        | 52
+        | 53
+        | 330
+        | 331
+        | 382..=385
+        | 730
+        | 740
+        | 760
+        | 800..=890 => 1,
         170 | 180 | 190 | 171 | 181 | 191 => 2,
         900 | 910 => 3,
         901 | 911 => 4,
@@ -169,14 +183,21 @@ impl Interp<'_, '_> {
                     let (key, n) = match (b.get(b'P'), b.get(b'E')) {
                         (Some(p), None) => ("M66", whole(p, b.pos_of(b'P'), "P")?),
                         (None, Some(e)) => ("M66E", whole(e, b.pos_of(b'E'), "E")?),
-                        _ => return fail(at, 3, "M66 needs one of P (digital) or E (analog input)"),
+                        _ => {
+                            return fail(at, 3, "M66 needs one of P (digital) or E (analog input)");
+                        }
                     };
                     let v = self.m.input(&format!("{key}[{n}]"));
                     self.params[5399] = v;
                 }
                 0 | 1 | 2 | 30 | 60 | 99 | 98 => {}
                 48..=53 => self.m.emit(Event::MCode(code)),
-                c if self.m.options.tcp_mcodes.is_some_and(|(on, off)| c == on || c == off) => {
+                c if self
+                    .m
+                    .options
+                    .tcp_mcodes
+                    .is_some_and(|(on, off)| c == on || c == off) =>
+                {
                     let on = self.m.options.tcp_mcodes.is_some_and(|(on, _)| c == on);
                     self.m.set_tcp(on);
                 }
@@ -253,11 +274,13 @@ impl Interp<'_, '_> {
                 }
                 540 | 550 | 560 | 570 | 580 | 590 => {
                     let k = (code / 10 - 53) as u16;
-                    self.m.select_offset(WorkOffset::Numbered(k), &format!("G{}", code / 10));
+                    self.m
+                        .select_offset(WorkOffset::Numbered(k), &format!("G{}", code / 10));
                 }
                 591..=593 => {
                     let k = 6 + (code - 590);
-                    self.m.select_offset(WorkOffset::Numbered(k), &format!("G59.{}", code - 590));
+                    self.m
+                        .select_offset(WorkOffset::Numbered(k), &format!("G59.{}", code - 590));
                 }
                 541 => {
                     let p = b.get(b'P').ok_or_else(|| Fail {
@@ -266,7 +289,10 @@ impl Interp<'_, '_> {
                         message: "G54.1 needs the offset number in P".into(),
                     })?;
                     let p = whole(p, b.pos_of(b'P'), "P")?;
-                    self.m.select_offset(WorkOffset::Numbered(100 + p as u16), &format!("G54.1 P{p}"));
+                    self.m.select_offset(
+                        WorkOffset::Numbered(100 + p as u16),
+                        &format!("G54.1 P{p}"),
+                    );
                 }
                 900 => self.incremental = false,
                 910 => self.incremental = true,
@@ -299,7 +325,11 @@ impl Interp<'_, '_> {
         self.m.set_tool_length(Some(h));
         if code == 434 || code == 435 {
             if self.flavour == Flavour::LinuxCnc {
-                return fail(at, 5, "G43.4/G43.5 is Fanuc's tool centre point control; LinuxCNC does TCP in its kinematics (see Options::tcp_mcodes)");
+                return fail(
+                    at,
+                    5,
+                    "G43.4/G43.5 is Fanuc's tool centre point control; LinuxCNC does TCP in its kinematics (see Options::tcp_mcodes)",
+                );
             }
             self.m.set_tcp(true);
         }
@@ -321,14 +351,59 @@ impl Interp<'_, '_> {
                 }
                 923 => {}
                 40 | 530 | 0 | 10 | 20 | 30 | 800..=890 | 730 | 740 | 760 => {}
-                170 | 180 | 190 | 200 | 210 | 400 | 410 | 411 | 420 | 421 | 430 | 431 | 432
-                | 434 | 435 | 490 | 540 | 550 | 560 | 570 | 580 | 590 | 591..=593 | 541 | 900 | 910 | 901 | 911 | 930 | 940 | 950
-                | 980 | 990 | 610 | 611 | 640 | 51 => {}
+                170
+                | 180
+                | 190
+                | 200
+                | 210
+                | 400
+                | 410
+                | 411
+                | 420
+                | 421
+                | 430
+                | 431
+                | 432
+                | 434
+                | 435
+                | 490
+                | 540
+                | 550
+                | 560
+                | 570
+                | 580
+                | 590
+                | 591..=593
+                | 541
+                | 900
+                | 910
+                | 901
+                | 911
+                | 930
+                | 940
+                | 950
+                | 980
+                | 990
+                | 610
+                | 611
+                | 640
+                | 51 => {}
                 682 | 683 => {
-                    return fail(at, 5, format!("G{} (tilted working plane) is not implemented: the virtual machine cannot follow it", show_g(code)));
+                    return fail(
+                        at,
+                        5,
+                        format!(
+                            "G{} (tilted working plane) is not implemented: the virtual machine cannot follow it",
+                            show_g(code)
+                        ),
+                    );
                 }
                 _ => {
-                    return fail(at, 1 + show_g(code).len(), format!("G{} is not supported by the interpreter", show_g(code)));
+                    return fail(
+                        at,
+                        1 + show_g(code).len(),
+                        format!("G{} is not supported by the interpreter", show_g(code)),
+                    );
                 }
             }
         }
@@ -360,13 +435,23 @@ impl Interp<'_, '_> {
                     (Flavour::LinuxCnc, _) if (1..=9).contains(&p) => p as u16,
                     (Flavour::Fanuc, 2) if (1..=6).contains(&p) => p as u16,
                     (Flavour::Fanuc, 20) if (1..=300).contains(&p) => 100 + p as u16,
-                    _ => return fail(b.pos_of(b'P'), 2, format!("G10 L{l}: P{p} is not a work offset")),
+                    _ => {
+                        return fail(
+                            b.pos_of(b'P'),
+                            2,
+                            format!("G10 L{l}: P{p} is not a work offset"),
+                        );
+                    }
                 };
                 let mut o = self.m.offsets.get(&key).copied().unwrap_or([0.0; MAX_AXES]);
                 let current = key_in_force(self.m.state.work_offset, key);
                 for (k, letter) in AXIS_LETTERS.iter().enumerate() {
-                    let Some(i) = self.letter_axis[k] else { continue };
-                    let Some(v) = self.scaled(b, *letter) else { continue };
+                    let Some(i) = self.letter_axis[k] else {
+                        continue;
+                    };
+                    let Some(v) = self.scaled(b, *letter) else {
+                        continue;
+                    };
                     let v = v * self.m.unit_of(i);
                     let linux_l20 = self.flavour == Flavour::LinuxCnc && l == 20;
                     o[i] = if linux_l20 {
@@ -394,13 +479,16 @@ impl Interp<'_, '_> {
     fn home(&mut self, b: &Block, code: u16, at: usize) -> Result<(), Fail> {
         let (t, programmed, travel, turned) = self.target(b, false)?;
         if programmed != 0 {
-            self.m.move_to(MotionKind::Rapid, &t, &travel, turned, programmed);
+            self.m
+                .move_to(MotionKind::Rapid, &t, &travel, turned, programmed);
         }
         let base = if code == 280 { 5161 } else { 5181 };
         let mut home = self.m.pos;
         let mut moved = 0u32;
         for k in 0..9 {
-            let Some(i) = self.letter_axis[k] else { continue };
+            let Some(i) = self.letter_axis[k] else {
+                continue;
+            };
             if programmed != 0 && programmed & (1 << i) == 0 {
                 continue;
             }
@@ -420,15 +508,20 @@ impl Interp<'_, '_> {
         }
         let _ = at;
         self.m.machine_frame = true;
-        self.m.move_to(MotionKind::Rapid, &home, &[0.0; MAX_AXES], 0, moved);
+        self.m
+            .move_to(MotionKind::Rapid, &home, &[0.0; MAX_AXES], 0, moved);
         self.m.machine_frame = false;
         Ok(())
     }
 
     fn g92(&mut self, b: &Block, code: u16) -> Result<(), Fail> {
         for (k, letter) in AXIS_LETTERS.iter().enumerate() {
-            let Some(i) = self.letter_axis[k] else { continue };
-            let Some(v) = self.scaled(b, *letter) else { continue };
+            let Some(i) = self.letter_axis[k] else {
+                continue;
+            };
+            let Some(v) = self.scaled(b, *letter) else {
+                continue;
+            };
             let v = v * self.m.unit_of(i);
             self.m.shift[i] = if code == 520 {
                 v

@@ -61,7 +61,11 @@ impl Interp<'_, '_> {
             return fail(start, 1, "O-word without a number or <name>");
         };
         let Some(kw) = c.ident().map(str::to_ascii_lowercase) else {
-            return fail(start, c.i - start + 1, "O-word without a keyword (sub, call, if, while, …)");
+            return fail(
+                start,
+                c.i - start + 1,
+                "O-word without a keyword (sub, call, if, while, …)",
+            );
         };
         let kw_at = c.i - kw.len();
         let here = line.pos;
@@ -94,11 +98,24 @@ impl Interp<'_, '_> {
                 self.src.seek(end.1);
             }
             "endif" => {}
-            "do" => self.oframes.push(OFrame { name, kind: OKind::Do, start: next }),
+            "do" => self.oframes.push(OFrame {
+                name,
+                kind: OKind::Do,
+                start: next,
+            }),
             "while" => self.o_while(&name, here, next, &mut c, kw_at, start)?,
             "endwhile" => {
-                let Some(f) = self.oframes.iter().rev().find(|f| f.name == name && f.kind == OKind::While) else {
-                    return fail(start, kw_at + 8 - start, format!("o{name} endwhile without its while"));
+                let Some(f) = self
+                    .oframes
+                    .iter()
+                    .rev()
+                    .find(|f| f.name == name && f.kind == OKind::While)
+                else {
+                    return fail(
+                        start,
+                        kw_at + 8 - start,
+                        format!("o{name} endwhile without its while"),
+                    );
                 };
                 let back = f.start;
                 self.src.seek(back);
@@ -106,7 +123,11 @@ impl Interp<'_, '_> {
             "repeat" => {
                 let n = self.condition_value(&mut c, kw_at)?;
                 if n >= 1.0 {
-                    self.oframes.push(OFrame { name, kind: OKind::Repeat(n as u64 - 1), start: next });
+                    self.oframes.push(OFrame {
+                        name,
+                        kind: OKind::Repeat(n as u64 - 1),
+                        start: next,
+                    });
                 } else {
                     let end = self.find_o(next, &name, &["endrepeat"], start)?;
                     self.src.seek(end.1);
@@ -136,7 +157,13 @@ impl Interp<'_, '_> {
 
     /// The next line from `from` with O-word `name` and one of `kws`:
     /// the keyword and the position after that line.
-    fn find_o(&self, from: Pos, name: &str, kws: &[&str], at: usize) -> Result<(String, Pos, Pos), Fail> {
+    fn find_o(
+        &self,
+        from: Pos,
+        name: &str,
+        kws: &[&str],
+        at: usize,
+    ) -> Result<(String, Pos, Pos), Fail> {
         let mut s = Source::new(self.src.text);
         s.seek(from);
         while let Some(l) = s.next_line() {
@@ -147,12 +174,17 @@ impl Interp<'_, '_> {
                 return Ok((kw, s.position(), l.pos));
             }
         }
-        fail(at, 1 + name.len(), format!("o{name}: no matching {} follows", kws.join(" / ")))
+        fail(
+            at,
+            1 + name.len(),
+            format!("o{name}: no matching {} follows", kws.join(" / ")),
+        )
     }
 
     fn skip_to_branch(&mut self, name: &str, mut from: Pos, at: usize) -> Result<(), Fail> {
         loop {
-            let (kw, after, line_pos) = self.find_o(from, name, &["elseif", "else", "endif"], at)?;
+            let (kw, after, line_pos) =
+                self.find_o(from, name, &["elseif", "else", "endif"], at)?;
             match kw.as_str() {
                 "elseif" => {
                     let Some(l) = self.src.line_at(line_pos) else {
@@ -181,10 +213,22 @@ impl Interp<'_, '_> {
         }
     }
 
-    fn o_while(&mut self, name: &str, here: Pos, next: Pos, c: &mut Cursor<'_>, kw_at: usize, start: usize) -> Result<(), Fail> {
+    fn o_while(
+        &mut self,
+        name: &str,
+        here: Pos,
+        next: Pos,
+        c: &mut Cursor<'_>,
+        kw_at: usize,
+        start: usize,
+    ) -> Result<(), Fail> {
         let cond = self.condition(c, kw_at)?;
         // The end of a do … while.
-        if let Some(k) = self.oframes.iter().rposition(|f| f.name == name && f.kind == OKind::Do) {
+        if let Some(k) = self
+            .oframes
+            .iter()
+            .rposition(|f| f.name == name && f.kind == OKind::Do)
+        {
             if cond {
                 let back = self.oframes[k].start;
                 self.src.seek(back);
@@ -193,10 +237,17 @@ impl Interp<'_, '_> {
             }
             return Ok(());
         }
-        let on_top = self.oframes.last().is_some_and(|f| f.name == name && f.kind == OKind::While);
+        let on_top = self
+            .oframes
+            .last()
+            .is_some_and(|f| f.name == name && f.kind == OKind::While);
         if cond {
             if !on_top {
-                self.oframes.push(OFrame { name: name.to_string(), kind: OKind::While, start: here });
+                self.oframes.push(OFrame {
+                    name: name.to_string(),
+                    kind: OKind::While,
+                    start: here,
+                });
             }
         } else {
             if on_top {
@@ -209,8 +260,16 @@ impl Interp<'_, '_> {
     }
 
     fn end_repeat(&mut self, name: &str, start: usize, kw_at: usize) -> Result<(), Fail> {
-        let Some(k) = self.oframes.iter().rposition(|f| f.name == name && matches!(f.kind, OKind::Repeat(_))) else {
-            return fail(start, kw_at + 9 - start, format!("o{name} endrepeat without its repeat"));
+        let Some(k) = self
+            .oframes
+            .iter()
+            .rposition(|f| f.name == name && matches!(f.kind, OKind::Repeat(_)))
+        else {
+            return fail(
+                start,
+                kw_at + 9 - start,
+                format!("o{name} endrepeat without its repeat"),
+            );
         };
         if let OKind::Repeat(left) = self.oframes[k].kind {
             if left > 0 {
@@ -277,7 +336,11 @@ impl Interp<'_, '_> {
         }
         c.skip_ws();
         if !c.at_end() && c.peek() != Some(b'(') && c.peek() != Some(b';') {
-            return fail(c.i, 1, "call arguments must be bracketed: `o100 call [1] [2]`");
+            return fail(
+                c.i,
+                1,
+                "call arguments must be bracketed: `o100 call [1] [2]`",
+            );
         }
         let entry = match self.subs.get(name) {
             Some(p) => *p,
@@ -303,12 +366,22 @@ impl Interp<'_, '_> {
 
     /// Enters a subprogram at `entry`; `own_locals` saves the local
     /// parameters (restored on return).
-    fn push_call(&mut self, entry: Pos, repeats: u64, own_locals: bool, name: String, at: usize) -> Result<(), Fail> {
+    fn push_call(
+        &mut self,
+        entry: Pos,
+        repeats: u64,
+        own_locals: bool,
+        name: String,
+        at: usize,
+    ) -> Result<(), Fail> {
         if self.calls.len() >= self.m.options.max_call_depth {
             return fail(
                 at,
                 1,
-                format!("subprogram calls nested deeper than {} (Options::max_call_depth): endless recursion?", self.m.options.max_call_depth),
+                format!(
+                    "subprogram calls nested deeper than {} (Options::max_call_depth): endless recursion?",
+                    self.m.options.max_call_depth
+                ),
             );
         }
         let locals = match self.flavour {
@@ -317,13 +390,18 @@ impl Interp<'_, '_> {
         };
         let saved_locals = own_locals.then(|| {
             let saved = self.params[1..locals].to_vec();
-            let fresh = if self.flavour == Flavour::Fanuc { VACANT } else { 0.0 };
+            let fresh = if self.flavour == Flavour::Fanuc {
+                VACANT
+            } else {
+                0.0
+            };
             for p in &mut self.params[1..locals] {
                 *p = fresh;
             }
             saved
         });
-        let named = (own_locals && self.flavour == Flavour::LinuxCnc).then(|| std::mem::take(&mut self.named));
+        let named = (own_locals && self.flavour == Flavour::LinuxCnc)
+            .then(|| std::mem::take(&mut self.named));
         self.calls.push(Call {
             ret: self.src.position(),
             repeats,
@@ -357,14 +435,22 @@ impl Interp<'_, '_> {
                 self.returned = value;
                 Ok(())
             }
-            _ => fail(at, 1 + name.len(), format!("o{name} endsub/return outside a call of o{name}")),
+            _ => fail(
+                at,
+                1 + name.len(),
+                format!("o{name} endsub/return outside a call of o{name}"),
+            ),
         }
     }
 
     // ----- Fanuc -------------------------------------------------------------
 
     /// Fanuc macro statements; `true` when the line was one.
-    pub(super) fn fanuc_statement(&mut self, line: &Line<'_>, c: &mut Cursor<'_>) -> Result<bool, Fail> {
+    pub(super) fn fanuc_statement(
+        &mut self,
+        line: &Line<'_>,
+        c: &mut Cursor<'_>,
+    ) -> Result<bool, Fail> {
         let save = c.i;
         let start = c.i;
         if c.eat_kw("IF", false) && {
@@ -481,7 +567,11 @@ impl Interp<'_, '_> {
             }
         };
         if !(v >= 1.0 && v <= 99_999_999.0) {
-            return fail(at, c.i - at, format!("GOTO {v}: sequence numbers are 1..99999999"));
+            return fail(
+                at,
+                c.i - at,
+                format!("GOTO {v}: sequence numbers are 1..99999999"),
+            );
         }
         Ok(v.round() as u64)
     }
@@ -490,7 +580,8 @@ impl Interp<'_, '_> {
     /// the start of the file.
     fn goto(&mut self, n: u64, at: usize) -> Result<(), Fail> {
         let here = self.src.position();
-        let found = find_n(self.src.text, here, None, n).or_else(|| find_n(self.src.text, Pos { offset: 0, line: 1 }, Some(here), n));
+        let found = find_n(self.src.text, here, None, n)
+            .or_else(|| find_n(self.src.text, Pos { offset: 0, line: 1 }, Some(here), n));
         match found {
             Some(p) => {
                 self.src.seek(p);
@@ -565,7 +656,13 @@ impl Interp<'_, '_> {
                         b'X' => 24,
                         b'Y' => 25,
                         b'Z' => 26,
-                        _ => return fail(word_at, 1, format!("{} cannot be a G65 argument", char::from(letter))),
+                        _ => {
+                            return fail(
+                                word_at,
+                                1,
+                                format!("{} cannot be a G65 argument", char::from(letter)),
+                            );
+                        }
                     };
                     args.push((var, v));
                 }
@@ -596,12 +693,19 @@ impl Interp<'_, '_> {
             let t = t.strip_prefix(['O', 'o', ':']).unwrap_or("");
             if let Some((n, len)) = read_uint(t.as_bytes())
                 && n == u64::from(p)
-                && !t.as_bytes().get(len).is_some_and(|c| c.is_ascii_alphanumeric())
+                && !t
+                    .as_bytes()
+                    .get(len)
+                    .is_some_and(|c| c.is_ascii_alphanumeric())
             {
                 return Ok(s.position());
             }
         }
-        fail(at, 3, format!("program O{p} is not in this file (other files are not searched)"))
+        fail(
+            at,
+            3,
+            format!("program O{p} is not in this file (other files are not searched)"),
+        )
     }
 
     /// `M98 P… L…`: a subprogram call (locals shared).
@@ -610,7 +714,11 @@ impl Interp<'_, '_> {
             return fail(at, 3, "M98 needs the program number in P");
         };
         let p = whole(p, b.pos_of(b'P'), "P")?;
-        let (program, mut repeats) = if p > 9999 && !b.has(b'L') { (p % 10000, p / 10000) } else { (p, 1) };
+        let (program, mut repeats) = if p > 9999 && !b.has(b'L') {
+            (p % 10000, p / 10000)
+        } else {
+            (p, 1)
+        };
         if let Some(l) = b.get(b'L').or(b.get(b'K')) {
             repeats = whole(l, b.pos_of(b'L'), "L")?;
         }
@@ -618,7 +726,13 @@ impl Interp<'_, '_> {
             return Ok(());
         }
         let entry = self.find_program(program, at)?;
-        self.push_call(entry, u64::from(repeats - 1), false, format!("O{program}"), at)
+        self.push_call(
+            entry,
+            u64::from(repeats - 1),
+            false,
+            format!("O{program}"),
+            at,
+        )
     }
 
     /// `M99`: back to the caller (after the calling block), or to the start

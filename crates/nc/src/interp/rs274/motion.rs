@@ -22,8 +22,14 @@ impl Interp<'_, '_> {
                 }
                 730 | 740 | 760 | 810..=890 => {
                     let c = code / 10;
-                    if matches!(c, 87 | 88) || self.flavour == Flavour::LinuxCnc && matches!(c, 74 | 76) {
-                        return fail(at, 3, format!("canned cycle G{c} is not supported by the interpreter"));
+                    if matches!(c, 87 | 88)
+                        || self.flavour == Flavour::LinuxCnc && matches!(c, 74 | 76)
+                    {
+                        return fail(
+                            at,
+                            3,
+                            format!("canned cycle G{c} is not supported by the interpreter"),
+                        );
                     }
                     // The initial level stays from one cycle code to the
                     // next (rs274ngc's cycle_il): only G80 and G0..G3 end it.
@@ -32,15 +38,31 @@ impl Interp<'_, '_> {
                 }
                 530 => g53 = Some(at),
                 50 | 51 | 52 | 53 => {
-                    return fail(at, 4, format!("G{} (spline) is not supported by the interpreter", show_g(code)));
+                    return fail(
+                        at,
+                        4,
+                        format!(
+                            "G{} (spline) is not supported by the interpreter",
+                            show_g(code)
+                        ),
+                    );
                 }
                 330 | 331 | 382..=385 => {
-                    return fail(at, 4, format!("G{} (threading / probing) is not supported by the interpreter", show_g(code)));
+                    return fail(
+                        at,
+                        4,
+                        format!(
+                            "G{} (threading / probing) is not supported by the interpreter",
+                            show_g(code)
+                        ),
+                    );
                 }
                 _ => {}
             }
         }
-        let uses_axes = [100, 280, 300, 920, 520].iter().any(|c| b.has_g(*c).is_some());
+        let uses_axes = [100, 280, 300, 920, 520]
+            .iter()
+            .any(|c| b.has_g(*c).is_some());
         let has_axes = b.has & AXIS_WORDS != 0;
         if uses_axes || !has_axes && !self.full_circle_words(b) {
             return Ok(());
@@ -56,7 +78,11 @@ impl Interp<'_, '_> {
             Motion::Cycle(c) => self.cycle(b, c),
             Motion::None => {
                 let at = first_axis(b);
-                fail(at, 1, "axis words without a motion mode (G80 is in force): give G0, G1, G2 or G3")
+                fail(
+                    at,
+                    1,
+                    "axis words without a motion mode (G80 is in force): give G0, G1, G2 or G3",
+                )
             }
         }
     }
@@ -69,12 +95,17 @@ impl Interp<'_, '_> {
 
     /// An arc block without axis words but with centre words (a full circle).
     fn full_circle_words(&self, b: &Block) -> bool {
-        matches!(self.motion, Motion::Cw | Motion::Ccw) && (b.has(b'I') || b.has(b'J') || b.has(b'K'))
+        matches!(self.motion, Motion::Cw | Motion::Ccw)
+            && (b.has(b'I') || b.has(b'J') || b.has(b'K'))
     }
 
     fn feed_check(&self, b: &Block, at: usize) -> Result<(), Fail> {
         if self.m.feed_mode == FeedMode::InverseTime && !b.has(b'F') {
-            return fail(at, 1, "inverse time feed (G93): every feed move needs its F word");
+            return fail(
+                at,
+                1,
+                "inverse time feed (G93): every feed move needs its F word",
+            );
         }
         if self.m.feed <= 0.0 {
             return fail(at, 1, "feed move with a zero feed rate (no F programmed)");
@@ -108,7 +139,13 @@ impl Interp<'_, '_> {
         let at = if b.has & AXIS_WORDS != 0 {
             first_axis(b)
         } else {
-            b.pos_of(if b.has(b'I') { b'I' } else if b.has(b'J') { b'J' } else { b'K' })
+            b.pos_of(if b.has(b'I') {
+                b'I'
+            } else if b.has(b'J') {
+                b'J'
+            } else {
+                b'K'
+            })
         };
         self.feed_check(b, at)?;
         let [x, y, z] = self.m.xyz;
@@ -135,7 +172,9 @@ impl Interp<'_, '_> {
                     Centre::At([start[pa] + oa, start[pb] + ob])
                 }
             }
-            (None, false) => return fail(at, 1, "an arc needs its centre (I, J, K) or its radius (R)"),
+            (None, false) => {
+                return fail(at, 1, "an arc needs its centre (I, J, K) or its radius (R)");
+            }
         };
         let turns = match (self.flavour, b.get(b'P')) {
             (Flavour::LinuxCnc, Some(p)) => {
@@ -155,7 +194,8 @@ impl Interp<'_, '_> {
             message: e.to_string(),
         })?;
         let _ = idx;
-        self.m.move_to(MotionKind::Arc(a), &t, &travel, turned, programmed);
+        self.m
+            .move_to(MotionKind::Arc(a), &t, &travel, turned, programmed);
         Ok(())
     }
 
@@ -165,7 +205,11 @@ impl Interp<'_, '_> {
         let [pa, pb, pn] = plane_axes(self.m.state.plane);
         let xyz = self.m.xyz;
         let (Some(ia), Some(ib), Some(inn)) = (xyz[pa], xyz[pb], xyz[pn]) else {
-            return fail(first_axis(b), 1, "canned cycles need the plane's axes and the axis normal to it");
+            return fail(
+                first_axis(b),
+                1,
+                "canned cycles need the plane's axes and the axis normal to it",
+            );
         };
         let letters = [b'X', b'Y', b'Z'];
         let (la, lb, ln) = (letters[pa], letters[pb], letters[pn]);
@@ -175,7 +219,11 @@ impl Interp<'_, '_> {
         if let Some(r) = self.length(b, b'R') {
             self.cycle_r = r;
         } else if new_run && self.flavour == Flavour::LinuxCnc {
-            return fail(first_axis(b), 1, "the first block of a canned cycle needs R");
+            return fail(
+                first_axis(b),
+                1,
+                "the first block of a canned cycle needs R",
+            );
         }
         if let Some(z) = self.length(b, ln) {
             self.cycle_z = z;
@@ -228,7 +276,11 @@ impl Interp<'_, '_> {
         let clear = if self.retract_initial { init } else { r };
         let mut ops = Vec::new();
         self.cycle_ops(code, r, bottom, clear, &mut ops)
-            .map_err(|m| Fail { at: first_axis(b), len: 1, message: m })?;
+            .map_err(|m| Fail {
+                at: first_axis(b),
+                len: 1,
+                message: m,
+            })?;
         let line = self.m_line();
         for k in 0..repeats {
             if self.incremental {
@@ -256,7 +308,14 @@ impl Interp<'_, '_> {
     }
 
     /// The cycle from the R plane down and out again.
-    fn cycle_ops(&mut self, code: u16, r: f64, bottom: f64, clear: f64, ops: &mut Vec<Op>) -> Result<(), String> {
+    fn cycle_ops(
+        &mut self,
+        code: u16,
+        r: f64,
+        bottom: f64,
+        clear: f64,
+        ops: &mut Vec<Op>,
+    ) -> Result<(), String> {
         let fanuc = self.flavour == Flavour::Fanuc;
         let delta = match self.flavour {
             // rs274ngc G83_RAPID_DELTA / G73 retract: 0.010 inch.
@@ -356,14 +415,20 @@ impl Interp<'_, '_> {
                     ops.push(Op::Dwell(p));
                 }
                 ops.push(Op::SpindleStop);
-                self.m.assume("Fanuc G76 shift direction +X of the plane (parameters RD1/RD2 = 0)".into());
+                self.m.assume(
+                    "Fanuc G76 shift direction +X of the plane (parameters RD1/RD2 = 0)".into(),
+                );
                 let q = self.cycle_q.abs();
                 ops.push(Op::Shift(q, 0.0));
                 ops.push(Op::Rapid(clear));
                 ops.push(Op::Shift(-q, 0.0));
                 ops.push(Op::Spindle(spindle));
             }
-            _ => return Err(format!("canned cycle G{code} is not supported by the interpreter")),
+            _ => {
+                return Err(format!(
+                    "canned cycle G{code} is not supported by the interpreter"
+                ));
+            }
         }
         Ok(())
     }
