@@ -65,8 +65,6 @@ pub(crate) struct Machine<'s> {
     pub n: usize,
     /// Indices of the axes named X, Y, Z.
     pub xyz: [Option<usize>; 3],
-    /// Index of the pressure word, if the machine has one.
-    pub pressure: Option<usize>,
     /// Current position: work coordinates, mm/deg; endless axes in [0, 360).
     pub pos: [f64; MAX_AXES],
     /// Endless axes: the position counted on without wrapping.
@@ -133,7 +131,6 @@ impl<'s> Machine<'s> {
             axes: axes[..n].to_vec(),
             n,
             xyz: [find("X"), find("Y"), find("Z")],
-            pressure: axes.iter().position(|a| a.pressure),
             pos,
             unwrapped,
             state,
@@ -218,13 +215,6 @@ impl<'s> Machine<'s> {
     pub fn emit(&mut self, event: Event) {
         self.step.event = event;
         self.sink.step(&self.step);
-    }
-
-    /// Emits a step with a CL line (CSV).
-    pub fn emit_cl(&mut self, cl_line: Option<usize>, event: Event) {
-        self.step.cl_line = cl_line;
-        self.emit(event);
-        self.step.cl_line = None;
     }
 
     /// Linear factor of program values: 25.4 in inch mode.
@@ -461,11 +451,6 @@ impl<'s> Machine<'s> {
         self.emit(Event::ToolLength(h));
     }
 
-    /// The plane's (first, second, normal) axis indices into X Y Z.
-    pub fn plane_axes(&self) -> [usize; 3] {
-        plane_axes(self.state.plane)
-    }
-
     /// Dwell for `seconds`.
     pub fn dwell(&mut self, seconds: f64) {
         self.emit(Event::Dwell { seconds });
@@ -491,34 +476,33 @@ pub(crate) fn wrap(v: f64) -> f64 {
 }
 
 impl Machine<'_> {
-    /// A move of a CSV row: the end values as they are (no modulo: the
-    /// table holds what was written), with the row's CL line.
+    /// A move of a CSV row to the written values (endless axes counted on
+    /// without wrapping, as the post wrote them), with the row's CL line.
     pub fn emit_cl_move(
         &mut self,
         cl_line: Option<usize>,
         kind: MotionKind,
-        target: &[f64; MAX_AXES],
+        values: &[f64; MAX_AXES],
         programmed: u32,
     ) {
-        let mut end = AxisValues::zeros(self.n);
-        let mut travel = AxisValues::zeros(self.n);
+        let mut target = self.pos;
+        let mut travel = [0.0; MAX_AXES];
+        let mut turned = 0u32;
         for i in 0..self.n {
-            end.as_mut_slice()[i] = target[i];
-            travel.as_mut_slice()[i] = target[i] - self.pos[i];
-            self.pos[i] = target[i];
+            if programmed & (1 << i) == 0 {
+                continue;
+            }
+            if self.axes[i].endless {
+                let (e, d) = self.rotary_target(i, values[i], RotaryMode::Continuous);
+                target[i] = e;
+                travel[i] = d;
+                turned |= 1 << i;
+            } else {
+                target[i] = values[i];
+            }
         }
-        self.report.moves += 1;
-        let mv = Move {
-            kind,
-            end,
-            travel,
-            programmed,
-            machine_frame: false,
-            feed: self.feed,
-            feed_mode: self.feed_mode,
-            cycle: None,
-            state: self.state,
-        };
-        self.emit_cl(cl_line, Event::Move(mv));
+        self.step.cl_line = cl_line;
+        self.move_to(kind, &target, &travel, turned, programmed);
+        self.step.cl_line = None;
     }
 }
