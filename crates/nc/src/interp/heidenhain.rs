@@ -661,6 +661,7 @@ impl<'a> Interp<'a, '_> {
                 "CALL LBL expected (CALL PGM: other files are not searched)",
             );
         }
+        c.skip_ws();
         let l_at = c.i;
         let Some(name) = label_name(c) else {
             return fail(c.i, 1, "label expected");

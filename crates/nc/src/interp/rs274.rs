@@ -286,6 +286,32 @@ impl<'a, 's> Interp<'a, 's> {
                 return Err(diagnostic(self.file, &line, f, false));
             }
         }
+        if !self.ended {
+            let open = self
+                .do_loops
+                .last()
+                .map(|(m, p)| (*p, format!("WHILE … DO {m} without its END {m}")))
+                .or_else(|| {
+                    self.oframes
+                        .last()
+                        .map(|f| (f.start, format!("o{} loop without its end", f.name)))
+                });
+            if let Some((pos, what)) = open
+                && let Some(line) = self.src.line_at(pos)
+            {
+                let len = line.text.len();
+                return Err(diagnostic(
+                    self.file,
+                    &line,
+                    Fail {
+                        at: 0,
+                        len,
+                        message: what,
+                    },
+                    false,
+                ));
+            }
+        }
         if !self.calls.is_empty() && !self.ended {
             let name = self
                 .calls

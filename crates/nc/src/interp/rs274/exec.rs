@@ -191,7 +191,7 @@ impl Interp<'_, '_> {
                     self.params[5399] = v;
                 }
                 0 | 1 | 2 | 30 | 60 | 99 | 98 => {}
-                48..=53 => self.m.emit(Event::MCode(code)),
+                48..=53 if self.flavour == Flavour::LinuxCnc => self.m.emit(Event::MCode(code)),
                 c if self
                     .m
                     .options

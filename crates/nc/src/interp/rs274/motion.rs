@@ -60,9 +60,12 @@ impl Interp<'_, '_> {
                 _ => {}
             }
         }
-        let uses_axes = [100, 280, 300, 920, 520]
-            .iter()
-            .any(|c| b.has_g(*c).is_some());
+        // Fanuc G04 X…: the X word is the dwell time.
+        let dwell_x = self.flavour == Flavour::Fanuc && b.has_g(40).is_some() && !b.has(b'P');
+        let uses_axes = dwell_x
+            || [100, 280, 300, 920, 520]
+                .iter()
+                .any(|c| b.has_g(*c).is_some());
         let has_axes = b.has & AXIS_WORDS != 0;
         if uses_axes || !has_axes && !self.full_circle_words(b) {
             return Ok(());
@@ -293,8 +296,10 @@ impl Interp<'_, '_> {
                 r,
                 up_to_r_first: k == 0,
                 // rs274ngc: under G98 the tool travels to the hole at the
-                // initial level (checked with rs274).
-                travel_level: (k == 0 && self.retract_initial).then(|| init.max(self.m.pos[inn])),
+                // initial level (checked with rs274); Fanuc positions at
+                // the level the tool is at.
+                travel_level: (k == 0 && self.retract_initial && self.flavour == Flavour::LinuxCnc)
+                    .then(|| init.max(self.m.pos[inn])),
                 ops: ops.clone(),
             };
             cycle::drill(&mut self.m, &hole);
