@@ -440,15 +440,10 @@ impl<'a, 's> Interp<'a, 's> {
     fn comment(&mut self, text: &[u8], block: &mut Block) {
         let t = String::from_utf8_lossy(text);
         let trimmed = t.trim_start();
-        let upper: String = trimmed
-            .chars()
-            .take(6)
-            .collect::<String>()
-            .to_ascii_uppercase();
         for kw in ["MSG,", "PRINT,", "DEBUG,"] {
-            if upper.starts_with(kw) {
-                let body = trimmed[kw.len()..].to_string();
-                block.message = Some(body);
+            // ASCII comparison: the keyword's bytes end on a boundary.
+            if trimmed.as_bytes().get(..kw.len()).is_some_and(|p| p.eq_ignore_ascii_case(kw.as_bytes())) {
+                block.message = Some(trimmed[kw.len()..].to_string());
                 return;
             }
         }
