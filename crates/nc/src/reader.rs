@@ -366,7 +366,7 @@ fn parse_number(s: &str) -> Option<(f64, &str)> {
     v.is_finite().then_some((v, &s[i..]))
 }
 
-pub(crate) fn read_csv(
+fn read_csv(
     dialect: &Dialect,
     axes: &[AxisSpec],
     file: &str,

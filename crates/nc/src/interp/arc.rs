@@ -150,6 +150,39 @@ pub(crate) fn circle_through(s: [f64; 2], m: [f64; 2], e: [f64; 2]) -> Option<([
     Some(([s[0] + cx, s[1] + cy], d < 0.0))
 }
 
+/// The last path element, kept so that `CT` can find its end tangent
+/// (worked out only when a `CT` asks: X Y Z before and after, the arc).
+pub(crate) type LastElement = ([f64; 3], [f64; 3], Option<Arc>);
+
+/// The unit direction of the path at the end of an element (a line from
+/// `before` to `after`, or an arc ending at `after`); `None` for a line of
+/// no length.
+pub(crate) fn end_tangent((before, after, arc): LastElement) -> Option<[f64; 3]> {
+    let t = match arc {
+        None => [
+            after[0] - before[0],
+            after[1] - before[1],
+            after[2] - before[2],
+        ],
+        Some(a) => {
+            let [pa, pb, _] = plane_axes(a.plane);
+            let (ra, rb) = (after[pa] - a.centre_mm[pa], after[pb] - a.centre_mm[pb]);
+            let mut t = [0.0; 3];
+            // Perpendicular to the radius, in the sense of turning.
+            if a.clockwise {
+                t[pa] = rb;
+                t[pb] = -ra;
+            } else {
+                t[pa] = -rb;
+                t[pb] = ra;
+            }
+            t
+        }
+    };
+    let n = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+    (n > 1e-12).then(|| [t[0] / n, t[1] / n, t[2] / n])
+}
+
 /// The centre of the circle that leaves `s` along the direction `t` and
 /// reaches `e` (Sinumerik `CT`), and whether it turns clockwise; `None`
 /// when `e` lies on the tangent.

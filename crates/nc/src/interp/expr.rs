@@ -119,6 +119,49 @@ impl<'a> Cursor<'a> {
     }
 }
 
+/// An identifier in upper case, on the stack when it is short (the hot
+/// path reads one per word: no allocation).
+pub(crate) struct Upper {
+    buf: [u8; 24],
+    len: usize,
+    long: Option<String>,
+}
+
+impl Upper {
+    pub fn of(s: &str) -> Upper {
+        let mut u = Upper {
+            buf: [0; 24],
+            len: s.len(),
+            long: None,
+        };
+        if s.len() <= u.buf.len() && s.is_ascii() {
+            for (d, b) in u.buf.iter_mut().zip(s.bytes()) {
+                *d = b.to_ascii_uppercase();
+            }
+        } else {
+            u.long = Some(s.to_ascii_uppercase());
+        }
+        u
+    }
+}
+
+impl std::ops::Deref for Upper {
+    type Target = str;
+    fn deref(&self) -> &str {
+        match &self.long {
+            Some(s) => s,
+            // Upper-cased ASCII is ASCII.
+            None => std::str::from_utf8(&self.buf[..self.len]).unwrap_or(""),
+        }
+    }
+}
+
+impl std::fmt::Display for Upper {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self)
+    }
+}
+
 /// The operands of a family: parameters and variables.
 pub(crate) trait Operands {
     /// Reads an operand at the cursor (after blanks) if the text there is

@@ -16,7 +16,7 @@ use kinpost_diag::Diagnostic;
 
 use super::arc::{self, Centre};
 use super::cycle::{self, Hole, Op};
-use super::expr::{self, Cursor, Lang, Operands};
+use super::expr::{self, Cursor, Lang, Operands, Upper};
 use super::machine::{Machine, RotaryMode, plane_axes};
 use super::num::{read_number, read_uint};
 use super::source::{Fail, Line, Pos, Source, diagnostic, fail};
@@ -26,6 +26,7 @@ use super::{
 };
 use crate::AxisSpec;
 
+mod fast;
 mod words;
 
 /// Q parameters of each kind: Q0..Q1999, QL0..QL499, QR0..QR499.
@@ -61,12 +62,14 @@ struct Interp<'a, 's> {
     labels: HashMap<String, Pos>,
     ended: bool,
     /// Direction of the path at the end of the last move (CT).
-    tangent: Option<[f64; 3]>,
+    tangent: Option<super::arc::LastElement>,
     /// BLK FORM 0.1 corner, waiting for 0.2.
     blank_min: Option<[f64; 3]>,
     warned: Vec<String>,
     /// CYCL DEF 247 waits for its Q339.
     pending_preset: bool,
+    /// The machine axis of each one-letter axis name A..Z, for the hot path.
+    letter_axis: [Option<usize>; 26],
 }
 
 /// Runs a Heidenhain program.
@@ -96,7 +99,14 @@ pub(crate) fn run(
         blank_min: None,
         warned: Vec::new(),
         pending_preset: false,
+        letter_axis: [None; 26],
     };
+    for (i, a) in axes.iter().enumerate().take(MAX_AXES) {
+        let b = a.name.as_bytes();
+        if b.len() == 1 && b[0].is_ascii_alphabetic() && !a.pressure {
+            it.letter_axis[usize::from(b[0].to_ascii_uppercase() - b'A')] = Some(i);
+        }
+    }
     while !it.ended {
         let Some(line) = it.src.next_line() else {
             break;
@@ -251,6 +261,9 @@ impl<'a> Interp<'a, '_> {
         if c.peek() == Some(b'~') {
             c.i += 1;
         }
+        if self.fast_line(b, c.i) {
+            return Ok(());
+        }
         self.statement(line, &mut c)
     }
 
@@ -275,10 +288,10 @@ impl<'a> Interp<'a, '_> {
                 return self.rest_is_comment(c);
             }
         }
-        let Some(id) = c.ident().map(str::to_ascii_uppercase) else {
+        let Some(id) = c.ident().map(Upper::of) else {
             return fail(c.i, 1, "a Heidenhain block is expected");
         };
-        match id.as_str() {
+        match &*id {
             "BEGIN" => self.begin_pgm(c),
             "END" => {
                 if c.eat_kw("PGM", true) {

@@ -252,7 +252,12 @@ impl<'s> Machine<'s> {
             }
             RotaryMode::Shortest | RotaryMode::Positive | RotaryMode::Negative => {
                 let e = wrap(v);
-                let mut d = (e - wrap(cur)).rem_euclid(TURN_DEG);
+                // Both in [0, 360): the difference is in (-360, 360), and
+                // adding a turn is exactly what rem_euclid would do.
+                let mut d = e - wrap(cur);
+                if d < 0.0 {
+                    d += TURN_DEG;
+                }
                 match mode {
                     RotaryMode::Shortest if d > TURN_DEG / 2.0 => d -= TURN_DEG,
                     RotaryMode::Negative if d > 0.0 => d -= TURN_DEG,
@@ -266,7 +271,6 @@ impl<'s> Machine<'s> {
 
     /// Emits a move to `target` (work coordinates; rotary travel in
     /// `travel` for the axes whose bit is in `turned`, else end − start).
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     pub fn move_to(
         &mut self,
@@ -276,11 +280,28 @@ impl<'s> Machine<'s> {
         turned: u32,
         programmed: u32,
     ) {
-        let mut end = AxisValues::zeros(self.n);
-        let mut travel = AxisValues::zeros(self.n);
+        self.report.moves += 1;
+        // The step keeps its Move between blocks: filled in place, no copy
+        // of the whole event per block.
+        if !matches!(self.step.event, Event::Move(_)) {
+            self.step.event = Event::Move(Move {
+                kind: MotionKind::Rapid,
+                end: AxisValues::zeros(self.n),
+                travel: AxisValues::zeros(self.n),
+                programmed: 0,
+                machine_frame: false,
+                feed: 0.0,
+                feed_mode: FeedMode::PerMinute,
+                cycle: None,
+                state: self.state,
+            });
+        }
+        let Event::Move(mv) = &mut self.step.event else {
+            unreachable!("made a Move above")
+        };
         {
-            let e = end.as_mut_slice();
-            let t = travel.as_mut_slice();
+            let e = mv.end.as_mut_slice();
+            let t = mv.travel.as_mut_slice();
             for i in 0..self.n {
                 if turned & (1 << i) != 0 {
                     t[i] = travel_in[i];
@@ -297,19 +318,14 @@ impl<'s> Machine<'s> {
                 self.pos[i] = e[i];
             }
         }
-        self.report.moves += 1;
-        let mv = Move {
-            kind,
-            end,
-            travel,
-            programmed,
-            machine_frame: self.machine_frame,
-            feed: self.feed,
-            feed_mode: self.feed_mode,
-            cycle: self.cycle,
-            state: self.state,
-        };
-        self.emit(Event::Move(mv));
+        mv.kind = kind;
+        mv.programmed = programmed;
+        mv.machine_frame = self.machine_frame;
+        mv.feed = self.feed;
+        mv.feed_mode = self.feed_mode;
+        mv.cycle = self.cycle;
+        mv.state = self.state;
+        self.sink.step(&self.step);
     }
 
     /// A straight move of the X, Y, Z axes (others stay), e.g. for cycles.
@@ -470,6 +486,10 @@ pub(crate) fn plane_axes(p: Plane) -> [usize; 3] {
 /// An angle in [0, 360).
 #[inline]
 pub(crate) fn wrap(v: f64) -> f64 {
+    // Most values are already in range: no division (fmod is slow).
+    if (0.0..TURN_DEG).contains(&v) {
+        return v + 0.0;
+    }
     let r = v.rem_euclid(TURN_DEG);
     // rem_euclid may round up to the period itself; -0.0 reads 0.
     if r >= TURN_DEG { 0.0 } else { r + 0.0 }

@@ -1,7 +1,7 @@
 //! Fast decimal number reading for the hot path.
 //!
-//! A number of at most 15 significant digits and at most 22 fraction digits
-//! is `m / 10^k` with both `m` and `10^k` exact in `f64`; one IEEE division
+//! A number whose digits make an integer `m` ≤ 2^53, with at most 22
+//! fraction digits, is `m / 10^k` with both `m` and `10^k` exact in `f64`; one IEEE division
 //! rounds that correctly, so the result is bit for bit what
 //! `str::parse::<f64>()` gives (and what the writer's
 //! `NumberFormat::quantize` returns for the printed text). Other numbers
@@ -41,38 +41,29 @@ pub(crate) fn read_number(b: &[u8]) -> Option<Number> {
     }
     let start = i;
     let mut mantissa: u64 = 0;
-    let mut significant = 0u32;
-    let mut fraction = 0u32;
-    let mut digits = 0u32;
-    while i < b.len() && b[i].is_ascii_digit() {
-        let d = u64::from(b[i] - b'0');
-        if significant > 0 || d != 0 {
-            significant += 1;
-        }
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(d);
-        digits += 1;
+    while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
         i += 1;
     }
+    let int_digits = i - start;
     let mut has_point = false;
-    if i < b.len() && b[i] == b'.' {
+    let mut fraction = 0usize;
+    if b.get(i) == Some(&b'.') {
         has_point = true;
         i += 1;
-        while i < b.len() && b[i].is_ascii_digit() {
-            let d = u64::from(b[i] - b'0');
-            if significant > 0 || d != 0 {
-                significant += 1;
-            }
-            mantissa = mantissa.wrapping_mul(10).wrapping_add(d);
-            digits += 1;
-            fraction += 1;
+        let f = i;
+        while let Some(d) = b.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d < 10) {
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
             i += 1;
         }
+        fraction = i - f;
     }
-    if digits == 0 {
+    if int_digits + fraction == 0 {
         return None;
     }
-    let magnitude = if significant <= 15 && fraction <= 22 {
-        mantissa as f64 / POW10[fraction as usize]
+    // At most 19 digits cannot overflow; below 2^53 the mantissa is exact.
+    let magnitude = if int_digits + fraction <= 19 && mantissa <= EXACT && fraction <= 22 {
+        mantissa as f64 / POW10[fraction]
     } else {
         slow(&b[start..i])?
     };
@@ -82,6 +73,9 @@ pub(crate) fn read_number(b: &[u8]) -> Option<Number> {
         has_point,
     })
 }
+
+/// 2^53: every integer up to it is exact in `f64`.
+const EXACT: u64 = 1 << 53;
 
 #[cold]
 fn slow(digits: &[u8]) -> Option<f64> {

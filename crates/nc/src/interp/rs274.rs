@@ -40,7 +40,7 @@ const LINUXCNC_PARAMS: usize = 5602;
 const FANUC_LOCALS: usize = 34;
 
 /// One block's words.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 struct Block {
     /// G-codes × 10 (`G43.4` → 434), in block order.
     g: Vec<(u16, usize)>,
@@ -187,7 +187,9 @@ struct Interp<'a, 's> {
     do_loops: Vec<(u8, Pos)>,
     calls: Vec<Call>,
     subs: HashMap<String, Pos>,
-    block: Block,
+    /// The block being read (boxed: lent out and back per line by moving
+    /// a pointer).
+    block: Option<Box<Block>>,
     /// Seen the first `%` line.
     percent: bool,
     ended: bool,
@@ -264,7 +266,7 @@ impl<'a, 's> Interp<'a, 's> {
             do_loops: Vec::new(),
             calls: Vec::new(),
             subs: HashMap::new(),
-            block: Block::new(),
+            block: Some(Box::new(Block::new())),
             percent: false,
             ended: false,
             warned_axis: 0,
@@ -372,15 +374,19 @@ impl<'a, 's> Interp<'a, 's> {
         if matches!(c.peek(), Some(b'O' | b'o')) {
             return self.o_word(line, c);
         }
+        if self.fast_line(b, c.i) {
+            return Ok(());
+        }
         if self.flavour == Flavour::Fanuc && self.fanuc_statement(line, &mut c)? {
             return Ok(());
         }
-        self.block.clear();
-        let mut block = std::mem::replace(&mut self.block, Block::new());
+        // The block's buffers go back to `self.block`: no allocation per line.
+        let mut block = self.block.take().unwrap_or_default();
+        block.clear();
         let r = self
             .read_block(b, c, &mut block)
             .and_then(|()| self.execute(&block, line));
-        self.block = block;
+        self.block = Some(block);
         r
     }
 
@@ -442,7 +448,11 @@ impl<'a, 's> Interp<'a, 's> {
         let trimmed = t.trim_start();
         for kw in ["MSG,", "PRINT,", "DEBUG,"] {
             // ASCII comparison: the keyword's bytes end on a boundary.
-            if trimmed.as_bytes().get(..kw.len()).is_some_and(|p| p.eq_ignore_ascii_case(kw.as_bytes())) {
+            if trimmed
+                .as_bytes()
+                .get(..kw.len())
+                .is_some_and(|p| p.eq_ignore_ascii_case(kw.as_bytes()))
+            {
                 block.message = Some(trimmed[kw.len()..].to_string());
                 return;
             }
@@ -845,5 +855,6 @@ impl Operands for Interp<'_, '_> {
 }
 
 mod exec;
+mod fast;
 mod flow;
 mod motion;

@@ -15,7 +15,7 @@ use kinpost_diag::Diagnostic;
 
 use super::arc::{self, Centre};
 use super::cycle::{self, Hole, Op};
-use super::expr::{self, Cursor, Lang, Operands};
+use super::expr::{self, Cursor, Lang, Operands, Upper};
 use super::machine::{MM_PER_INCH, Machine, RotaryMode, plane_axes, wrap};
 use super::num::{read_number, read_uint};
 use super::source::{Fail, Line, Pos, Source, diagnostic, fail};
@@ -26,6 +26,7 @@ use super::{
 use crate::AxisSpec;
 
 mod block;
+mod fast;
 mod flow;
 
 /// R parameters R0..R999.
@@ -105,9 +106,12 @@ struct Interp<'a, 's> {
     ended: bool,
     warned_axis: Vec<String>,
     /// Direction of the path at the end of the last move (for CT), X Y Z.
-    tangent: Option<[f64; 3]>,
+    tangent: Option<super::arc::LastElement>,
     /// Where the current line starts.
     current: Pos,
+    /// The machine axis of each one-letter axis name A..Z (not the pressure
+    /// word), for the hot path.
+    letter_axis: [Option<usize>; 26],
 }
 
 /// Runs a Sinumerik program.
@@ -134,7 +138,14 @@ pub(crate) fn run(
         warned_axis: Vec::new(),
         tangent: None,
         current: Pos { offset: 0, line: 1 },
+        letter_axis: [None; 26],
     };
+    for (i, a) in axes.iter().enumerate().take(MAX_AXES) {
+        let b = a.name.as_bytes();
+        if b.len() == 1 && b[0].is_ascii_alphabetic() && !a.pressure {
+            it.letter_axis[usize::from(b[0].to_ascii_uppercase() - b'A')] = Some(i);
+        }
+    }
     while !it.ended {
         let Some(line) = it.src.next_line() else {
             break;
@@ -189,18 +200,22 @@ fn line_head(b: &[u8]) -> (Option<u64>, Option<(usize, usize)>, usize) {
         }
         c.skip_ws();
     }
+    // A label: an identifier and `:`.
     let mut label = None;
-    let save = c.i;
-    if let Some(id) = c.ident() {
-        c.skip_ws();
-        if c.peek() == Some(b':') && c.peek_at(1) != Some(b'=') {
-            label = Some((save, save + id.len()));
-            c.i += 1;
-        } else {
-            c.i = save;
+    let start = c.i;
+    if b.get(start)
+        .is_some_and(|x| x.is_ascii_alphabetic() || *x == b'_')
+    {
+        let end = b[start..]
+            .iter()
+            .position(|x| !(x.is_ascii_alphanumeric() || *x == b'_'))
+            .map_or(b.len(), |k| start + k);
+        let mut d = Cursor::new(b, end);
+        d.skip_ws();
+        if d.peek() == Some(b':') && d.peek_at(1) != Some(b'=') {
+            label = Some((start, end));
+            c.i = d.i + 1;
         }
-    } else {
-        c.i = save;
     }
     (number, label, c.i)
 }
@@ -225,6 +240,9 @@ impl<'a> Interp<'a, '_> {
         let mut c = Cursor::new(b, start);
         c.skip_ws();
         if c.at_end() || c.peek() == Some(b';') {
+            return Ok(());
+        }
+        if self.fast_line(c.b, c.i) {
             return Ok(());
         }
         if self.statement(line, &mut c)? {

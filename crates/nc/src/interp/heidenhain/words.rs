@@ -4,21 +4,21 @@ use super::*;
 
 /// The words of a contour block.
 #[derive(Debug, Default)]
-struct Contour {
+pub(super) struct Contour {
     /// Axis values (mm / deg) and whether incremental.
-    axis: [Option<(f64, bool)>; MAX_AXES],
-    first_axis_at: Option<usize>,
+    pub(super) axis: [Option<(f64, bool)>; MAX_AXES],
+    pub(super) first_axis_at: Option<usize>,
     /// X Y Z words (for CC, also when the machine lacks an axis).
-    xyz: [Option<(f64, bool)>; 3],
-    radius: Option<f64>,
-    dr: Option<bool>,
-    pr: Option<(f64, bool)>,
-    pa: Option<(f64, bool)>,
-    rapid: bool,
-    feed: Option<f64>,
-    per_rev: Option<f64>,
-    comp: Option<CutterComp>,
-    m: Vec<(u32, usize)>,
+    pub(super) xyz: [Option<(f64, bool)>; 3],
+    pub(super) radius: Option<f64>,
+    pub(super) dr: Option<bool>,
+    pub(super) pr: Option<(f64, bool)>,
+    pub(super) pa: Option<(f64, bool)>,
+    pub(super) rapid: bool,
+    pub(super) feed: Option<f64>,
+    pub(super) per_rev: Option<f64>,
+    pub(super) comp: Option<CutterComp>,
+    pub(super) m: Vec<(u32, usize)>,
 }
 
 const AXIS_LETTERS: &[u8] = b"XYZABCUVW";
@@ -33,7 +33,7 @@ impl Interp<'_, '_> {
                 break;
             }
             let at = c.i;
-            let Some(id) = c.ident().map(str::to_ascii_uppercase) else {
+            let Some(id) = c.ident().map(Upper::of) else {
                 return fail(at, 1, format!("`{}` is not a word here", char::from(ch)));
             };
             self.contour_word(&id, at, line, c, &mut w)?;
@@ -227,7 +227,12 @@ impl Interp<'_, '_> {
         (t, travel, programmed, turned)
     }
 
-    fn straight(&mut self, w: &Contour, machine_frame: bool, at: usize) -> Result<bool, Fail> {
+    pub(super) fn straight(
+        &mut self,
+        w: &Contour,
+        machine_frame: bool,
+        at: usize,
+    ) -> Result<bool, Fail> {
         let (t, travel, programmed, turned) = self.targets(w, machine_frame);
         if programmed == 0 {
             return Ok(false);
@@ -379,7 +384,7 @@ impl Interp<'_, '_> {
                 arc::arc(plane, cw, start, end, Centre::Radius(r), 0, &tol).map_err(err)?
             }
             _ => {
-                let Some(tg) = self.tangent else {
+                let Some(tg) = self.tangent.and_then(super::super::arc::end_tangent) else {
                     return fail(at, 2, "CT needs a contour element before it (its tangent)");
                 };
                 let (c, cw) = arc::tangent_centre(
@@ -403,31 +408,10 @@ impl Interp<'_, '_> {
         Ok(true)
     }
 
-    fn note_tangent(&mut self, before: [f64; 3], arc: Option<super::super::Arc>) {
+    pub(super) fn note_tangent(&mut self, before: [f64; 3], arc: Option<super::super::Arc>) {
         let after = self.m.xyz_pos();
-        let t = match arc {
-            None => [
-                after[0] - before[0],
-                after[1] - before[1],
-                after[2] - before[2],
-            ],
-            Some(a) => {
-                let [pa, pb, _] = plane_axes(a.plane);
-                let (ra, rb) = (after[pa] - a.centre_mm[pa], after[pb] - a.centre_mm[pb]);
-                let mut t = [0.0; 3];
-                if a.clockwise {
-                    t[pa] = rb;
-                    t[pb] = -ra;
-                } else {
-                    t[pa] = -rb;
-                    t[pb] = ra;
-                }
-                t
-            }
-        };
-        let n = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-        if n > 1e-12 {
-            self.tangent = Some([t[0] / n, t[1] / n, t[2] / n]);
+        if arc.is_some() || after != before {
+            self.tangent = Some((before, after, arc));
         }
     }
 

@@ -598,7 +598,10 @@ impl Interp<'_, '_> {
         while let Some(l) = s.next_line() {
             let t = l.text.trim_start();
             let t = strip_n(t).trim_start();
-            if t.as_bytes().get(..3).is_some_and(|p| p.eq_ignore_ascii_case(b"END")) {
+            if t.as_bytes()
+                .get(..3)
+                .is_some_and(|p| p.eq_ignore_ascii_case(b"END"))
+            {
                 // The first three bytes are ASCII: a boundary.
                 let rest = t[3..].trim_start();
                 if rest.starts_with(char::from(b'0' + m)) {

@@ -90,7 +90,7 @@ impl Interp<'_, '_> {
         }
     }
 
-    fn set_motion(&mut self, m: Motion) {
+    pub(super) fn set_motion(&mut self, m: Motion) {
         self.motion = m;
         self.base_motion = m;
         self.cycle_initial = None;

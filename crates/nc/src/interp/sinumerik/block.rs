@@ -107,7 +107,7 @@ impl Interp<'_, '_> {
     /// One word, assignment or keyword.
     fn word(&mut self, c: &mut Cursor<'_>, w: &mut Words, line: &Line<'_>) -> Result<(), Fail> {
         let start = c.i;
-        let id = c.ident().unwrap_or("").to_ascii_uppercase();
+        let id = Upper::of(c.ident().unwrap_or(""));
         let save_after_ident = c.i;
         c.skip_ws();
         let assign = c.peek() == Some(b'=') && c.peek_at(1) != Some(b'=');
@@ -130,7 +130,7 @@ impl Interp<'_, '_> {
             return Ok(());
         }
         c.i = save_after_ident;
-        let kw = match id.as_str() {
+        let kw = match &*id {
             "TRAORI" => Some(Kw::Traori),
             "TRAFOOF" => Some(Kw::Trafoof),
             "CIP" => Some(Kw::Cip),
@@ -145,7 +145,7 @@ impl Interp<'_, '_> {
             w.kw.push((k, start));
             return Ok(());
         }
-        if QUIET.contains(&id.as_str()) {
+        if QUIET.contains(&&*id) {
             return Ok(());
         }
         // A one-letter address with a number: G642, M20, X10.5, F250.
@@ -359,8 +359,8 @@ impl Interp<'_, '_> {
     /// `expr`, or `AC(expr)` / `IC(…)` / `DC(…)` / `ACP(…)` / `ACN(…)`.
     fn moded_value(&mut self, c: &mut Cursor<'_>) -> Result<(f64, AxisMode), Fail> {
         let save = c.i;
-        if let Some(f) = c.ident().map(str::to_ascii_uppercase) {
-            let mode = match f.as_str() {
+        if let Some(f) = c.ident().map(Upper::of) {
+            let mode = match &*f {
                 "AC" => Some(AxisMode::Ac),
                 "IC" => Some(AxisMode::Ic),
                 "DC" => Some(AxisMode::Dc),
@@ -546,7 +546,7 @@ impl Interp<'_, '_> {
         Ok(())
     }
 
-    fn set_motion(&mut self, m: Motion) {
+    pub(super) fn set_motion(&mut self, m: Motion) {
         self.motion = m;
         self.motion_set = true;
     }
@@ -676,32 +676,10 @@ impl Interp<'_, '_> {
     }
 
     /// Remembers the direction of the path at the end of the last move.
-    fn note_tangent(&mut self, before: [f64; 3], arc: Option<super::super::Arc>) {
+    pub(super) fn note_tangent(&mut self, before: [f64; 3], arc: Option<super::super::Arc>) {
         let after = self.m.xyz_pos();
-        let t = match arc {
-            None => [
-                after[0] - before[0],
-                after[1] - before[1],
-                after[2] - before[2],
-            ],
-            Some(a) => {
-                let [pa, pb, _] = plane_axes(a.plane);
-                let (ra, rb) = (after[pa] - a.centre_mm[pa], after[pb] - a.centre_mm[pb]);
-                let mut t = [0.0; 3];
-                // Perpendicular to the radius, in the sense of turning.
-                if a.clockwise {
-                    t[pa] = rb;
-                    t[pb] = -ra;
-                } else {
-                    t[pa] = -rb;
-                    t[pb] = ra;
-                }
-                t
-            }
-        };
-        let n = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-        if n > 1e-12 {
-            self.tangent = Some([t[0] / n, t[1] / n, t[2] / n]);
+        if arc.is_some() || after != before {
+            self.tangent = Some((before, after, arc));
         }
     }
 
@@ -711,16 +689,34 @@ impl Interp<'_, '_> {
         w: &Words,
         machine_frame: bool,
     ) -> Result<([f64; MAX_AXES], [f64; MAX_AXES], u32), Fail> {
+        self.targets_of(
+            w.axes,
+            &w.axis_value,
+            &w.axis_mode,
+            machine_frame,
+            w.first_axis_at,
+        )
+    }
+
+    /// End values of the axes in `axes` (bit i), given as `value` in `mode`.
+    pub(super) fn targets_of(
+        &mut self,
+        axes: u32,
+        value: &[f64; MAX_AXES],
+        modes: &[Option<AxisMode>; MAX_AXES],
+        machine_frame: bool,
+        first_axis_at: usize,
+    ) -> Result<([f64; MAX_AXES], [f64; MAX_AXES], u32), Fail> {
         let mut t = self.m.pos;
         let mut travel = [0.0; MAX_AXES];
         let mut turned = 0u32;
         for i in 0..self.m.n {
-            if w.axes & (1 << i) == 0 {
+            if axes & (1 << i) == 0 {
                 continue;
             }
-            let Some(mode) = w.axis_mode[i] else { continue };
+            let Some(mode) = modes[i] else { continue };
             let rotary = self.m.axes[i].rotary;
-            let v = w.axis_value[i] * self.m.unit_of(i);
+            let v = value[i] * self.m.unit_of(i);
             if machine_frame {
                 t[i] = v - self.m.state.offset[i];
                 continue;
@@ -744,7 +740,7 @@ impl Interp<'_, '_> {
             };
             if !rotary && rmode != RotaryMode::Direct {
                 return fail(
-                    w.first_axis_at,
+                    first_axis_at,
                     1,
                     format!("DC/ACP/ACN on the linear axis {}", self.m.axes[i].name),
                 );
@@ -818,7 +814,7 @@ impl Interp<'_, '_> {
                 arc::arc(plane, cw, start, end, Centre::At(c), 0, &tol).map_err(err)?
             }
             Motion::Ct => {
-                let Some(t) = self.tangent else {
+                let Some(t) = self.tangent.and_then(super::super::arc::end_tangent) else {
                     return fail(at, 2, "CT needs a move before it (its tangent)");
                 };
                 let (c, cw) =

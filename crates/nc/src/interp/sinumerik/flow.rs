@@ -43,9 +43,9 @@ impl Interp<'_, '_> {
         let Some(id) = c.ident() else {
             return Ok(false);
         };
-        let kw = id.to_ascii_uppercase();
+        let kw = Upper::of(id);
         let next = self.src.position();
-        match kw.as_str() {
+        match &*kw {
             "IF" => {
                 let cond = self.eval(c)? != 0.0;
                 let save2 = c.i;
