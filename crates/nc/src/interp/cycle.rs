@@ -126,7 +126,7 @@ pub(crate) fn pecks(
 ) -> Result<(), String> {
     let q = q.abs();
     let count = ((r - bottom) / q).ceil();
-    if !(count <= MAX_PECKS) {
+    if count.is_nan() || count > MAX_PECKS {
         return Err(format!(
             "a peck of {q} mm from {r} down to {bottom} makes more than {MAX_PECKS} pecks"
         ));

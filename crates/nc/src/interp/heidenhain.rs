@@ -269,24 +269,24 @@ impl<'a> Interp<'a, '_> {
 
     fn statement(&mut self, line: &Line<'a>, c: &mut Cursor<'_>) -> Result<(), Fail> {
         let start = c.i;
-        if matches!(c.peek(), Some(b'Q' | b'q')) {
-            if let Some(r) = self.q_ref(c)? {
-                if !c.eat(b'=') {
-                    return fail(start, c.i - start, "`=` expected after the Q parameter");
-                }
-                let v = self.eval(c)?;
-                self.q_set(r, v);
-                if self.pending_preset && r == (0, 339) {
-                    self.pending_preset = false;
-                    if !(0.0..=65535.0 - 1000.0).contains(&v) || v.fract() != 0.0 {
-                        return fail(start, c.i - start, format!("preset number {v}"));
-                    }
-                    let k = 1000 + v as u16;
-                    self.m
-                        .select_offset(WorkOffset::Numbered(k), &format!("preset {v}"));
-                }
-                return self.rest_is_comment(c);
+        if matches!(c.peek(), Some(b'Q' | b'q'))
+            && let Some(r) = self.q_ref(c)?
+        {
+            if !c.eat(b'=') {
+                return fail(start, c.i - start, "`=` expected after the Q parameter");
             }
+            let v = self.eval(c)?;
+            self.q_set(r, v);
+            if self.pending_preset && r == (0, 339) {
+                self.pending_preset = false;
+                if !(0.0..=65535.0 - 1000.0).contains(&v) || v.fract() != 0.0 {
+                    return fail(start, c.i - start, format!("preset number {v}"));
+                }
+                let k = 1000 + v as u16;
+                self.m
+                    .select_offset(WorkOffset::Numbered(k), &format!("preset {v}"));
+            }
+            return self.rest_is_comment(c);
         }
         let Some(id) = c.ident().map(Upper::of) else {
             return fail(c.i, 1, "a Heidenhain block is expected");

@@ -284,7 +284,7 @@ impl<'s> Machine<'s> {
         // The step keeps its Move between blocks: filled in place, no copy
         // of the whole event per block.
         if !matches!(self.step.event, Event::Move(_)) {
-            self.step.event = Event::Move(Move {
+            self.step.event = Event::Move(Box::new(Move {
                 kind: MotionKind::Rapid,
                 end: AxisValues::zeros(self.n),
                 travel: AxisValues::zeros(self.n),
@@ -294,7 +294,7 @@ impl<'s> Machine<'s> {
                 feed_mode: FeedMode::PerMinute,
                 cycle: None,
                 state: self.state,
-            });
+            }));
         }
         let Event::Move(mv) = &mut self.step.event else {
             unreachable!("made a Move above")

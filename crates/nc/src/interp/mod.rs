@@ -335,8 +335,8 @@ pub enum StopKind {
 /// Something the replay must see.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Event {
-    /// A motion block.
-    Move(Move),
+    /// A motion block (boxed: the other events are small).
+    Move(Box<Move>),
     /// Tool change (`M6`, `TOOL CALL`): the tool now in the spindle.
     ToolChange {
         /// Tool number.

@@ -80,11 +80,7 @@ const EXACT: u64 = 1 << 53;
 #[cold]
 fn slow(digits: &[u8]) -> Option<f64> {
     let s = std::str::from_utf8(digits).ok()?;
-    let s = if s.ends_with('.') {
-        &s[..s.len() - 1]
-    } else {
-        s
-    };
+    let s = s.strip_suffix('.').unwrap_or(s);
     let v: f64 = if let Some(rest) = s.strip_prefix('.') {
         format!("0.{rest}").parse().ok()?
     } else {

@@ -478,7 +478,7 @@ impl<'a, 's> Interp<'a, 's> {
                 block.g.push((code, start));
             }
             b'M' => {
-                if !(v >= 0.0 && v < 1e6 && v.fract() == 0.0) {
+                if !((0.0..1e6).contains(&v) && v.fract() == 0.0) {
                     return fail(start, c.i - start, format!("`M{v}` is not an M-code"));
                 }
                 block.m.push((v as u32, start));

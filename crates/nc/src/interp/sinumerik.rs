@@ -410,10 +410,9 @@ impl Interp<'_, '_> {
         if let Some(axis) = key
             .strip_prefix("$AA_IW[")
             .and_then(|r| r.strip_suffix(']'))
+            && let Some(i) = self.m.axis(axis)
         {
-            if let Some(i) = self.m.axis(axis) {
-                return Ok(self.m.pos[i]);
-            }
+            return Ok(self.m.pos[i]);
         }
         fail(
             at,

@@ -273,7 +273,7 @@ impl Interp<'_, '_> {
                     self.m.set_tool_length(None);
                 }
                 540 | 550 | 560 | 570 | 580 | 590 => {
-                    let k = (code / 10 - 53) as u16;
+                    let k = code / 10 - 53;
                     self.m
                         .select_offset(WorkOffset::Numbered(k), &format!("G{}", code / 10));
                 }
@@ -642,7 +642,7 @@ fn key_in_force(wo: WorkOffset, key: u16) -> bool {
 
 /// `43.4` for 434.
 pub(super) fn show_g(code: u16) -> String {
-    if code % 10 == 0 {
+    if code.is_multiple_of(10) {
         format!("{}", code / 10)
     } else {
         format!("{}.{}", code / 10, code % 10)

@@ -91,14 +91,14 @@ impl Interp<'_, '_> {
         let mut t = self.m.pos;
         let mut travel = [0.0; MAX_AXES];
         let (mut programmed, mut turned) = (0u32, 0u32);
-        for k in 0..9 {
+        for (k, value) in values.iter().enumerate() {
             if has & (1 << k) == 0 {
                 continue;
             }
             let Some(i) = self.letter_axis[k] else {
                 continue;
             };
-            let mut v = values[k];
+            let mut v = *value;
             if fanuc_units && no_point & (1 << k) != 0 {
                 v *= increment;
             }

@@ -566,7 +566,7 @@ impl Interp<'_, '_> {
                 None => return fail(c.i, 1, "GOTO needs a sequence number"),
             }
         };
-        if !(v >= 1.0 && v <= 99_999_999.0) {
+        if !(1.0..=99_999_999.0).contains(&v) {
             return fail(
                 at,
                 c.i - at,

@@ -37,7 +37,7 @@ impl Interp<'_, '_> {
                     self.m.emit(Event::Cycle { code: c });
                 }
                 530 => g53 = Some(at),
-                50 | 51 | 52 | 53 => {
+                50..=53 => {
                     return fail(
                         at,
                         4,
@@ -117,10 +117,10 @@ impl Interp<'_, '_> {
     }
 
     fn straight(&mut self, b: &Block, g53: Option<usize>) -> Result<(), Fail> {
-        if let Some(at) = g53 {
-            if self.incremental {
-                return fail(at, 3, "G53 with incremental distance (G91)");
-            }
+        if let Some(at) = g53
+            && self.incremental
+        {
+            return fail(at, 3, "G53 with incremental distance (G91)");
         }
         let rapid = self.motion == Motion::Rapid;
         if !rapid {

@@ -179,7 +179,7 @@ impl Interp<'_, '_> {
         line: &Line<'_>,
     ) -> Result<(), Fail> {
         let whole = |v: f64| -> Result<u32, Fail> {
-            if v >= 0.0 && v < 1e9 && v.fract() == 0.0 {
+            if (0.0..1e9).contains(&v) && v.fract() == 0.0 {
                 Ok(v as u32)
             } else {
                 fail(
@@ -271,7 +271,7 @@ impl Interp<'_, '_> {
             "CR" => w.cr = Some(self.eval(c)?),
             "TURN" => {
                 let v = self.eval(c)?;
-                if !(v >= 0.0 && v < 1e6 && v.fract() == 0.0) {
+                if !((0.0..1e6).contains(&v) && v.fract() == 0.0) {
                     return fail(
                         at,
                         4,
@@ -300,7 +300,7 @@ impl Interp<'_, '_> {
                     );
                 }
                 let v = self.eval(c)?;
-                if !(v >= 0.0 && v < 1e9 && v.fract() == 0.0) {
+                if !((0.0..1e9).contains(&v) && v.fract() == 0.0) {
                     return fail(at, 1, format!("T={v}: a tool number is expected"));
                 }
                 w.t = Some((v as u32, at));
