@@ -5,7 +5,11 @@
 //! `DIALECTS.md`). [`NcWriter`] writes a program in a dialect: header and
 //! footer templates, tool changes, comments and — on the hot path — motion
 //! blocks, formatted without allocation. [`read_program`] reads such a program
-//! back into blocks of axis values, for closed-loop checks and simulation.
+//! back into blocks of axis values, for closed-loop checks. [`interp`] is the
+//! interpreter of real programs for the four controller families (Sinumerik,
+//! Fanuc, LinuxCNC, Heidenhain) and the CSV table: expressions, variables,
+//! control flow, arcs and drilling cycles resolved into a stream of typed
+//! steps for the virtual machine (`INTERPRETER.md`).
 //!
 //! ```
 //! use kinpost_nc::{AxisSpec, Block, Dialect, Motion, NcWriter};
@@ -19,9 +23,12 @@
 //! assert_eq!(text, "X=459.000 Y=8.807 Z361.368 B0.000 A=DC(0.000) F250\n");
 //! ```
 
+#![deny(missing_docs)]
+
 use std::collections::BTreeMap;
 
 mod dialect;
+pub mod interp;
 mod reader;
 mod template;
 mod writer;
