@@ -506,18 +506,45 @@ impl Default for Options {
 
 impl Options {
     /// Sets an input from a `NAME=VALUE` argument (`--input '$A_IN[5]=1'`).
-    pub fn parse_input(&mut self, arg: &str) -> Result<(), String> {
-        let (name, value) = arg
-            .split_once('=')
-            .ok_or_else(|| format!("`{arg}`: expected NAME=VALUE"))?;
-        let v: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| format!("`{arg}`: `{value}` is not a number"))?;
+    pub fn parse_input(&mut self, arg: &str) -> Result<(), InputError> {
+        let Some((name, value)) = arg.split_once('=') else {
+            return Err(InputError::NoValue(arg.to_string()));
+        };
+        let v: f64 = value.trim().parse().map_err(|_| InputError::NotANumber {
+            arg: arg.to_string(),
+            value: value.to_string(),
+        })?;
         self.inputs.insert(normalize_input(name), v);
         Ok(())
     }
 }
+
+/// Why an `--input NAME=VALUE` argument cannot be used.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum InputError {
+    /// No `=`.
+    NoValue(String),
+    /// The value is not a number.
+    NotANumber {
+        /// The argument.
+        arg: String,
+        /// Its value part.
+        value: String,
+    },
+}
+
+impl std::fmt::Display for InputError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            InputError::NoValue(arg) => write!(f, "`{arg}`: expected NAME=VALUE"),
+            InputError::NotANumber { arg, value } => {
+                write!(f, "`{arg}`: `{value}` is not a number")
+            }
+        }
+    }
+}
+
+impl std::error::Error for InputError {}
 
 /// Input names compare without case and blanks.
 pub(crate) fn normalize_input(name: &str) -> String {
