@@ -20,9 +20,13 @@ mod file;
 mod kinematics;
 mod model;
 mod pressure;
+mod solid;
 pub mod subproblems;
 
-pub use file::machine_from_toml;
+pub use file::{
+    MAX_MESH_BYTES, MeshFiles, machine_from_toml, machine_from_toml_with, mesh_from_stl,
+};
+pub use kinematics::BodyPoses;
 pub use kinematics::{
     AXIS_ROUNDING_RAD, Excursion, Folds, IkError, Joints, Kinematics, MAX_AXIS_ROUNDING_RAD,
     Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,
@@ -31,3 +35,7 @@ pub use model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,
 };
 pub use pressure::{Clamp, PressureAxis, WheelModel, interpolate};
+pub use solid::{
+    Body, CollisionSettings, DEFAULT_ERROR_CLEARANCE_MM, DEFAULT_WARNING_CLEARANCE_MM, Mesh,
+    PairClearance, Role, Shape, Solid,
+};
