@@ -40,7 +40,7 @@ pub mod bound;
 pub mod shapes;
 mod world;
 
-pub use world::{Contact, ContactKind, MoveContact, Motion, World};
+pub use world::{Contact, ContactKind, Motion, MoveContact, World};
 
 /// How near a clearance a pair may come, unreported, between two poses of
 /// [`World::check_move`], mm: the sweep stops halving a stretch once the

@@ -92,7 +92,10 @@ pub(crate) fn build(shape: &Shape, solid: &str) -> Result<Built, BuildError> {
         } => {
             let half = h / 2.0;
             if bottom == top {
-                convex(SharedShape::new(Cylinder::new(half, *bottom)), standing(half))
+                convex(
+                    SharedShape::new(Cylinder::new(half, *bottom)),
+                    standing(half),
+                )
             } else if *bottom == 0.0 {
                 // parry's cone: apex at +y, base at −y; the apex up at the top.
                 let flip = Pose::from_parts(
@@ -139,14 +142,21 @@ pub(crate) fn build_mesh(mesh: &Mesh, solid: &str) -> Result<Built, BuildError> 
     if mesh.triangles.is_empty() {
         return Err(bad(format!("mesh `{}` has no triangle", mesh.source)));
     }
-    if let Some(t) = mesh.triangles.iter().find(|t| t.iter().any(|&i| i as usize >= n)) {
+    if let Some(t) = mesh
+        .triangles
+        .iter()
+        .find(|t| t.iter().any(|&i| i as usize >= n))
+    {
         return Err(bad(format!(
             "mesh `{}`: triangle {t:?} names a vertex beyond its {n} vertices",
             mesh.source
         )));
     }
     if mesh.vertices.iter().flatten().any(|x| !x.is_finite()) {
-        return Err(bad(format!("mesh `{}` has a vertex that is not finite", mesh.source)));
+        return Err(bad(format!(
+            "mesh `{}` has a vertex that is not finite",
+            mesh.source
+        )));
     }
     let vertices: Vec<Vector> = mesh
         .vertices

@@ -249,10 +249,7 @@ impl World {
     /// Every solid placed at joint values `q`.
     fn place_all(&self, q: &[f64]) -> Vec<Placed> {
         let bodies = self.kin.body_poses(q);
-        self.items
-            .iter()
-            .map(|item| place(item, &bodies))
-            .collect()
+        self.items.iter().map(|item| place(item, &bodies)).collect()
     }
 
     /// Every pair too close at joint values `q` (machine-file order, every
@@ -320,11 +317,15 @@ impl World {
             return None;
         }
         let (ia, ib) = (&self.items[p.a], &self.items[p.b]);
-        let found =
-            query::closest_points(&a.pose, &*ia.shape.0, &b.pose, &*ib.shape.0, margin);
+        let found = query::closest_points(&a.pose, &*ia.shape.0, &b.pose, &*ib.shape.0, margin);
         let distance = match found {
             Ok(ClosestPoints::Intersecting) => return Some(0.0),
-            Ok(ClosestPoints::WithinMargin(p1, p2)) => Some((p1 - p2).length()),
+            // Within the margin, GJK may stop as soon as it knows so: the
+            // exact distance, for the report.
+            Ok(ClosestPoints::WithinMargin(p1, p2)) => Some(
+                query::distance(&a.pose, &*ia.shape.0, &b.pose, &*ib.shape.0)
+                    .map_or((p1 - p2).length(), |d| d.distance),
+            ),
             Ok(ClosestPoints::Disjoint) => None,
             // No query for these shapes (none of kinpost's): the boxes'
             // gap is a distance the solids are not nearer than.

@@ -38,10 +38,20 @@ pub fn slab(
     for j in 0..ny - 1 {
         for i in 0..nx - 1 {
             // Top: counter-clockwise seen from +z; bottom the other way.
-            let (a, b, c, d) = (v(1, i, j), v(1, i + 1, j), v(1, i + 1, j + 1), v(1, i, j + 1));
+            let (a, b, c, d) = (
+                v(1, i, j),
+                v(1, i + 1, j),
+                v(1, i + 1, j + 1),
+                v(1, i, j + 1),
+            );
             triangles.push([a, b, c]);
             triangles.push([a, c, d]);
-            let (a, b, c, d) = (v(0, i, j), v(0, i + 1, j), v(0, i + 1, j + 1), v(0, i, j + 1));
+            let (a, b, c, d) = (
+                v(0, i, j),
+                v(0, i + 1, j),
+                v(0, i + 1, j + 1),
+                v(0, i, j + 1),
+            );
             triangles.push([a, c, b]);
             triangles.push([a, d, c]);
         }
