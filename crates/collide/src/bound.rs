@@ -112,3 +112,44 @@ fn turn(a: &ChainAxis, deg: f64, y: &Vector3<f64>) -> Vector3<f64> {
     let r = UnitQuaternion::from_axis_angle(&a.direction, deg.to_radians());
     a.point + r * (y - a.point)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinpost_machine::builtin;
+
+    /// On one linear axis the bound is the travel; on one rotary axis the
+    /// arc of the farthest point of the ball: (distance of the centre from
+    /// the line + radius) × angle.
+    #[test]
+    fn single_axes_give_their_closed_forms() {
+        let m = builtin::load("mts1600").unwrap().unwrap();
+        let x = m.axis_index("X").unwrap();
+        let a = m.axis_index("A").unwrap();
+        let mut from = m.home_joints();
+        let mut to = from.clone();
+        to[x] = 30.0;
+        let on_x = MotionBound::new(&m, Body::Axis(x), Vector3::new(5.0, 6.0, 7.0), 9.0);
+        assert_eq!(on_x.path_bound_mm(&from, &to), 30.0);
+        // The ball 100 mm from the A line, radius 10, turned 90°: the
+        // farthest point travels a quarter circle of radius 110.
+        let on_a = MotionBound::new(&m, Body::Axis(a), Vector3::new(-300.0, 60.0, 80.0), 10.0);
+        to[x] = 0.0;
+        to[a] = 90.0;
+        let want = 110.0 * std::f64::consts::FRAC_PI_2;
+        assert!((on_a.path_bound_mm(&from, &to) - want).abs() < 1e-9);
+        // With X moving as well, the X travel adds to it (X carries A).
+        to[x] = -40.0;
+        assert!((on_a.path_bound_mm(&from, &to) - (want + 40.0)).abs() < 1e-9);
+        // The base never moves; the tool side does not move with X and A.
+        let base = MotionBound::new(&m, Body::Base, Vector3::zeros(), 1e3);
+        assert_eq!(base.path_bound_mm(&from, &to), 0.0);
+        let tool = MotionBound::new(&m, Body::Tool, Vector3::zeros(), 1e3);
+        assert_eq!(tool.path_bound_mm(&from, &to), 0.0);
+        // A locked axis (C of the 5-axis mts1600) adds nothing.
+        let c = m.axis_index("C").unwrap();
+        from[c] = 0.0;
+        to[c] = 50.0;
+        assert_eq!(tool.path_bound_mm(&from, &to), 0.0);
+    }
+}

@@ -317,20 +317,31 @@ impl World {
             return None;
         }
         let (ia, ib) = (&self.items[p.a], &self.items[p.b]);
-        let found = query::closest_points(&a.pose, &*ia.shape.0, &b.pose, &*ib.shape.0, margin);
-        let distance = match found {
-            Ok(ClosestPoints::Intersecting) => return Some(0.0),
-            // Within the margin, GJK may stop as soon as it knows so: the
-            // exact distance, for the report.
-            Ok(ClosestPoints::WithinMargin(p1, p2)) => Some(
-                query::distance(&a.pose, &*ia.shape.0, &b.pose, &*ib.shape.0)
-                    .map_or((p1 - p2).length(), |d| d.distance),
-            ),
-            Ok(ClosestPoints::Disjoint) => None,
-            // No query for these shapes (none of kinpost's): the boxes'
-            // gap is a distance the solids are not nearer than.
-            Err(_) => Some(aabb_gap(&a.aabb, &b.aabb)),
+        let (sa, sb) = (&*ia.shape.0, &*ib.shape.0);
+        let distance = match (sa.as_trimesh(), sb.as_trimesh()) {
+            (Some(mesh), None) if sb.as_support_map().is_some() => {
+                mesh_to_convex(mesh, &a.pose, sb, &b.pose, margin)
+            }
+            (None, Some(mesh)) if sa.as_support_map().is_some() => {
+                mesh_to_convex(mesh, &b.pose, sa, &a.pose, margin)
+            }
+            _ => match query::closest_points(&a.pose, sa, &b.pose, sb, margin) {
+                Ok(ClosestPoints::Intersecting) => Some(0.0),
+                // Within the margin, GJK may stop as soon as it knows so:
+                // the exact distance, for the report.
+                Ok(ClosestPoints::WithinMargin(p1, p2)) => Some(
+                    query::distance(&a.pose, sa, &b.pose, sb)
+                        .map_or((p1 - p2).length(), |d| d.distance),
+                ),
+                Ok(ClosestPoints::Disjoint) => None,
+                // No query for these shapes (none of kinpost's): the boxes'
+                // gap is a distance the solids are not nearer than.
+                Err(_) => Some(aabb_gap(&a.aabb, &b.aabb)),
+            },
         };
+        if distance == Some(0.0) {
+            return distance;
+        }
         // Surfaces apart: one solid may still lie wholly inside the other
         // (a mesh has no inside for the distance query); then its box is
         // inside the other's, and any one of its points is inside.
@@ -439,6 +450,56 @@ fn place(item: &Item, bodies: &kinpost_machine::BodyPoses) -> Placed {
         pose,
         aabb: item.local_aabb.transform_by(&pose),
     }
+}
+
+/// The distance between a triangle mesh and a convex shape, if it is at
+/// most `margin`.
+///
+/// parry's own query bounds the distance to a node of the mesh's BVH by
+/// the gap between the node's box and the shape's box, which for a large
+/// round solid over a finely cut surface (a wheel over a blank, a tilted
+/// holder) leaves thousands of triangles to measure. Here a node's bound
+/// is the exact distance from the shape to the node's box (GJK; the box
+/// holds every triangle below it, so no triangle is nearer), taken only
+/// when the gap of the boxes does not already prune it: a surface farther
+/// than the margin is usually dismissed at its root.
+fn mesh_to_convex(
+    mesh: &parry3d_f64::shape::TriMesh,
+    mesh_pose: &Pose,
+    shape: &dyn parry3d_f64::shape::Shape,
+    shape_pose: &Pose,
+    margin: f64,
+) -> Option<f64> {
+    use parry3d_f64::shape::Cuboid;
+    // The shape in the mesh's frame.
+    let pose = mesh_pose.inv_mul(shape_pose);
+    let shape_aabb = shape.compute_aabb(&pose);
+    // `find_best` keeps strictly smaller costs: a distance exactly at the
+    // margin is kept.
+    let limit = margin + margin.abs().max(1.0) * 1e-12;
+    let node_bound = |node: &parry3d_f64::partitioning::BvhNode, best: f64| {
+        let aabb = node.aabb();
+        let gap = aabb_gap(&aabb, &shape_aabb);
+        if gap >= best {
+            return gap;
+        }
+        let cuboid = Cuboid::new(aabb.half_extents());
+        query::distance(
+            &Pose::from_translation(aabb.center()),
+            &cuboid,
+            &pose,
+            shape,
+        )
+        .map_or(gap, |d| d.distance)
+    };
+    let leaf = |i: u32, _best: f64| {
+        query::distance(&Pose::IDENTITY, &mesh.triangle(i), &pose, shape)
+            .ok()
+            .map(|d| d.distance)
+    };
+    mesh.bvh()
+        .find_best(limit, node_bound, leaf)
+        .map(|(_, d)| d.min(margin))
 }
 
 /// The distance between two boxes (0 when they overlap).
