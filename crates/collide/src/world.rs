@@ -381,12 +381,31 @@ impl World {
         path: &(dyn Fn(f64, &mut Vec<f64>) + Sync),
         motion: Motion,
     ) -> Vec<MoveContact> {
+        // A pair whose boxes at the start are farther apart than the two
+        // solids can travel over the whole move, plus its clearance, stays
+        // clear: dismissed without a query.
+        let (mut q0, mut q1) = (Vec::new(), Vec::new());
+        path(0.0, &mut q0);
+        path(1.0, &mut q1);
+        let start = self.place_all(&q0);
+        let travel: Vec<f64> = self
+            .items
+            .iter()
+            .map(|i| i.bound.path_bound_mm(&q0, &q1))
+            .collect();
         self.pairs
             .iter()
             .filter(|p| !(p.cutting && motion == Motion::Feed))
+            .filter(|p| {
+                aabb_gap(&start[p.a].aabb, &start[p.b].aabb) - (travel[p.a] + travel[p.b])
+                    <= p.warning
+            })
             .filter_map(|p| {
-                self.sweep_pair(p, path, p.error, motion)
-                    .or_else(|| self.sweep_pair(p, path, p.warning, motion))
+                self.sweep_pair(p, path, p.error, motion).or_else(|| {
+                    (p.warning > p.error)
+                        .then(|| self.sweep_pair(p, path, p.warning, motion))
+                        .flatten()
+                })
             })
             .collect()
     }
@@ -459,10 +478,11 @@ fn place(item: &Item, bodies: &kinpost_machine::BodyPoses) -> Placed {
 /// the gap between the node's box and the shape's box, which for a large
 /// round solid over a finely cut surface (a wheel over a blank, a tilted
 /// holder) leaves thousands of triangles to measure. Here a node's bound
-/// is the exact distance from the shape to the node's box (GJK; the box
-/// holds every triangle below it, so no triangle is nearer), taken only
-/// when the gap of the boxes does not already prune it: a surface farther
-/// than the margin is usually dismissed at its root.
+/// is the distance from the shape to the node's box (GJK; the box
+/// holds every triangle below it, so no triangle is nearer), asked only
+/// whether it exceeds the best distance so far, and only when the gap of
+/// the boxes does not already prune the node: a surface farther than the
+/// margin is usually dismissed at its root.
 fn mesh_to_convex(
     mesh: &parry3d_f64::shape::TriMesh,
     mesh_pose: &Pose,
@@ -483,14 +503,15 @@ fn mesh_to_convex(
         if gap >= best {
             return gap;
         }
+        // GJK stops as soon as it proves the box farther than the best
+        // distance so far (the node is pruned); otherwise the boxes' gap
+        // stays its bound, a true lower one.
         let cuboid = Cuboid::new(aabb.half_extents());
-        query::distance(
-            &Pose::from_translation(aabb.center()),
-            &cuboid,
-            &pose,
-            shape,
-        )
-        .map_or(gap, |d| d.distance)
+        let centre = Pose::from_translation(aabb.center());
+        match query::closest_points(&centre, &cuboid, &pose, shape, best) {
+            Ok(ClosestPoints::Disjoint) => f64::MAX,
+            _ => gap,
+        }
     };
     let leaf = |i: u32, _best: f64| {
         query::distance(&Pose::IDENTITY, &mesh.triangle(i), &pose, shape)
