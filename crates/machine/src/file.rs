@@ -15,6 +15,9 @@ use crate::model::{
 };
 use crate::pressure::{PressureAxis, WheelModel};
 
+mod solids;
+pub use solids::{MAX_MESH_BYTES, MeshFiles, mesh_from_stl};
+
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;
 
@@ -40,6 +43,9 @@ struct RawMachine {
     workpiece: Option<RawWorkpiece>,
     tool: Option<Spanned<RawTool>>,
     pressure: Option<Spanned<RawPressure>>,
+    #[serde(default)]
+    solid: Vec<solids::RawSolid>,
+    collision: Option<solids::RawCollision>,
 }
 
 #[derive(Deserialize, Default)]
@@ -360,11 +366,27 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
             unknown.check(t, fields, &[]);
         }
     }
+    solids::unknown_names(doc, &mut unknown);
     unknown.into_diagnostics(file, source)
 }
 
-/// Reads a machine file. `file` is the name used in diagnostics.
+/// Reads a machine file. `file` is the name used in diagnostics and, taken
+/// as a path, the file whose folder its `mesh` files are read from (see
+/// [`machine_from_toml_with`]).
 pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostics> {
+    let folder = std::path::Path::new(file)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    machine_from_toml_with(source, file, MeshFiles::Folder(folder))
+}
+
+/// Reads a machine file whose `mesh` files are read from `meshes`. `file`
+/// is the name used in diagnostics.
+pub fn machine_from_toml_with(
+    source: &str,
+    file: &str,
+    meshes: MeshFiles,
+) -> Result<Machine, Diagnostics> {
     // Syntax first, then the keys and types of the machine file.
     if let Err(e) = source.parse::<toml::Table>() {
         return Err(toml_error(&e, file, source, true).into());
@@ -512,6 +534,12 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         .pressure
         .as_ref()
         .and_then(|p| check_pressure(&mut c, p, &axes));
+    let (solids, declared) = solids::check_solids(&mut c, &raw.solid, &axes, meshes);
+    let collision = raw
+        .collision
+        .as_ref()
+        .map(|r| solids::check_collision(&mut c, r, &declared))
+        .unwrap_or_default();
 
     if !c.errors.is_empty() {
         return Err(Diagnostics(c.errors));
@@ -539,6 +567,8 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
             singular_cone_deg,
         },
         pressure,
+        solids,
+        collision,
     })
 }
 

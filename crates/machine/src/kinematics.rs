@@ -42,9 +42,11 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::angle::{atan2_deg, sin_cos_deg};
 
+mod bodies;
 mod chord;
 mod reach;
 mod singular;
+pub use bodies::BodyPoses;
 pub use chord::{lever_over, midpoint_bound};
 pub use reach::{AXIS_ROUNDING_RAD, IkFailure, MAX_AXIS_ROUNDING_RAD};
 pub use singular::{Excursion, Folds, Singularity};
@@ -356,6 +358,10 @@ pub struct Kinematics {
     /// may lie and still be solved at the nearest one (see
     /// [`Kinematics::set_axis_rounding`]).
     axis_rounding: f64,
+    /// The axes in the machine frame, for [`Kinematics::body_poses`].
+    body_axes: Vec<bodies::BodyAxis>,
+    /// The part frame at home, machine frame.
+    w0: nalgebra::Isometry3<f64>,
 }
 
 #[inline]
@@ -577,6 +583,13 @@ impl Kinematics {
             between,
             free_lin,
             axis_rounding: AXIS_ROUNDING_RAD,
+            body_axes: bodies::BodyAxis::of(machine),
+            w0: nalgebra::Isometry3::from_parts(
+                machine.workpiece_origin.into(),
+                nalgebra::UnitQuaternion::from_rotation_matrix(
+                    &nalgebra::Rotation3::from_matrix_unchecked(machine.workpiece_rotation),
+                ),
+            ),
         }
     }
 

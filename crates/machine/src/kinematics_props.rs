@@ -140,6 +140,8 @@ fn random_machine(rng: &mut Draw) -> Machine {
         },
         post: PostSettings::default(),
         pressure: None,
+        solids: Vec::new(),
+        collision: Default::default(),
     }
 }
 
@@ -231,6 +233,39 @@ proptest! {
             let want = reference_fk(&m, &q);
             let got = kin.fk(&q);
             prop_assert!(same_pose(&want, &got, true), "{want:?}\n{got:?}\n{m:?}");
+        }
+    }
+
+    /// The bodies of the virtual machine move as the kinematics does: the
+    /// tool point, axis and reference at home moved by the tool body, seen
+    /// from the part frame, are `fk(q)` (and the definition); each axis body
+    /// is its side's product of axis motions up to that axis.
+    #[test]
+    fn body_poses_carry_the_tool_to_fk(mut rng in rngs()) {
+        let m = random_machine(&mut rng);
+        let kin = Kinematics::new(&m);
+        for _ in 0..4 {
+            let q = random_joints(&m, &mut rng);
+            let bodies = kin.body_poses(&q);
+            let part_to_tool = bodies.part_frame().inverse() * bodies.tool;
+            let got = Pose {
+                point: (part_to_tool * Point3::from(m.tool.point)).coords,
+                axis: part_to_tool * m.tool.axis,
+                reference: m.tool.reference.map(|r| part_to_tool * r),
+            };
+            prop_assert!(same_pose(&kin.fk(&q), &got, true), "{:?}\n{got:?}\n{m:?}", kin.fk(&q));
+            prop_assert!(same_pose(&reference_fk(&m, &q), &got, true));
+            for (i, a) in m.axes.iter().enumerate() {
+                let mut want = Isometry3::identity();
+                for (b, &v) in m.axes[..=i].iter().zip(&q) {
+                    if b.side == a.side {
+                        want *= motion(b, b.fixed.unwrap_or(v));
+                    }
+                }
+                let got = bodies.of(crate::Body::Axis(i));
+                let x = Point3::from(rng.point(500.0));
+                prop_assert!(close(&(want * x).coords, &(got * x).coords, 1e-9));
+            }
         }
     }
 

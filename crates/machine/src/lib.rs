@@ -1,5 +1,7 @@
 //! The machine model of kinpost: machine files, forward and inverse
-//! kinematics (DESIGN.md §2).
+//! kinematics (DESIGN.md §2), and the solids of the virtual machine with
+//! the settings of its collision check ([`Solid`], [`CollisionSettings`],
+//! moved by [`Kinematics::body_poses`]; checked by `kinpost-collide`).
 //!
 //! ```
 //! use kinpost_machine::{builtin, Kinematics};
@@ -22,12 +24,16 @@ mod file;
 mod kinematics;
 mod model;
 mod pressure;
+mod solid;
 pub mod subproblems;
 pub mod tolerance;
 
 pub use at_pressure::KinematicsAtPressure;
 pub use describe::Mm;
-pub use file::machine_from_toml;
+pub use file::{
+    MAX_MESH_BYTES, MeshFiles, machine_from_toml, machine_from_toml_with, mesh_from_stl,
+};
+pub use kinematics::BodyPoses;
 pub use kinematics::{
     AXIS_ROUNDING_RAD, Excursion, Folds, IkError, IkFailure, Joints, Kinematics,
     MAX_AXIS_ROUNDING_RAD, Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,
@@ -36,3 +42,7 @@ pub use model::{
     Axis, AxisKind, MAX_AXES, Machine, OutputMode, Pose, PostSettings, Prefer, Side, Tool, Wrap,
 };
 pub use pressure::{Clamp, PressureAxis, WheelModel, interpolate};
+pub use solid::{
+    Body, CollisionSettings, DEFAULT_ERROR_CLEARANCE_MM, DEFAULT_WARNING_CLEARANCE_MM, Mesh,
+    PairClearance, Role, Shape, Solid,
+};

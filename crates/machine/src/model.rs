@@ -181,6 +181,11 @@ pub struct Machine {
     /// A process axis that moves the tool point (the grinding pressure H1),
     /// if the machine has one; see [`Machine::at_pressure`].
     pub pressure: Option<crate::PressureAxis>,
+    /// The solids of the virtual machine (`[[solid]]`), in file order.
+    pub solids: Vec<crate::Solid>,
+    /// When solids are too close, and which pairs are not checked
+    /// (`[collision]`).
+    pub collision: crate::CollisionSettings,
 }
 
 /// A tool pose in the part frame: what one CL point asks for.
