@@ -53,9 +53,7 @@ fn without_tests(text: &str) -> String {
 
 /// Whether `line` closes an item opened at `indent`.
 fn is_closing(line: &str, indent: usize) -> bool {
-    line.len() > indent
-        && line[..indent].trim().is_empty()
-        && line[indent..].starts_with('}')
+    line.len() > indent && line[..indent].trim().is_empty() && line[indent..].starts_with('}')
 }
 
 /// A library crate's top-level modules and the files of each.
@@ -202,7 +200,14 @@ fn functions(text: &str) -> Vec<(usize, String, usize)> {
         let Some(at) = words.iter().position(|w| *w == "fn") else {
             continue;
         };
-        let qualifiers = ["pub", "pub(crate)", "pub(super)", "const", "unsafe", "async"];
+        let qualifiers = [
+            "pub",
+            "pub(crate)",
+            "pub(super)",
+            "const",
+            "unsafe",
+            "async",
+        ];
         if !words[..at].iter().all(|w| qualifiers.contains(w)) || t.trim_end().ends_with(';') {
             continue;
         }
@@ -210,7 +215,11 @@ fn functions(text: &str) -> Vec<(usize, String, usize)> {
         let end = (i + 1..lines.len())
             .find(|&k| is_closing(lines[k], indent))
             .unwrap_or(lines.len() - 1);
-        found.push((i + 1, words.get(at + 1).unwrap_or(&"").to_string(), end - i + 1));
+        found.push((
+            i + 1,
+            words.get(at + 1).unwrap_or(&"").to_string(),
+            end - i + 1,
+        ));
     }
     found
 }
@@ -258,5 +267,8 @@ fn no_library_returns_a_string_error() {
             }
         }
     }
-    assert!(found.is_empty(), "public functions with a String error: {found:#?}");
+    assert!(
+        found.is_empty(),
+        "public functions with a String error: {found:#?}"
+    );
 }

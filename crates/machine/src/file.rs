@@ -16,7 +16,7 @@ use crate::model::{
 use crate::pressure::{PressureAxis, WheelModel};
 
 mod solids;
-pub use solids::{MAX_MESH_BYTES, MeshFiles, mesh_from_stl};
+pub use solids::{MAX_MESH_BYTES, MeshFiles, StlError, mesh_from_stl};
 
 /// How far from 1 the length of a direction may be (it is then normalised).
 const UNIT_TOLERANCE: f64 = 1e-6;

@@ -395,6 +395,169 @@ impl Rigid {
     }
 }
 
+/// The effective orientation chain (directions only) of `chain` (axis
+/// and sign, outermost first): the free rotary axes with their directions,
+/// and the constant rotations before, between and after them.
+fn orientation_chain(
+    machine: &Machine,
+    chain: &[(usize, f64)],
+) -> (Vec<(usize, V3)>, Vec<Matrix3<f64>>) {
+    let mut free_rot = Vec::new();
+    let mut between = vec![Matrix3::identity()];
+    for &(i, sign) in chain {
+        let a = &machine.axes[i];
+        if !a.is_rotary() {
+            continue;
+        }
+        let w = a.direction * sign;
+        match a.fixed {
+            Some(v) => {
+                let last = between.last_mut().expect("never empty");
+                *last *= rotation(&w, rad(v));
+            }
+            None => {
+                free_rot.push((i, w));
+                between.push(Matrix3::identity());
+            }
+        }
+    }
+    (free_rot, between)
+}
+
+/// The chain's motions in the part frame, the constants of locked rotary
+/// axes carried inwards, and the product of those constants (which moves
+/// the tool frame).
+fn motion_steps(
+    machine: &Machine,
+    chain: &[(usize, f64)],
+    free_lin: &[usize],
+    free_rot: &[(usize, V3)],
+) -> (Vec<Step>, Rigid) {
+    let rw0t = machine.workpiece_rotation.transpose();
+    let mut carried = Rigid {
+        rot: Rot::from_matrix(&rw0t),
+        shift: -(rw0t * machine.workpiece_origin),
+    };
+    let mut steps = Vec::new();
+    for &(i, sign) in chain {
+        let a = &machine.axes[i];
+        let dir = a.direction * sign;
+        match (a.kind, a.fixed) {
+            (AxisKind::Linear, _) => steps.push(Step::Linear {
+                axis: i,
+                column: free_lin.iter().position(|&j| j == i),
+                dir: carried.rot.apply(&dir),
+            }),
+            (AxisKind::Rotary, Some(v)) => {
+                carried = carried.then_inner(&Rigid::about(&dir, &a.point, v));
+            }
+            (AxisKind::Rotary, None) => {
+                let slot = free_rot.iter().position(|&(j, _)| j == i).expect("free");
+                steps.push(Step::Rotary(Turn::new(
+                    i,
+                    slot,
+                    carried.rot.apply(&dir),
+                    carried.rot.apply(&a.point) + carried.shift,
+                )));
+            }
+        }
+    }
+    (steps, carried)
+}
+
+/// The slots of the free rotary axes: their travel, and the arc of it
+/// where it is less than a full turn and a degree.
+fn rotary_slots(steps: &[Step], limits: &[Option<[f64; 2]>; MAX_AXES]) -> [Slot; 3] {
+    let mut slots = [Slot::default(); 3];
+    for step in steps {
+        if let Step::Rotary(t) = step {
+            let limits = limits[t.axis];
+            slots[t.slot] = Slot {
+                axis: t.axis,
+                limits,
+                // A travel of a full turn and a degree has an equivalent of
+                // every angle, with margin over the rounding of
+                // `turn_range`.
+                arc: match limits {
+                    Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
+                    _ => None,
+                },
+            };
+        }
+    }
+    slots
+}
+
+/// The linear axes of a chain as the inverse kinematics solves them.
+struct LinearPart {
+    /// The first step that is a free linear axis.
+    split: usize,
+    /// The steps after it that are not free linear axes.
+    inner_fixed: Vec<Step>,
+    /// The travel of each free linear axis, with a slack for rounding.
+    bounds: Vec<(usize, [f64; 2])>,
+    solve: LinearSolve,
+}
+
+impl LinearPart {
+    fn of(steps: &[Step], free_lin: &[usize], limits: &[Option<[f64; 2]>; MAX_AXES]) -> LinearPart {
+        let is_free_linear = |s: &Step| {
+            matches!(
+                s,
+                Step::Linear {
+                    column: Some(_),
+                    ..
+                }
+            )
+        };
+        let split = steps.iter().position(is_free_linear).unwrap_or(steps.len());
+        let last_linear = steps.iter().rposition(is_free_linear).unwrap_or(split);
+        let turns_between = steps[split..last_linear.max(split)]
+            .iter()
+            .any(|s| matches!(s, Step::Rotary(_)));
+        let inner_fixed = steps[split..]
+            .iter()
+            .filter(|s| !is_free_linear(s))
+            .copied()
+            .collect();
+        let mut columns = [V3::zeros(); 3];
+        for s in steps {
+            if let Step::Linear {
+                column: Some(k),
+                dir,
+                ..
+            } = s
+            {
+                columns[*k] = *dir;
+            }
+        }
+        let bounds: Vec<(usize, [f64; 2])> = free_lin
+            .iter()
+            .map(|&i| {
+                let b = match limits[i] {
+                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
+                    None => [f64::NEG_INFINITY, f64::INFINITY],
+                };
+                (i, b)
+            })
+            .collect();
+        let solve = match cramer_rows(&columns) {
+            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant {
+                rows,
+                axes: [free_lin[0], free_lin[1], free_lin[2]],
+                bounds: std::array::from_fn(|k| bounds[k].1),
+            },
+            _ => LinearSolve::General,
+        };
+        LinearPart {
+            split,
+            inner_fixed,
+            bounds,
+            solve,
+        }
+    }
+}
+
 impl Kinematics {
     /// Compiles a validated machine.
     pub fn new(machine: &Machine) -> Kinematics {
@@ -424,125 +587,20 @@ impl Kinematics {
             .collect();
         let free_lin: Vec<usize> = (0..n).filter(|&i| !rotary[i] && !is_fixed[i]).collect();
 
-        // Effective orientation chain (directions only): the free rotary
-        // axes and the constant rotations between them.
-        let mut free_rot = Vec::new();
-        let mut between = vec![Matrix3::identity()];
-        for &(i, sign) in &chain {
-            if !rotary[i] {
-                continue;
-            }
-            let w = machine.axes[i].direction * sign;
-            if is_fixed[i] {
-                let last = between.last_mut().expect("never empty");
-                *last *= rotation(&w, rad(fixed[i]));
-            } else {
-                free_rot.push((i, w));
-                between.push(Matrix3::identity());
-            }
-        }
-
-        // The constants carried inwards: `carried` is the product of the
-        // constant motions met so far.
-        let rw0t = machine.workpiece_rotation.transpose();
-        let mut carried = Rigid {
-            rot: Rot::from_matrix(&rw0t),
-            shift: -(rw0t * machine.workpiece_origin),
-        };
-        let mut steps = Vec::new();
-        for &(i, sign) in &chain {
-            let a = &machine.axes[i];
-            let dir = a.direction * sign;
-            match (a.kind, a.fixed) {
-                (AxisKind::Linear, _) => steps.push(Step::Linear {
-                    axis: i,
-                    column: free_lin.iter().position(|&j| j == i),
-                    dir: carried.rot.apply(&dir),
-                }),
-                (AxisKind::Rotary, Some(v)) => {
-                    carried = carried.then_inner(&Rigid::about(&dir, &a.point, v));
-                }
-                (AxisKind::Rotary, None) => {
-                    let slot = free_rot.iter().position(|&(j, _)| j == i).expect("free");
-                    steps.push(Step::Rotary(Turn::new(
-                        i,
-                        slot,
-                        carried.rot.apply(&dir),
-                        carried.rot.apply(&a.point) + carried.shift,
-                    )));
-                }
-            }
-        }
+        let (free_rot, between) = orientation_chain(machine, &chain);
+        let (steps, carried) = motion_steps(machine, &chain, &free_lin, &free_rot);
         let tool = &machine.tool;
         let tip = carried.rot.apply(&tool.point) + carried.shift;
         let tip_axis = carried.rot.apply(&tool.axis);
         let tip_reference = carried.rot.apply(&tool.reference.unwrap_or_else(V3::zeros));
-
-        let mut slots = [Slot::default(); 3];
-        for step in &steps {
-            if let Step::Rotary(t) = step {
-                let limits = limits[t.axis];
-                slots[t.slot] = Slot {
-                    axis: t.axis,
-                    limits,
-                    // A travel of a full turn and a degree has an
-                    // equivalent of every angle, with margin over the
-                    // rounding of `turn_range`.
-                    arc: match limits {
-                        Some([lo, hi]) if hi - lo < 361.0 => Some(Arc::new(lo, hi)),
-                        _ => None,
-                    },
-                };
-            }
-        }
-        let is_free_linear = |s: &Step| {
-            matches!(
-                s,
-                Step::Linear {
-                    column: Some(_),
-                    ..
-                }
-            )
-        };
-        let split = steps.iter().position(is_free_linear).unwrap_or(steps.len());
-        let last_linear = steps.iter().rposition(is_free_linear).unwrap_or(split);
-        let turns_between = steps[split..last_linear.max(split)]
-            .iter()
-            .any(|s| matches!(s, Step::Rotary(_)));
-        let inner_fixed = steps[split..]
-            .iter()
-            .filter(|s| !is_free_linear(s))
-            .copied()
-            .collect();
-        let mut columns = [V3::zeros(); 3];
-        for s in &steps {
-            if let Step::Linear {
-                column: Some(k),
-                dir,
-                ..
-            } = s
-            {
-                columns[*k] = *dir;
-            }
-        }
-        let free_lin_bounds: Vec<(usize, [f64; 2])> = free_lin
-            .iter()
-            .map(|&i| {
-                let bounds = match limits[i] {
-                    Some([lo, hi]) => [lo - 1e-9, hi + 1e-9],
-                    None => [f64::NEG_INFINITY, f64::INFINITY],
-                };
-                (i, bounds)
-            })
-            .collect();
-        let linear_solve = match cramer_rows(&columns) {
-            Some(rows) if free_lin.len() == 3 && !turns_between => LinearSolve::Constant {
-                rows,
-                axes: [free_lin[0], free_lin[1], free_lin[2]],
-                bounds: std::array::from_fn(|k| free_lin_bounds[k].1),
-            },
-            _ => LinearSolve::General,
-        };
+        let slots = rotary_slots(&steps, &limits);
+        let linear = LinearPart::of(&steps, &free_lin, &limits);
+        let (split, inner_fixed, free_lin_bounds, linear_solve) = (
+            linear.split,
+            linear.inner_fixed,
+            linear.bounds,
+            linear.solve,
+        );
 
         let (sp2_w2, sp2_p) = match free_rot.len() {
             2 => (

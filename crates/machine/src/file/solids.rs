@@ -280,14 +280,44 @@ fn read_mesh(name: &str, meshes: MeshFiles) -> Result<Mesh, String> {
     mesh_from_stl(&bytes, name).map_err(|e| format!("mesh file `{name}`: {e}"))
 }
 
+/// Why an STL file cannot be a mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StlError {
+    /// The STL reader refuses it (its message).
+    Unreadable(String),
+    /// No triangle.
+    NoTriangle,
+    /// A vertex not finite or too far out.
+    Vertex([f64; 3]),
+    /// More vertices than a `u32` counts.
+    TooManyVertices,
+}
+
+impl std::fmt::Display for StlError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StlError::Unreadable(e) => write!(f, "not a readable STL file ({e})"),
+            StlError::NoTriangle => f.write_str("the STL file has no triangle"),
+            StlError::Vertex(v) => write!(
+                f,
+                "a vertex ({}, {}, {}) is not finite or farther than {MAX_COORDINATE_MM:e} mm out",
+                v[0], v[1], v[2]
+            ),
+            StlError::TooManyVertices => f.write_str("more vertices than 2^32"),
+        }
+    }
+}
+
+impl std::error::Error for StlError {}
+
 /// A mesh from the bytes of an STL file (binary or ASCII), mm. `source`
 /// names it in messages. Its vertices must be finite and within
 /// 1e6 mm of the origin, and it must have a triangle.
-pub fn mesh_from_stl(bytes: &[u8], source: &str) -> Result<Mesh, String> {
+pub fn mesh_from_stl(bytes: &[u8], source: &str) -> Result<Mesh, StlError> {
     let read = stl_io::read_stl(&mut std::io::Cursor::new(bytes))
-        .map_err(|e| format!("not a readable STL file ({e})"))?;
+        .map_err(|e| StlError::Unreadable(e.to_string()))?;
     if read.faces.is_empty() {
-        return Err("the STL file has no triangle".into());
+        return Err(StlError::NoTriangle);
     }
     let vertices: Vec<[f64; 3]> = read
         .vertices
@@ -298,13 +328,10 @@ pub fn mesh_from_stl(bytes: &[u8], source: &str) -> Result<Mesh, String> {
         v.iter()
             .any(|x| !x.is_finite() || x.abs() > MAX_COORDINATE_MM)
     }) {
-        return Err(format!(
-            "a vertex ({}, {}, {}) is not finite or farther than {MAX_COORDINATE_MM:e} mm out",
-            v[0], v[1], v[2]
-        ));
+        return Err(StlError::Vertex(*v));
     }
     let Ok(count) = u32::try_from(vertices.len()) else {
-        return Err("more vertices than 2^32".into());
+        return Err(StlError::TooManyVertices);
     };
     let triangles = read
         .faces
