@@ -424,6 +424,11 @@ impl<W: Write> NcWriter<W> {
         }
     }
 
+    /// The output, as written so far (every line goes to it whole, at once).
+    pub fn get_ref(&self) -> &W {
+        &self.out
+    }
+
     /// Number of motion blocks written so far.
     pub fn blocks_written(&self) -> u64 {
         self.blocks

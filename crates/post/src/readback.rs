@@ -21,13 +21,13 @@ pub enum ReadBackError {
     /// The dialect's reader refuses the program.
     #[error("the program does not read back: {0}")]
     Unreadable(Box<Diagnostic>),
-    /// Another number of motion blocks.
-    #[error("{written} blocks written, {read} read back")]
-    Count {
-        /// Blocks written.
-        written: usize,
-        /// Blocks read.
-        read: usize,
+    /// A written block is not read back at its line.
+    #[error("block {index} (program line {line}) does not read back as a block")]
+    Missing {
+        /// 0-based index among the blocks written.
+        index: usize,
+        /// Its line in the program.
+        line: usize,
     },
     /// A block reads back with another value or motion.
     #[error("block {index} (program line {line}) reads back as {read}, written as {written}")]
@@ -43,16 +43,18 @@ pub enum ReadBackError {
     },
 }
 
-/// The output of a program, kept as it is written.
+/// The output of a program, kept as it is written, with its lines counted.
 struct Tee<W> {
     out: W,
     text: Vec<u8>,
+    lines: usize,
 }
 
 impl<W: Write> Write for Tee<W> {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         let n = self.out.write(buf)?;
         self.text.extend_from_slice(&buf[..n]);
+        self.lines += buf[..n].iter().filter(|&&b| b == b'\n').count();
         Ok(n)
     }
 
@@ -61,10 +63,16 @@ impl<W: Write> Write for Tee<W> {
     }
 }
 
-/// A block as written: its motion and its rounded values.
-struct Written {
-    motion: Motion,
-    values: Vec<f64>,
+/// A block as written: its line in the program, its motion and its values
+/// rounded as written (NaN: no value, e.g. no pressure programmed).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WrittenBlock {
+    /// 1-based line of the program.
+    pub line: usize,
+    /// Rapid or feed.
+    pub motion: Motion,
+    /// The values, machine order, rounded as written.
+    pub values: Vec<f64>,
 }
 
 /// An NC writer whose program is read back at [`ProgramWriter::finish`]
@@ -73,37 +81,36 @@ pub struct ReadBack<W: Write> {
     writer: NcWriter<Tee<W>>,
     dialect: Dialect,
     axes: Vec<AxisSpec>,
-    written: Vec<Written>,
+    written: Vec<WrittenBlock>,
 }
 
-/// The blocks read back from `text` against those `written`: every block
-/// the writer wrote (a block that changes no word is not written), with its
-/// values as rounded.
-fn compare(
+/// The program `text` read with `dialect`'s reader against the blocks the
+/// writer wrote into it: each written block must read back, at its line,
+/// with its motion and every value it carries (other lines, e.g. a
+/// header's, are not the writer's blocks; a value the dialect never writes,
+/// a locked axis, reads back as none).
+pub fn compare_read_back(
     dialect: &Dialect,
     axes: &[AxisSpec],
-    written: &[Written],
+    written: &[WrittenBlock],
     text: &str,
 ) -> Result<(), ReadBackError> {
     let read = read_program(dialect, axes, "read-back", text)
         .map_err(|d| ReadBackError::Unreadable(Box::new(d)))?;
-    // Blocks that repeat the one before are not written.
-    let mut expected: Vec<&Written> = Vec::new();
-    for w in written {
-        if expected.last().is_none_or(|l| l.values != w.values) {
-            expected.push(w);
-        }
-    }
-    if expected.len() != read.len() {
-        return Err(ReadBackError::Count {
-            written: expected.len(),
-            read: read.len(),
-        });
-    }
-    for (index, (w, r)) in expected.iter().zip(&read).enumerate() {
+    let mut at = read.iter().peekable();
+    for (index, w) in written.iter().enumerate() {
+        while at.next_if(|r| r.line < w.line).is_some() {}
+        let Some(r) = at.next_if(|r| r.line == w.line) else {
+            return Err(ReadBackError::Missing {
+                index,
+                line: w.line,
+            });
+        };
+        // (An axis the dialect never writes, a locked one, reads back as
+        // no value.)
         let same = w.motion == r.motion
             && w.values.iter().zip(&r.axes).all(|(w, r)| match r {
-                Some(r) => w.to_bits() == r.to_bits() || (w.is_nan() && r.is_nan()),
+                Some(r) => w.to_bits() == r.to_bits(),
                 None => true,
             });
         if !same {
@@ -116,6 +123,13 @@ fn compare(
         }
     }
     Ok(())
+}
+
+impl<W: Write> ReadBack<W> {
+    /// Lines written so far (the writer writes whole lines at once).
+    fn writer_lines(&self) -> usize {
+        self.writer.get_ref().lines
+    }
 }
 
 impl<W: Write> BlockSink for ReadBack<W> {
@@ -136,11 +150,17 @@ impl<W: Write> BlockSink for ReadBack<W> {
                 }
             })
             .collect();
+        let before = self.writer_lines();
         self.writer.block(block)?;
-        self.written.push(Written {
-            motion: block.motion,
-            values,
-        });
+        // A block that changes no word is not written.
+        let after = self.writer_lines();
+        if after > before {
+            self.written.push(WrittenBlock {
+                line: after,
+                motion: block.motion,
+                values,
+            });
+        }
         Ok(())
     }
 
@@ -169,6 +189,7 @@ impl<W: Write> ProgramWriter for ReadBack<W> {
                 Tee {
                     out,
                     text: Vec::new(),
+                    lines: 0,
                 },
             ),
             dialect: dialect.clone(),
@@ -202,6 +223,6 @@ impl<W: Write> ProgramWriter for ReadBack<W> {
         let mut tee = ProgramWriter::finish(self.writer)?;
         tee.flush()?;
         let text = String::from_utf8_lossy(&tee.text);
-        Ok(compare(&self.dialect, &self.axes, &self.written, &text).map(|()| tee.out))
+        Ok(compare_read_back(&self.dialect, &self.axes, &self.written, &text).map(|()| tee.out))
     }
 }
