@@ -53,7 +53,7 @@ pub struct PathPoint {
 #[derive(Debug, Clone, Copy)]
 pub struct Planned<'a> {
     /// The configuration decided and the pose it reaches.
-    pub node: Node,
+    pub node: &'a Node,
     /// Rapid or feed.
     pub motion: Motion,
     /// The CL feed rate in force, mm/min.
@@ -575,7 +575,7 @@ impl<C> Planner<C> {
         sink.point(
             kin,
             &Planned {
-                node: d.node,
+                node: &d.node,
                 motion: p.motion,
                 feed: p.feed,
                 pressure: p.pressure,

@@ -76,7 +76,7 @@ fn the_linearization_keeps_the_contact_point_on_the_segment() {
         .collect();
     for (k, node) in nodes.iter().enumerate() {
         let planned = Planned {
-            node: *node,
+            node,
             motion: if k == 0 { Motion::Rapid } else { Motion::Feed },
             feed: Some(300.0),
             pressure: f64::NAN,

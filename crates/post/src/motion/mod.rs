@@ -221,21 +221,22 @@ impl<S: MotionSink> MotionStage<S> {
             l.segment_line = t.site.line;
         }
         self.pressure_change(kin, t)?;
-        if let Some(last) = self.last
-            && t.motion == Motion::Feed
+        if t.motion == Motion::Feed
+            && let Some(last) = &self.last
         {
             if t.cut && !t.continuous {
+                let last = *last;
                 for node in &self.reconfigure(kin, &last, t)? {
                     self.inserted(kin, node, Motion::Feed, t)?;
                 }
             } else {
-                self.linearize(kin, &last, t)?;
+                self.linearize(kin, t)?;
             }
         }
         if t.motion == Motion::Rapid {
             self.unwind_where_the_rapid_ends(kin, t)?;
         }
-        self.block(kin, &t.node, t.motion, Some(t.site.line), t)
+        self.block(kin, t.node, t.motion, Some(t.site.line), t)
     }
 
     /// The wheel moves with the pressure (Qi, thesis, ch. 3): the last
@@ -280,22 +281,18 @@ impl<S: MotionSink> MotionStage<S> {
         Ok(())
     }
 
-    /// The blocks that linearize the feed move from `last` into `t`.
-    fn linearize(
-        &mut self,
-        kin: &Kinematics,
-        last: &Last,
-        t: &Planned<'_>,
-    ) -> Result<(), PostError> {
-        let Some(l) = &mut self.linearizer else {
+    /// The blocks that linearize the feed move from the last block into
+    /// `t`.
+    fn linearize(&mut self, kin: &Kinematics, t: &Planned<'_>) -> Result<(), PostError> {
+        let (Some(l), Some(last)) = (&mut self.linearizer, &self.last) else {
             return Ok(());
         };
-        if l.settles(kin, &last.node, &t.node, last.lever) {
+        if l.settles(kin, &last.node, t.node, last.lever) {
             return Ok(());
         }
         let mut inserted = std::mem::take(&mut self.inserted);
         inserted.clear();
-        match l.split(kin, &last.node, &t.node, last.lever, 0, &mut inserted) {
+        match l.split(kin, &last.node, t.node, last.lever, 0, &mut inserted) {
             Ok(()) => {}
             // A move that starts a segment may be a repositioning the CL
             // asks for at feed: it is written as it is.
@@ -321,7 +318,7 @@ impl<S: MotionSink> MotionStage<S> {
         let Some(last) = &self.last else {
             return Ok(());
         };
-        let mut kept = t.node;
+        let mut kept = *t.node;
         for &i in &self.unwind {
             let turns = ((last.node.joints[i] - kept.joints[i]) / 360.0).round();
             kept.joints[i] += 360.0 * turns;

@@ -26,7 +26,7 @@ impl<S: MotionSink> MotionStage<S> {
         last: &Last,
         t: &Planned<'_>,
     ) -> Result<Vec<Node>, PostError> {
-        let (from, to) = (&last.node, &t.node);
+        let (from, to) = (&last.node, t.node);
         let (axis, a, b) = self.largest_jump(&from.joints, &to.joints);
         if !self.reconfigure {
             return Err(t
