@@ -502,6 +502,7 @@ impl Dialect {
                 );
             }
             check_variables(&env, kind_t, t, source, &mut err);
+            check_budget(&env, kind_t, t, source, &mut err);
             templates.insert(kind_t, t.get_ref().clone());
         }
 
@@ -876,6 +877,37 @@ fn check_variables(
     }
 }
 
+/// A template that goes past its budget (fuel, output, nesting) with sample
+/// values would stop a post, or run for long before it does: refused at
+/// load, where it is written.
+fn check_budget(
+    env: &Environment<'static>,
+    kind: TemplateKind,
+    t: &Spanned<String>,
+    source: &str,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    let vars = template::sample_vars("sample", kind.variables());
+    if let Some(e) = template::budget_error(env, kind.key(), &vars) {
+        err(
+            template::error_span_in_toml(source, t.span(), t.get_ref(), &e),
+            budget_message(kind, &e),
+        );
+    }
+}
+
+fn budget_message(kind: TemplateKind, e: &minijinja::Error) -> String {
+    format!(
+        "template `{}` rendered with sample values: {} (a template may run about {} \
+         instructions, make about {} MB of data and write {} bytes)",
+        kind.key(),
+        template::error_message(e),
+        template::TEMPLATE_FUEL,
+        template::TEMPLATE_FUEL * 64 / 1_000_000,
+        template::MAX_TEMPLATE_OUTPUT_BYTES,
+    )
+}
+
 /// The variables the writer gives template `kind`.
 fn given_variables(kind: TemplateKind) -> Vec<&'static str> {
     ProgramInfo::VARIABLES
@@ -918,7 +950,17 @@ pub fn check_template(kind: TemplateKind, source: &str) -> Result<(), TemplateEr
             line: Some(source[..range.start].matches('\n').count() + 1),
             range: Some(range),
         }),
-        None => Ok(()),
+        None => {
+            let vars = template::sample_vars("sample", kind.variables());
+            match template::budget_error(&env, kind.key(), &vars) {
+                Some(e) => Err(TemplateError {
+                    message: budget_message(kind, &e),
+                    range: template::error_range(source, &e),
+                    line: e.line(),
+                }),
+                None => Ok(()),
+            }
+        }
     }
 }
 

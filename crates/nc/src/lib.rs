@@ -24,6 +24,7 @@ use std::collections::BTreeMap;
 mod dialect;
 mod number;
 mod reader;
+mod sanitize;
 mod template;
 mod writer;
 
@@ -35,8 +36,11 @@ pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use minijinja::Value;
 pub use number::{MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
-pub use template::{TemplateError, template_span_in_toml};
-pub use writer::{NcWriter, Spindle};
+pub use template::{
+    MAX_TEMPLATE_OUTPUT_BYTES, TEMPLATE_FUEL, TEMPLATE_RECURSION_LIMIT, TemplateError,
+    template_span_in_toml,
+};
+pub use writer::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
 
 /// One machine axis as the writer and reader need it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -235,6 +239,16 @@ pub enum NcError {
         /// What went wrong.
         message: String,
     },
+    /// A value that cannot stand in a program: one that would be written as
+    /// 0 or is too large to write (a spindle speed, a tool number).
+    Value {
+        /// What it is (`spindle speed`).
+        what: &'static str,
+        /// The value as given.
+        value: String,
+        /// Why it cannot be written, and what can be.
+        reason: String,
+    },
     /// A line longer than the dialect's `max_line_length` that is not a
     /// comment to shorten (a CL `INSERT`, a template line).
     LineTooLong {
@@ -265,6 +279,11 @@ impl std::fmt::Display for NcError {
                 }
                 write!(f, ": {message}")
             }
+            NcError::Value {
+                what,
+                value,
+                reason,
+            } => write!(f, "cannot write the {what} {value}: {reason}"),
             NcError::LineTooLong {
                 source,
                 text,
@@ -287,7 +306,7 @@ impl std::error::Error for NcError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             NcError::Io(e) => Some(e),
-            NcError::Template { .. } | NcError::LineTooLong { .. } => None,
+            NcError::Template { .. } | NcError::Value { .. } | NcError::LineTooLong { .. } => None,
         }
     }
 }
