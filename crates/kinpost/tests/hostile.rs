@@ -1,0 +1,369 @@
+//! The command under hostile or unlucky input: nothing from outside
+//! becomes code, templates stop, outputs are all or nothing (signals
+//! included), values are range-checked, readers stay linear, every input
+//! error is located.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn kinpost(dir: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_kinpost"));
+    c.args(args).current_dir(dir);
+    c
+}
+
+fn run(dir: &Path, args: &[&str]) -> Output {
+    kinpost(dir, args).output().expect("run kinpost")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[track_caller]
+fn assert_exit(o: &Output, code: i32) {
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "stdout:\n{}\nstderr:\n{}",
+        stdout(o),
+        stderr(o)
+    );
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A short CL file for `trunnion-ac`.
+const CL: &str =
+    "TOOL PATH/P1,TOOL,T1\nSPINDL/1200,CLW\nFEDRAT/MMPM,500\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n";
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Whether a line of a program (block number and blanks skipped) starts
+/// with the code the tests try to inject.
+fn injected(program: &str) -> Option<&str> {
+    program.lines().find(|l| {
+        let code = l.trim_start_matches(|c: char| c.is_ascii_digit() || c == ' ' || c == 'N');
+        code.starts_with("G0 Z-100") || code.starts_with("G00 Z-100") || code.starts_with(";.cls")
+    })
+}
+
+#[test]
+fn a_line_break_in_the_cl_file_name_is_no_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "part\nG0 Z-100\n;.cls";
+    write(dir.path(), name, CL);
+    for dialect in ["sinumerik", "linuxcnc", "heidenhain", "fanuc"] {
+        let o = run(
+            dir.path(),
+            &["post", name, "-m", "trunnion-ac", "-d", dialect, "-q"],
+        );
+        assert_exit(&o, 0);
+        let program = stdout(&o);
+        assert_eq!(injected(&program), None, "{dialect}:\n{program}");
+        assert!(
+            program.contains("part G0 Z-100 ;.cls"),
+            "{dialect}:\n{program}"
+        );
+    }
+}
+
+#[test]
+fn control_characters_in_partno_and_tool_path_stay_out_of_the_header() {
+    let dir = tempfile::tempdir().unwrap();
+    for first in [
+        "PARTNO NAME\rG00 Z-100\u{0}\u{c}\u{b}\u{1b}",
+        "TOOL PATH/NAME\rG00 Z-100\u{1b},TOOL,T1",
+    ] {
+        write(
+            dir.path(),
+            "p.cls",
+            &format!("{first}\n{}", &CL[CL.find('\n').unwrap() + 1..]),
+        );
+        for dialect in ["sinumerik", "linuxcnc", "heidenhain", "fanuc"] {
+            let o = run(
+                dir.path(),
+                &["post", "p.cls", "-m", "trunnion-ac", "-d", dialect, "-q"],
+            );
+            assert_exit(&o, 0);
+            let program = stdout(&o);
+            assert!(
+                !program.bytes().any(|b| b < 0x20 && b != b'\n'),
+                "{dialect}: {program:?}"
+            );
+        }
+    }
+}
+
+/// A dialect file whose header runs without end, or doubles a string, is
+/// refused at load, at its line, in seconds, and leaves no temporary file.
+#[test]
+fn runaway_templates_are_refused_with_their_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(root().join("crates/nc/dialects/sinumerik.toml")).unwrap();
+    let loops =
+        "{% for a in range(100000) %}{% for b in range(100000) %}{{ a }}{% endfor %}{% endfor %}";
+    let doubling = "{% set ns = namespace(s='0123456789') %}{% for i in range(40) %}{% set ns.s = ns.s ~ ns.s %}{% endfor %}{{ ns.s }}";
+    for (k, t) in [loops, doubling].into_iter().enumerate() {
+        let dialect = base.replacen("G90 G71 G17 G64\n", &format!("G90 G71 G17 G64\n{t}\n"), 1);
+        write(dir.path(), "mine.toml", &dialect);
+        write(dir.path(), "p.cls", CL);
+        let started = Instant::now();
+        let o = run(
+            dir.path(),
+            &[
+                "post",
+                "p.cls",
+                "-m",
+                "trunnion-ac",
+                "-d",
+                "./mine.toml",
+                "-o",
+                "p.mpf",
+            ],
+        );
+        assert!(started.elapsed() < Duration::from_secs(20), "{k}");
+        assert_exit(&o, 1);
+        let err = stderr(&o);
+        assert!(err.contains("mine.toml:"), "{err}");
+        assert!(err.contains("rendered with sample values"), "{err}");
+        assert_eq!(listing(dir.path()), ["mine.toml", "p.cls"]);
+        let o = run(dir.path(), &["dialect", "check", "mine.toml"]);
+        assert_exit(&o, 1);
+        assert!(stderr(&o).contains("mine.toml:"), "{}", stderr(&o));
+        // A machine file whose header does the same is not valid.
+        let machine =
+            std::fs::read_to_string(root().join("crates/machine/machines/trunnion-ac.toml"))
+                .unwrap()
+                .replacen("[post]\n", &format!("[post]\nheader = '''\n{t}\n'''\n"), 1);
+        write(dir.path(), "m.toml", &machine);
+        let o = run(dir.path(), &["machine", "check", "m.toml"]);
+        assert_exit(&o, 1);
+        assert!(stderr(&o).contains("m.toml:"), "{}", stderr(&o));
+        std::fs::remove_file(dir.path().join("m.toml")).unwrap();
+    }
+    let o = run(dir.path(), &["dialect", "check", "sinumerik"]);
+    assert_exit(&o, 0);
+}
+
+#[test]
+fn a_failed_output_leaves_no_other_output() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "p.cls", CL);
+    let o = run(
+        dir.path(),
+        &[
+            "post",
+            "p.cls",
+            "-m",
+            "trunnion-ac",
+            "-o",
+            "x.mpf",
+            "--json",
+            "/dev/full",
+        ],
+    );
+    assert_exit(&o, 1);
+    assert_eq!(listing(dir.path()), ["p.cls"]);
+    // The same for `path`.
+    let pts = dir.path().join("pts.csv");
+    let mut text = String::new();
+    for i in 0..5 {
+        for j in 0..5 {
+            text.push_str(&format!(
+                "{i},{j},{},{},0\n",
+                f64::from(i) * 10.0,
+                f64::from(j) * 10.0
+            ));
+        }
+    }
+    std::fs::write(&pts, text).unwrap();
+    let o = run(dir.path(), &["surface", "fit", "pts.csv", "-o", "s.json"]);
+    assert_exit(&o, 0);
+    let o = run(
+        dir.path(),
+        &[
+            "path",
+            "s.json",
+            "--tool",
+            "wheel:radius=50,width=20",
+            "--stepover",
+            "5",
+            "--feed",
+            "600",
+            "-o",
+            "p2.cls",
+            "--svg",
+            "/dev/full",
+        ],
+    );
+    assert_exit(&o, 1);
+    assert_eq!(listing(dir.path()), ["p.cls", "pts.csv", "s.json"]);
+}
+
+#[cfg(unix)]
+#[test]
+fn two_links_to_one_new_file_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "p.cls", CL);
+    std::os::unix::fs::symlink("new.mpf", dir.path().join("a.lnk")).unwrap();
+    std::os::unix::fs::symlink("new.mpf", dir.path().join("b.lnk")).unwrap();
+    let o = run(
+        dir.path(),
+        &[
+            "post",
+            "p.cls",
+            "-m",
+            "trunnion-ac",
+            "-o",
+            "a.lnk",
+            "--json",
+            "b.lnk",
+        ],
+    );
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("same file"), "{}", stderr(&o));
+    assert!(!dir.path().join("new.mpf").exists());
+}
+
+#[cfg(unix)]
+#[test]
+fn standard_input_that_is_the_output_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let cl = write(dir.path(), "f.cls", CL);
+    let o = kinpost(
+        dir.path(),
+        &["post", "-", "-m", "trunnion-ac", "-o", "f.cls"],
+    )
+    .stdin(std::fs::File::open(&cl).unwrap())
+    .output()
+    .unwrap();
+    assert_exit(&o, 2);
+    assert!(stderr(&o).contains("standard input"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&cl).unwrap(), CL);
+}
+
+/// SIGINT, SIGTERM and SIGHUP in the middle of a post remove its staged
+/// files; the exit code is 128 + the signal.
+#[cfg(unix)]
+#[test]
+fn a_signal_leaves_no_temporary_file() {
+    for (signal, number) in [("INT", 2), ("TERM", 15), ("HUP", 1)] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut child = kinpost(
+            dir.path(),
+            &[
+                "post",
+                "-",
+                "-m",
+                "trunnion-ac",
+                "-o",
+                "out.mpf",
+                "--json",
+                "out.json",
+            ],
+        )
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+        let mut input = child.stdin.take().unwrap();
+        input.write_all(b"FEDRAT/MMPM,500\n").unwrap();
+        for i in 0..20_000 {
+            writeln!(input, "GOTO/{}.0,0,0,0,0,1", i % 100).unwrap();
+        }
+        input.flush().unwrap();
+        // Both outputs are staged while the post waits for more input.
+        let started = Instant::now();
+        while listing(dir.path()).len() < 2 {
+            assert!(
+                started.elapsed() < Duration::from_secs(20),
+                "{signal}: nothing staged"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let killed = Command::new("kill")
+            .args([format!("-{signal}"), child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let o = child.wait_with_output().unwrap();
+        drop(input);
+        assert_eq!(
+            o.status.code(),
+            Some(128 + number),
+            "{signal}: {}",
+            stderr(&o)
+        );
+        assert_eq!(listing(dir.path()), Vec::<String>::new(), "{signal}");
+    }
+}
+
+#[test]
+fn spindle_speeds_out_of_range_are_errors_with_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    for speed in ["0.4", "1e308"] {
+        write(
+            dir.path(),
+            "p.cls",
+            &CL.replace("SPINDL/1200", &format!("SPINDL/{speed}")),
+        );
+        for dialect in ["sinumerik", "linuxcnc", "heidenhain", "fanuc"] {
+            let o = run(
+                dir.path(),
+                &[
+                    "post",
+                    "p.cls",
+                    "-m",
+                    "trunnion-ac",
+                    "-d",
+                    dialect,
+                    "-o",
+                    "p.nc",
+                ],
+            );
+            assert_exit(&o, 1);
+            let err = stderr(&o);
+            assert!(err.contains("p.cls:2:"), "{dialect} {speed}: {err}");
+            assert!(err.contains("spindle speed"), "{dialect} {speed}: {err}");
+            assert_eq!(listing(dir.path()), ["p.cls"]);
+        }
+    }
+}
+
+/// Standard output is spooled, not held in memory, and a failed run
+/// prints no part of its program.
+#[test]
+fn a_failed_run_prints_nothing_on_standard_output() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "p.cls",
+        &format!("{CL}GOTO/0,0,0,0.8660254,0,0.5\nGOTO/0,0,0,0,0,-1\n"),
+    );
+    let o = run(dir.path(), &["post", "p.cls", "-m", "trunnion-ac", "-q"]);
+    assert_exit(&o, 1);
+    assert!(o.stdout.is_empty(), "{}", stdout(&o));
+}
