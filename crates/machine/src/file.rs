@@ -405,18 +405,26 @@ pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostic
         }
     };
 
-    let mut axes = Vec::with_capacity(raw.axis.len());
-    let mut direction_ok = Vec::with_capacity(raw.axis.len());
-    for a in &raw.axis {
-        let (axis, ok) = check_axis(&mut c, a, &raw.axis);
+    // Past the limit, only the axes up to it are checked (each against the
+    // others, for duplicate names): the first table past it is the error,
+    // and a file of 300 000 tables takes no quadratic work.
+    let listed = &raw.axis[..raw.axis.len().min(MAX_AXES)];
+    let mut axes = Vec::with_capacity(listed.len());
+    let mut direction_ok = Vec::with_capacity(listed.len());
+    for a in listed {
+        let (axis, ok) = check_axis(&mut c, a, listed);
         axes.push(axis);
         direction_ok.push(ok);
     }
-    if axes.len() > MAX_AXES {
+    if raw.axis.len() > MAX_AXES {
         c.error(
             raw.axis[MAX_AXES].name.span(),
-            format!("a machine has at most {MAX_AXES} axes"),
+            format!(
+                "a machine has at most {MAX_AXES} axes; this file has {} [[axis]] tables",
+                raw.axis.len()
+            ),
         );
+        return Err(Diagnostics(c.errors));
     }
     check_axis_counts(&mut c, &raw.axis, &axes, &direction_ok);
 
@@ -803,8 +811,11 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         (AxisKind::Linear, None) => Vector3::zeros(),
     };
     let offset = match &a.machine_offset {
-        Some(o) if !o.get_ref().is_finite() => {
-            c.error(o.span(), "machine_offset must be a finite number");
+        Some(o) if !(o.get_ref().is_finite() && o.get_ref().abs() <= MAX_COORDINATE_MM) => {
+            c.error(
+                o.span(),
+                format!("machine_offset must be a finite number within ±{MAX_COORDINATE_MM:e}"),
+            );
             0.0
         }
         Some(o) => *o.get_ref(),
@@ -817,6 +828,18 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         limits_ok = false;
         if !(lo.is_finite() && hi.is_finite() && nc_lo.is_finite() && nc_hi.is_finite()) {
             c.error(l.span(), "limits must be finite numbers");
+        } else if [lo, hi, nc_lo, nc_hi]
+            .iter()
+            .any(|v| v.abs() > MAX_COORDINATE_MM)
+        {
+            // (Tolerances and travel diagonals are computed from them:
+            // ±1e154 would make them infinite.)
+            c.error(
+                l.span(),
+                format!(
+                    "limits must lie within ±{MAX_COORDINATE_MM:e} (mm or degrees, NC and machine values)"
+                ),
+            );
         } else if lo > hi {
             c.error(
                 l.span(),
@@ -838,8 +861,11 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
     });
     let fixed = a.fixed.as_ref().map(|f| {
         let v = *f.get_ref();
-        if !v.is_finite() {
-            c.error(f.span(), "fixed value must be a finite number");
+        if !(v.is_finite() && v.abs() <= MAX_COORDINATE_MM) {
+            c.error(
+                f.span(),
+                format!("fixed value must be a finite number within ±{MAX_COORDINATE_MM:e}"),
+            );
         } else if let Some([lo, hi]) = limits
             && limits_ok
             && (v < lo || v > hi)
@@ -1047,6 +1073,27 @@ axis = [0, 0, 1]
         assert!(e.contains("m.toml:7:13"), "{e}");
         let e = err(&GOOD.replace("direction = [1, 0, 0]", "direction = [1, 1, 0]"));
         assert!(e.contains("not a unit vector (length 1.414213562)"), "{e}");
+    }
+
+    /// Limits so large that a tolerance would become infinite, and a file
+    /// of many axis tables: errors, the latter at its first table past the
+    /// limit.
+    #[test]
+    fn huge_limits_and_many_axis_tables_are_errors() {
+        let src = crate::builtin::source("trunnion-ac").unwrap();
+        let huge = src.replacen("limits = [", "limits = [-1e154, 1e154] # was [", 1);
+        let e = machine_from_toml(&huge, "m.toml").unwrap_err().to_string();
+        assert!(e.contains("limits must lie within"), "{e}");
+        let mut many = String::from("name = \"m\"\n");
+        for i in 0..50_000 {
+            many.push_str(&format!(
+                "[[axis]]\nname = \"X{i}\"\nkind = \"linear\"\nside = \"tool\"\ndirection = [1, 0, 0]\n"
+            ));
+        }
+        let e = machine_from_toml(&many, "m.toml").unwrap_err();
+        assert_eq!(e.0.len(), 1, "{e}");
+        assert_eq!(e.0[0].line, 5 * MAX_AXES + 3, "{e}");
+        assert!(e.0[0].message.contains("50000 [[axis]] tables"), "{e}");
     }
 
     #[test]
