@@ -93,7 +93,7 @@ mod words;
 
 pub use kinpost_diag::{Diagnostic, Severity};
 pub use number::parse_number;
-pub use reader::ClReader;
+pub use reader::{ClReader, MAX_STATEMENT_BYTES, MAX_STATEMENT_LINES};
 
 /// A point or a direction: `[x, y, z]`.
 pub type Vec3 = [f64; 3];

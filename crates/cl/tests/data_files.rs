@@ -112,9 +112,10 @@ fn seed_figure_28a() {
 /// SolidWorks-CAM APT files: 3-axis (no tool axis anywhere), arcs as CIRCLE.
 #[test]
 fn apt_files_read_up_to_the_first_circle() {
-    for (path, circle_line, gotos_before) in
-        [("cl/solidworks/boss.apt", 37, 19), ("cl/solidworks/RotateThin.apt", 23, 4)]
-    {
+    for (path, circle_line, gotos_before) in [
+        ("cl/solidworks/boss.apt", 37, 19),
+        ("cl/solidworks/RotateThin.apt", 23, 4),
+    ] {
         // Without a default axis the first GOTO is already an error.
         let (_, _, error) = read_all(open(path));
         let e = error.expect("GOTO without a tool axis");
@@ -162,7 +163,8 @@ fn apt_files_read_up_to_the_first_circle() {
 
 #[test]
 fn apt_first_moves_are_rapid_then_feed() {
-    let (statements, _, _) = read_all(open("cl/solidworks/boss.apt").with_default_axis([0.0, 0.0, 1.0]));
+    let (statements, _, _) =
+        read_all(open("cl/solidworks/boss.apt").with_default_axis([0.0, 0.0, 1.0]));
     let moves: Vec<_> = statements
         .iter()
         .filter_map(|s| match s.event {
