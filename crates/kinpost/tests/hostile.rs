@@ -93,8 +93,8 @@ fn a_line_break_in_the_cl_file_name_is_no_block() {
 fn control_characters_in_partno_and_tool_path_stay_out_of_the_header() {
     let dir = tempfile::tempdir().unwrap();
     for first in [
-        "PARTNO NAME\rG00 Z-100\u{0}\u{c}\u{b}\u{1b}",
-        "TOOL PATH/NAME\rG00 Z-100\u{1b},TOOL,T1",
+        "PARTNO NAME\u{0}\u{c}\u{b}\u{1b}G00 Z-100 X",
+        "TOOL PATH/NAME\u{1b}\u{c}G00 Z-100\u{1b},TOOL,T1",
     ] {
         write(
             dir.path(),
@@ -366,4 +366,28 @@ fn a_failed_run_prints_nothing_on_standard_output() {
     let o = run(dir.path(), &["post", "p.cls", "-m", "trunnion-ac", "-q"]);
     assert_exit(&o, 1);
     assert!(o.stdout.is_empty(), "{}", stdout(&o));
+}
+
+/// A carriage return inside a line (in PARTNO, or a whole file with CR
+/// line ends) is an error at its place: never a file read as one line,
+/// never an empty program with exit 0.
+#[test]
+fn carriage_returns_inside_lines_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for cl in [
+        "PARTNO NAME\rG00 Z-100\nFEDRAT/MMPM,500\nGOTO/0,0,0,0,0,1\n".to_string(),
+        CL.replace('\n', "\r"),
+        format!("$$ made on a Mac\r{}", CL.replace('\n', "\r")),
+    ] {
+        write(dir.path(), "p.cls", &cl);
+        let o = run(
+            dir.path(),
+            &["post", "p.cls", "-m", "trunnion-ac", "-o", "p.mpf"],
+        );
+        assert_exit(&o, 1);
+        let err = stderr(&o);
+        assert!(err.contains("p.cls:1:"), "{err}");
+        assert!(err.contains("carriage return"), "{err}");
+        assert_eq!(listing(dir.path()), ["p.cls"]);
+    }
 }
