@@ -103,13 +103,20 @@ impl Diagnostic {
         source_line: impl Into<String>,
         message: impl Into<String>,
     ) -> Self {
+        // (A message that quotes a huge token is cut here too, so that
+        // what reaches a JSON summary is as short as what is shown.)
+        let message = message.into();
+        let message = match cut(&message, MESSAGE_CHARS) {
+            std::borrow::Cow::Borrowed(_) => message,
+            std::borrow::Cow::Owned(short) => short,
+        };
         Diagnostic {
             severity,
             file: file.into(),
             line,
             column,
             width: width.max(1),
-            message: message.into(),
+            message,
             source_line: source_line.into(),
         }
     }
