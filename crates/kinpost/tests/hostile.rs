@@ -391,3 +391,210 @@ fn carriage_returns_inside_lines_are_errors() {
         assert_eq!(listing(dir.path()), ["p.cls"]);
     }
 }
+
+/// A small wavy surface fitted in `dir` (`s.json`).
+fn fitted_surface(dir: &Path) {
+    let mut text = String::new();
+    for i in 0..8 {
+        for j in 0..8 {
+            let (x, y) = (f64::from(i) * 10.0, f64::from(j) * 8.0);
+            let z = 3.0 * (f64::from(i) / 3.0).sin() + 2.0 * (f64::from(j) / 4.0).cos();
+            text.push_str(&format!("{i},{j},{x},{y},{z:.4}\n"));
+        }
+    }
+    write(dir, "pts.csv", &text);
+    assert_exit(&run(dir, &["surface", "fit", "pts.csv", "-o", "s.json"]), 0);
+}
+
+/// Options that would ask for billions of CL points or passes are refused
+/// before the work, with the count they would need.
+#[test]
+fn path_options_too_fine_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    fitted_surface(dir.path());
+    let base = [
+        "path",
+        "s.json",
+        "--tool",
+        "wheel:radius=50,width=20",
+        "--feed",
+        "600",
+        "-o",
+        "p.cls",
+    ];
+    for (extra, code, says) in [
+        (
+            &["--stepover", "5", "--max-angle", "1e-9"][..],
+            1,
+            "CL points",
+        ),
+        (&["--stepover", "1e-9"][..], 1, "passes"),
+        (&["--stepover", "5", "--chordtol", "1e-12"][..], 2, "1e-6"),
+        (&["--scallop", "1e-12"][..], 2, "1e-6"),
+    ] {
+        let args: Vec<&str> = base.iter().chain(extra).copied().collect();
+        let started = Instant::now();
+        let o = run(dir.path(), &args);
+        assert!(started.elapsed() < Duration::from_secs(30), "{extra:?}");
+        assert_exit(&o, code);
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert!(!dir.path().join("p.cls").exists());
+    }
+}
+
+/// One long line of a points file is read in linear time (it was
+/// quadratic: a 2 MB line took 12 s, 8 MB over 3 minutes).
+#[test]
+fn a_long_points_line_is_read_in_linear_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let line: String = "0,0,1,2,3,".repeat(800_000);
+    write(dir.path(), "long.csv", &format!("{line}\n"));
+    let started = Instant::now();
+    let o = run(dir.path(), &["surface", "fit", "long.csv", "-o", "s.json"]);
+    assert!(started.elapsed() < Duration::from_secs(30));
+    assert_exit(&o, 1);
+    // The error does not echo the 8 MB line.
+    assert!(o.stderr.len() < 4000, "{}", o.stderr.len());
+}
+
+/// Bytes that are not UTF-8 in a machine, dialect, points or surface file
+/// are an error at the file, line and column of the first.
+#[test]
+fn invalid_utf8_is_located_in_every_input_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "p.cls", CL);
+    let machine = std::fs::read(root().join("crates/machine/machines/trunnion-ac.toml")).unwrap();
+    let mut bad = b"# caf\xe9\n".to_vec();
+    bad.extend_from_slice(&machine);
+    std::fs::write(d.join("m.toml"), &bad).unwrap();
+    let dialect = std::fs::read(root().join("crates/nc/dialects/sinumerik.toml")).unwrap();
+    let mut bad = b"# caf\xe9\n".to_vec();
+    bad.extend_from_slice(&dialect);
+    std::fs::write(d.join("d.toml"), &bad).unwrap();
+    std::fs::write(d.join("pts.csv"), b"0,0,1,2,3\n0,1,1,2,\xff\n").unwrap();
+    std::fs::write(d.join("s.json"), b"{\n \"knots\": \"\xfe\"}\n").unwrap();
+    for (args, at) in [
+        (&["machine", "check", "m.toml"][..], "m.toml:1:6"),
+        (&["post", "p.cls", "-m", "m.toml"][..], "m.toml:1:6"),
+        (&["dialect", "check", "d.toml"][..], "d.toml:1:6"),
+        (
+            &["post", "p.cls", "-m", "trunnion-ac", "-d", "d.toml"][..],
+            "d.toml:1:6",
+        ),
+        (
+            &["surface", "fit", "pts.csv", "-o", "f.json"][..],
+            "pts.csv:2:9",
+        ),
+        (
+            &["surface", "eval", "s.json", "--uv", "0.5,0.5"][..],
+            "s.json:2:12",
+        ),
+    ] {
+        let o = run(d, args);
+        assert_exit(&o, 1);
+        let err = stderr(&o);
+        assert!(err.contains(at), "{args:?}: {err}");
+        assert!(err.contains("UTF-8"), "{args:?}: {err}");
+    }
+}
+
+/// A relative `[post] dialect` path is the machine file's neighbour, from
+/// any folder; a built-in name wins over a file of that name only when it
+/// is a plain name, and the run says so.
+#[test]
+fn names_resolve_the_same_from_any_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("cell")).unwrap();
+    let dialect = std::fs::read_to_string(root().join("crates/nc/dialects/sinumerik.toml"))
+        .unwrap()
+        .replace("; POSTED BY KINPOST", "; MY CELL POST");
+    write(&d.join("cell"), "mine.toml", &dialect);
+    let machine =
+        std::fs::read_to_string(root().join("crates/machine/machines/trunnion-ac.toml")).unwrap();
+    let machine = match machine.find("dialect = ") {
+        Some(at) => {
+            let end = at + machine[at..].find('\n').unwrap();
+            format!(
+                "{}dialect = \"./mine.toml\"{}",
+                &machine[..at],
+                &machine[end..]
+            )
+        }
+        None => panic!("trunnion-ac has a [post] dialect"),
+    };
+    write(&d.join("cell"), "m.toml", &machine);
+    write(d, "p.cls", CL);
+    let from_top = run(d, &["post", "p.cls", "-m", "cell/m.toml", "-q"]);
+    assert_exit(&from_top, 0);
+    assert!(
+        stdout(&from_top).contains("; MY CELL POST"),
+        "{}",
+        stdout(&from_top)
+    );
+    let from_cell = run(&d.join("cell"), &["post", "../p.cls", "-m", "m.toml", "-q"]);
+    assert_exit(&from_cell, 0);
+    assert_eq!(
+        stdout(&from_top),
+        stdout(&from_cell).replace("../p.cls", "p.cls")
+    );
+    // A file named like a built-in in the current folder: the built-in,
+    // with a note; `./NAME` reads the file.
+    write(d, "sinumerik", &dialect);
+    let o = run(
+        d,
+        &[
+            "post",
+            "p.cls",
+            "-m",
+            "trunnion-ac",
+            "-d",
+            "sinumerik",
+            "-q",
+        ],
+    );
+    assert_exit(&o, 0);
+    assert!(!stdout(&o).contains("; MY CELL POST"));
+    assert!(stderr(&o).contains("built-in dialect"), "{}", stderr(&o));
+    let o = run(
+        d,
+        &[
+            "post",
+            "p.cls",
+            "-m",
+            "trunnion-ac",
+            "-d",
+            "./sinumerik",
+            "-q",
+        ],
+    );
+    assert_exit(&o, 0);
+    assert!(stdout(&o).contains("; MY CELL POST"));
+}
+
+/// A huge token is not echoed whole, neither on standard error nor in the
+/// JSON summary.
+#[test]
+fn a_huge_token_is_not_echoed_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let token = "X".repeat(500_000);
+    write(dir.path(), "p.cls", &format!("{token}/1\n{CL}"));
+    let o = run(
+        dir.path(),
+        &[
+            "post",
+            "p.cls",
+            "-m",
+            "trunnion-ac",
+            "-o",
+            "p.mpf",
+            "--json",
+            "p.json",
+        ],
+    );
+    assert_exit(&o, 0);
+    assert!(o.stderr.len() < 5000, "{}", o.stderr.len());
+    let json = std::fs::read_to_string(dir.path().join("p.json")).unwrap();
+    assert!(json.len() < 20_000, "{}", json.len());
+}
