@@ -821,7 +821,11 @@ impl<W: Write> NcWriter<W> {
         let name = self.names.get(axis).map_or("feed", String::as_str);
         io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!("cannot write {name} = {value}: {e}"),
+            if value.abs() >= 1e15 {
+                format!("cannot write {name} = {value:e}: {e}")
+            } else {
+                format!("cannot write {name} = {value}: {e}")
+            },
         )
     }
 
@@ -1075,6 +1079,17 @@ impl<W: Write> NcWriter<W> {
             Ok(n) => n,
             Err(e) => return Err(self.bad_value(index, value, e)),
         };
+        if n == 0 && value != 0.0 {
+            // (As for feeds: a pressure asked for must not be written as
+            // none.)
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "cannot write {} = {value}: it would be written as 0 with the dialect's decimals",
+                    p.name
+                ),
+            ));
+        }
         if p.word.known && p.word.last == n {
             return Ok(());
         }
