@@ -598,3 +598,29 @@ fn a_huge_token_is_not_echoed_whole() {
     let json = std::fs::read_to_string(dir.path().join("p.json")).unwrap();
     assert!(json.len() < 20_000, "{}", json.len());
 }
+
+/// A pressure too large to write is an error at its CL line, shown in a
+/// few characters (not 309 digits).
+#[test]
+fn pressures_that_cannot_be_written_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for p in ["1e308", "1e30"] {
+        write(
+            dir.path(),
+            "p.cls",
+            &format!(
+                "PRESSURE/H1,{p}\nFEDRAT/MMPM,250\nGOTO/-416.0000,70.5000,16.5300,0.0000000,0.0000000,1.0000000\nGOTO/-416.0000,70.5000,13.0000\n"
+            ),
+        );
+        let o = run(
+            dir.path(),
+            &["post", "p.cls", "-m", "mts1600", "-o", "p.mpf"],
+        );
+        assert_exit(&o, 1);
+        let err = stderr(&o);
+        assert!(err.contains("cannot write H1"), "{err}");
+        assert!(err.contains("p.cls:"), "{err}");
+        assert!(err.len() < 2000, "{err}");
+        assert_eq!(listing(dir.path()), ["p.cls"]);
+    }
+}
