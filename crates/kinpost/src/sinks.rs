@@ -95,13 +95,13 @@ pub fn deliver(sinks: Vec<Sink>) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     let mut stdout_error = None;
-    if let Some(spool) = spool {
-        if let Err(e) = copy_spool(spool) {
-            if e.kind() == io::ErrorKind::BrokenPipe {
-                stdout_error = Some(e);
-            } else {
-                return Err(anyhow::Error::new(e).context("cannot write to standard output"));
-            }
+    if let Some(spool) = spool
+        && let Err(e) = copy_spool(spool)
+    {
+        if e.kind() == io::ErrorKind::BrokenPipe {
+            stdout_error = Some(e);
+        } else {
+            return Err(anyhow::Error::new(e).context("cannot write to standard output"));
         }
     }
     let mut list = output::staged();

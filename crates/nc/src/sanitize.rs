@@ -39,7 +39,7 @@ impl CommentSyntax {
                 .replace
                 .iter()
                 .any(|(from, _)| text.contains(from.as_str()))
-            && !(self.ascii && !text.is_ascii())
+            && (!self.ascii || text.is_ascii())
             && (suffix.is_empty() || !(text.contains(suffix) || text.contains(prefix)));
         if plain {
             return Cow::Borrowed(text);

@@ -84,10 +84,10 @@ fn split_csv(line: &str) -> Vec<Field<'_>> {
     let mut start = 0;
     // Characters before `start`.
     let mut start_chars = 0;
-    let mut chars = 0;
-    for (k, c) in line
+    for (chars, (k, c)) in line
         .char_indices()
         .chain(std::iter::once((line.len(), ',')))
+        .enumerate()
     {
         if c == ',' {
             let raw = &line[start..k];
@@ -100,7 +100,6 @@ fn split_csv(line: &str) -> Vec<Field<'_>> {
             start = k + 1;
             start_chars = chars + 1;
         }
-        chars += 1;
     }
     out
 }
