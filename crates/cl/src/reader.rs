@@ -516,13 +516,14 @@ impl<R: BufRead> ClReader<R> {
     fn carriage_return(&mut self, start: usize, end: usize, at: usize) -> Diagnostic {
         let bytes = &self.raw[start..end];
         let column = String::from_utf8_lossy(&bytes[..at]).chars().count() + 1;
-        let shown = &bytes[..bytes.len().min(at + 200)];
+        // (The whole line, as the fast path's diagnostic has it: the
+        // display shows the part around the column.)
         Diagnostic::error(
             &self.file,
             self.line,
             column,
             1,
-            String::from_utf8_lossy(shown),
+            String::from_utf8_lossy(bytes),
             CR_INSIDE_A_LINE,
         )
     }

@@ -70,3 +70,35 @@ fn a_file_with_cr_line_ends_is_an_error_at_the_first_cr() {
     assert!(r.next_statement().unwrap().is_some());
     assert!(r.next_statement().unwrap().is_none());
 }
+
+/// Every statement and diagnostic of `input`, through `reader`.
+fn transcript(reader: impl std::io::BufRead) -> Vec<String> {
+    let mut r = ClReader::new(reader, "t.cls");
+    let mut out = Vec::new();
+    for _ in 0..100 {
+        let item = r.next_statement();
+        let end = matches!(item, Ok(None));
+        out.push(format!("{item:?}"));
+        out.extend(r.take_warnings().iter().map(|w| format!("{w:?}")));
+        if end {
+            break;
+        }
+    }
+    out
+}
+
+/// Found by the `cl_reader` fuzz target: a CR in a long line gave the same
+/// error on both paths but another source line.
+#[test]
+fn a_carriage_return_in_a_long_line_reads_alike_on_both_paths() {
+    let text = format!(
+        "PARTNO/FIVE AXIS DEMO\nTPARTNO NAME\rG00 {} Z-100\nSPINDL/1200,CLW\n",
+        "\0".repeat(300)
+    );
+    let general = transcript(std::io::BufReader::with_capacity(1, text.as_bytes()));
+    assert_eq!(transcript(text.as_bytes()), general);
+    assert!(
+        general.iter().any(|t| t.contains("carriage return")),
+        "{general:?}"
+    );
+}
