@@ -742,13 +742,16 @@ impl Dialect {
     }
 
     /// Renders a template source (e.g. a machine file's header override) with
-    /// this dialect's template settings and filters.
+    /// this dialect's template settings, filters and limits; every string in
+    /// `vars` is cleaned for the dialect first ([`CommentSyntax::clean`]).
     pub fn render_template(
         &self,
         source: &str,
         vars: &BTreeMap<String, minijinja::Value>,
     ) -> Result<String, crate::NcError> {
-        template::render_str(&self.env, "template", source, vars)
+        let mut vars = vars.clone();
+        self.comment.clean_vars(&mut vars);
+        template::render_str(&self.env, "template", source, &vars)
     }
 }
 
