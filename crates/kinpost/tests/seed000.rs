@@ -6,8 +6,7 @@ use kinpost::{PostOptions, post};
 
 fn data(path: &str) -> String {
     let p = format!("{}/../../data/{path}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&p)
-        .unwrap_or_else(|e| panic!("{p}: {e} (data/ of the repository)"))
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e} (data/ of the repository)"))
 }
 
 #[test]

@@ -22,8 +22,7 @@ use nalgebra::{Vector3, Vector4};
 use seed002_paper::{PHI, R_S1, eq25, eq30_angles_deg, same_angle_within};
 
 fn cl_text(direction: Direction) -> String {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/li-bspline/points.csv");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/li-bspline/points.csv");
     let grid = read_grid(&std::fs::read_to_string(&path).unwrap(), "points.csv").unwrap();
     let surface = Surface::fit(&grid, &FitOptions::default()).unwrap();
     let options = PathOptions {
