@@ -516,9 +516,18 @@ fn note_builtin_over_file(what: &str, name: &str) {
 
 /// A file read whole as UTF-8 text: an error names the file, and for bytes
 /// that are not UTF-8 the line and column of the first.
-fn read_text(path: &Path, what: &str) -> Result<String> {
-    let bytes =
-        std::fs::read(path).with_context(|| format!("cannot read {what} {}", path.display()))?;
+/// At most `limit` bytes and one more are read: the loader refuses a
+/// larger file by its size, and a file of gigabytes is not read whole.
+fn read_text(path: &Path, what: &str, limit: usize) -> Result<String> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(limit as u64 + 1).read_to_end(&mut bytes))
+        .with_context(|| format!("cannot read {what} {}", path.display()))?;
+    if bytes.len() > limit {
+        // (Cut at the limit, perhaps inside a character: the loader
+        // refuses it by its size.)
+        return Ok(String::from_utf8_lossy(&bytes).into_owned());
+    }
     kinpost::diag::decode_utf8(bytes, &path.to_string_lossy()).map_err(report)
 }
 
@@ -534,7 +543,11 @@ fn load_machine(name: &str) -> Result<Machine> {
         return m.map_err(report);
     }
     if is_file_to_read(path) {
-        let src = read_text(path, "machine file")?;
+        let src = read_text(
+            path,
+            "machine file",
+            kinpost::machine::MAX_MACHINE_FILE_BYTES,
+        )?;
         return machine_from_source(&src, name);
     }
     match builtin::load(name) {
@@ -587,7 +600,7 @@ fn load_dialect(name: &str) -> Result<Dialect> {
         return Ok(d);
     }
     if is_file_to_read(path) {
-        let src = read_text(path, "dialect file")?;
+        let src = read_text(path, "dialect file", kinpost::nc::MAX_DIALECT_FILE_BYTES)?;
         return Dialect::from_toml(&src, name).map_err(report);
     }
     if let Some(d) = Dialect::builtin(name) {

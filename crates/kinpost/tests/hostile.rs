@@ -624,3 +624,32 @@ fn pressures_that_cannot_be_written_are_errors() {
         assert_eq!(listing(dir.path()), ["p.cls"]);
     }
 }
+
+/// A machine file of 300 000 `[[axis]]` tables (15 MB) is refused by its
+/// size before it is parsed; one of a few hundred tables at its tenth.
+#[test]
+fn machine_files_with_many_axis_tables_are_refused_early() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = |i: usize| {
+        format!(
+            "[[axis]]\nname = \"X{i}\"\nkind = \"linear\"\nside = \"tool\"\ndirection = [1, 0, 0]\n"
+        )
+    };
+    let many: String = std::iter::once("name = \"m\"\n".to_string())
+        .chain((0..300_000).map(table))
+        .collect();
+    write(dir.path(), "many.toml", &many);
+    let started = Instant::now();
+    let o = run(dir.path(), &["machine", "check", "many.toml"]);
+    assert!(started.elapsed() < Duration::from_secs(20));
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("many.toml:1:1"), "{}", stderr(&o));
+    let few: String = std::iter::once("name = \"m\"\n".to_string())
+        .chain((0..500).map(table))
+        .collect();
+    write(dir.path(), "few.toml", &few);
+    let o = run(dir.path(), &["machine", "check", "few.toml"]);
+    assert_exit(&o, 1);
+    assert!(stderr(&o).contains("at most 9 axes"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("few.toml:48:"), "{}", stderr(&o));
+}

@@ -28,6 +28,11 @@ const MAX_ROTARY_TRAVEL: f64 = 3600.0;
 /// through such a point solves to wrong positions.
 const MAX_COORDINATE_MM: f64 = 1e6;
 
+/// The largest machine file read: 1 MiB, hundreds of times a commented
+/// machine with a pressure table. A larger text (300 000 `[[axis]]`
+/// tables) is refused before it is parsed, in bounded time and memory.
+pub const MAX_MACHINE_FILE_BYTES: usize = 1 << 20;
+
 #[derive(Deserialize)]
 struct RawMachine {
     name: Option<Spanned<String>>,
@@ -365,6 +370,21 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
 
 /// Reads a machine file. `file` is the name used in diagnostics.
 pub fn machine_from_toml(source: &str, file: &str) -> Result<Machine, Diagnostics> {
+    if source.len() > MAX_MACHINE_FILE_BYTES {
+        return Err(Diagnostic::error(
+            file,
+            1,
+            1,
+            1,
+            source.lines().next().unwrap_or(""),
+            format!(
+                "the machine file has {} bytes, more than {MAX_MACHINE_FILE_BYTES}: a machine \
+                 file is a few kilobytes (is this a machine file?)",
+                source.len()
+            ),
+        )
+        .into());
+    }
     // Syntax first, then the keys and types of the machine file.
     if let Err(e) = source.parse::<toml::Table>() {
         return Err(toml_error(&e, file, source, true).into());
@@ -1094,6 +1114,10 @@ axis = [0, 0, 1]
             ));
         }
         let e = machine_from_toml(&many, "m.toml").unwrap_err();
+        assert_eq!(e.0.len(), 1, "{e}");
+        assert!(e.0[0].message.contains("bytes"), "{e}");
+        let few = many[..many.find("[[axis]]\nname = \"X300\"").unwrap()].to_string();
+        let e = machine_from_toml(&few, "m.toml").unwrap_err();
         assert_eq!(e.0.len(), 1, "{e}");
         assert_eq!(e.0[0].line, 5 * MAX_AXES + 3, "{e}");
         assert!(e.0[0].message.contains("at most 9 axes"), "{e}");

@@ -22,7 +22,7 @@ mod model;
 mod pressure;
 pub mod subproblems;
 
-pub use file::machine_from_toml;
+pub use file::{MAX_MACHINE_FILE_BYTES, machine_from_toml};
 pub use kinematics::{
     AXIS_ROUNDING_RAD, Excursion, Folds, IkError, Joints, Kinematics, MAX_AXIS_ROUNDING_RAD,
     Singularity, Solution, Violation, lever_over, midpoint_bound, wrap180,

@@ -248,6 +248,10 @@ impl TemplateKind {
     }
 }
 
+/// The largest dialect file read: 1 MiB, hundreds of times a commented
+/// dialect; a larger text is refused before it is parsed.
+pub const MAX_DIALECT_FILE_BYTES: usize = 1 << 20;
+
 /// A parsed, validated NC dialect.
 #[derive(Clone)]
 pub struct Dialect {
@@ -314,6 +318,21 @@ impl Dialect {
     /// Parses and validates a dialect file. Every problem is reported as a
     /// diagnostic naming `file_name`, line and column.
     pub fn from_toml(source: &str, file_name: &str) -> Result<Dialect, Diagnostics> {
+        if source.len() > MAX_DIALECT_FILE_BYTES {
+            return Err(Diagnostic::error(
+                file_name,
+                1,
+                1,
+                1,
+                source.lines().next().unwrap_or(""),
+                format!(
+                    "the dialect file has {} bytes, more than {MAX_DIALECT_FILE_BYTES}: a dialect \
+                     file is a few kilobytes (is this a dialect file?)",
+                    source.len()
+                ),
+            )
+            .into());
+        }
         // serde would stop at the first unknown key or value: they are all
         // found here (the `Raw*` types let unknown keys pass), and reported
         // with the mistakes the checks below find.

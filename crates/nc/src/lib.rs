@@ -29,8 +29,8 @@ mod template;
 mod writer;
 
 pub use dialect::{
-    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MotionWords, Numbering,
-    TemplateKind, WordFormat, check_template,
+    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
+    MotionWords, Numbering, TemplateKind, WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use minijinja::Value;
