@@ -94,7 +94,7 @@ mod writer;
 
 pub use kinpost_diag::{Diagnostic, Severity};
 pub use number::parse_number;
-pub use reader::ClReader;
+pub use reader::{ClReader, MAX_STATEMENT_BYTES, MAX_STATEMENT_LINES};
 pub use writer::{ClWriter, WriteError};
 
 /// A point or a direction: `[x, y, z]`.

@@ -381,8 +381,26 @@ impl<R: BufRead> ClReader<R> {
     fn read_lines(&mut self) -> Result<Read, Diagnostic> {
         loop {
             let mut start = self.raw.len();
-            match self.input.read_until(b'\n', &mut self.raw) {
-                Ok(0) => {
+            if self.segments.len() >= MAX_STATEMENT_LINES {
+                // (At the line that would be one too many.)
+                self.line += 1;
+                return Err(self.too_long(format!(
+                    "the statement that starts on line {} goes on over more than {MAX_STATEMENT_LINES} \
+                     lines (`$` continuations): a CL statement is a line or a few",
+                    self.segments[0].line
+                )));
+            }
+            match read_line_bounded(&mut self.input, &mut self.raw, MAX_STATEMENT_BYTES) {
+                Ok(None) => {
+                    self.line += 1;
+                    return Err(self.too_long(format!(
+                        "the statement on line {} is longer than {MAX_STATEMENT_BYTES} bytes \
+                         (its lines and `$` continuations): a CL statement is a line or a few; \
+                         is this a CL file?",
+                        self.segments.first().map_or(self.line, |s| s.line)
+                    )));
+                }
+                Ok(Some(0)) => {
                     let Some(last) = self.segments.last() else {
                         return Ok(Read::Eof);
                     };
@@ -394,7 +412,7 @@ impl<R: BufRead> ClReader<R> {
                         "the statement continues (`$`) past the end of the file",
                     ));
                 }
-                Ok(_) => {}
+                Ok(Some(_)) => {}
                 Err(e) => return Err(self.read_error(e)),
             }
             self.line += 1;
@@ -408,6 +426,15 @@ impl<R: BufRead> ClReader<R> {
             self.raw.truncate(end);
             if self.line == 1 && self.raw.starts_with(b"\xEF\xBB\xBF") {
                 start += 3;
+            }
+            // (Trailing CRs are blanks at the end of a line, as on the fast
+            // path.)
+            let content = trim_end_ascii(&self.raw[start..end]);
+            if let Some(at) = self.raw[start..start + content]
+                .iter()
+                .position(|&b| b == b'\r')
+            {
+                return Err(self.carriage_return(start, end, at));
             }
             let line = match std::str::from_utf8(&self.raw[start..end]) {
                 Ok(line) => line,
@@ -459,6 +486,45 @@ impl<R: BufRead> ClReader<R> {
             0,
             "",
             format!("cannot read the file: {e}"),
+        )
+    }
+
+    /// A statement or line past the reader's limits: the error, at the
+    /// current line (its start shown); the reader then reports the end of
+    /// the input (the rest of the line is not read).
+    #[cold]
+    fn too_long(&mut self, message: String) -> Diagnostic {
+        self.finished = true;
+        let start = self.segments.last().map_or(0, |s| s.raw_end);
+        let shown = &self.raw[start.min(self.raw.len())..];
+        let shown = &shown[..shown.len().min(200)];
+        Diagnostic::error(
+            &self.file,
+            self.line,
+            1,
+            1,
+            String::from_utf8_lossy(shown),
+            message,
+        )
+    }
+
+    /// A carriage return inside a line (byte `at` of the line in
+    /// `raw[start..end]`): ends lines on some systems (classic Mac OS, some
+    /// controllers), is a stray byte on others; the reader does not guess
+    /// which statements were meant.
+    #[cold]
+    fn carriage_return(&mut self, start: usize, end: usize, at: usize) -> Diagnostic {
+        let bytes = &self.raw[start..end];
+        let column = String::from_utf8_lossy(&bytes[..at]).chars().count() + 1;
+        // (The whole line, as the fast path's diagnostic has it: the
+        // display shows the part around the column.)
+        Diagnostic::error(
+            &self.file,
+            self.line,
+            column,
+            1,
+            String::from_utf8_lossy(bytes),
+            CR_INSIDE_A_LINE,
         )
     }
 
@@ -518,6 +584,11 @@ impl<R: BufRead> ClReader<R> {
     /// Interprets the logical statement in `text`.
     #[inline(always)]
     fn interpret(&mut self) -> Result<Option<ClEvent>, Diagnostic> {
+        // (A line read on the fast path: its CR is checked here, the
+        // general path checked it already.)
+        if let Some(at) = self.text_bytes().iter().position(|&b| b == b'\r') {
+            return Err(self.error((at, at + 1), CR_INSIDE_A_LINE));
+        }
         let b = self.text_bytes();
         let start = skip_blanks(b, 0);
         if start == b.len() {
@@ -1380,6 +1451,58 @@ fn make(
     match severity {
         Severity::Error => Diagnostic::error(file, line, column, width, source_line, message),
         Severity::Warning => Diagnostic::warning(file, line, column, width, source_line, message),
+    }
+}
+
+/// The most bytes a logical statement may have, its physical lines and
+/// `$` continuations (and comment lines between them) together: 1 MiB, a
+/// thousand times a long CL line. Past it the input is an error (a binary
+/// file, a line without end), not memory without bound.
+pub const MAX_STATEMENT_BYTES: usize = 1 << 20;
+
+/// The most physical lines a logical statement may span (`$`
+/// continuations): fifty million `$` lines would otherwise be one
+/// statement held in memory.
+pub const MAX_STATEMENT_LINES: usize = 10_000;
+
+const CR_INSIDE_A_LINE: &str = "a carriage return (CR) inside a line: lines must end with LF or \
+     CR LF; a file whose lines end with CR alone (classic Mac OS) must be converted \
+     (e.g. `tr '\\r' '\\n'`)";
+
+/// `read_until(b'\n')` that stops once `buf` would hold more than `limit`
+/// bytes: `Ok(None)` then (what was read stays in `buf`), else the bytes
+/// read (0 at the end of the input).
+fn read_line_bounded<R: BufRead>(
+    input: &mut R,
+    buf: &mut Vec<u8>,
+    limit: usize,
+) -> std::io::Result<Option<usize>> {
+    let mut read = 0;
+    loop {
+        let available = match input.fill_buf() {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if available.is_empty() {
+            return Ok(Some(read));
+        }
+        let (take, done) = match available.iter().position(|&b| b == b'\n') {
+            Some(i) => (i + 1, true),
+            None => (available.len(), false),
+        };
+        if buf.len() + take > limit {
+            let room = limit.saturating_sub(buf.len());
+            buf.extend_from_slice(&available[..room.min(take)]);
+            input.consume(room.min(take));
+            return Ok(None);
+        }
+        buf.extend_from_slice(&available[..take]);
+        input.consume(take);
+        read += take;
+        if done {
+            return Ok(Some(read));
+        }
     }
 }
 

@@ -106,13 +106,20 @@ impl Diagnostic {
         source_line: impl Into<String>,
         message: impl Into<String>,
     ) -> Self {
+        // (A message that quotes a huge token is cut here too, so that
+        // what reaches a JSON summary is as short as what is shown.)
+        let message = message.into();
+        let message = match cut(&message, MESSAGE_CHARS) {
+            std::borrow::Cow::Borrowed(_) => message,
+            std::borrow::Cow::Owned(short) => short,
+        };
         Diagnostic {
             severity,
             file: file.into(),
             line,
             column,
             width: width.max(1),
-            message: message.into(),
+            message,
             source_line: source_line.into(),
         }
     }
@@ -157,6 +164,83 @@ impl Diagnostic {
 /// The most characters of a source line a diagnostic shows.
 const SHOWN_CHARS: usize = 160;
 
+/// The most characters of a message a diagnostic shows: a message that
+/// quotes a token of 100 MB (a CL line without breaks) shows its start and
+/// end.
+pub const MESSAGE_CHARS: usize = 400;
+
+/// The most characters of a piece of input a message quotes
+/// ([`excerpt`]).
+pub const EXCERPT_CHARS: usize = 60;
+
+/// `text` to quote in a message: whole when it has at most
+/// [`EXCERPT_CHARS`] characters, else its start, `…` and how long it is.
+/// The one place that decides how much of an input a message echoes.
+pub fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
+    cut(text, EXCERPT_CHARS)
+}
+
+/// `text` cut to about `max` characters: its start and end around a `…`
+/// that says how many bytes it has.
+fn cut(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    if text.len() <= max || text.chars().nth(max).is_none() {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let head_chars = max * 2 / 3;
+    let tail_chars = max / 6;
+    let head_end = text
+        .char_indices()
+        .nth(head_chars)
+        .map_or(text.len(), |(i, _)| i);
+    let tail_start = text
+        .char_indices()
+        .rev()
+        .nth(tail_chars.saturating_sub(1))
+        .map_or(head_end, |(i, _)| i.max(head_end));
+    std::borrow::Cow::Owned(format!(
+        "{}…[{} bytes]…{}",
+        &text[..head_end],
+        text.len(),
+        &text[tail_start..]
+    ))
+}
+
+/// `bytes` as UTF-8 text, or an error at the line and column of the first
+/// byte that is not UTF-8 (the line shown with that byte as U+FFFD).
+pub fn decode_utf8(bytes: Vec<u8>, file: &str) -> Result<String, Diagnostic> {
+    match String::from_utf8(bytes) {
+        Ok(s) => Ok(s),
+        Err(e) => {
+            let bytes = e.as_bytes();
+            let at = e.utf8_error().valid_up_to();
+            let line_start = bytes[..at]
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |i| i + 1);
+            let line_end = bytes[at..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(bytes.len(), |i| at + i);
+            let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+            // (Valid up to `at`: the characters before it count exactly.)
+            let before = std::str::from_utf8(&bytes[line_start..at]).unwrap_or("");
+            let column = before.chars().count() + 1;
+            let text = String::from_utf8_lossy(&bytes[line_start..line_end]);
+            Err(Diagnostic::error(
+                file,
+                line,
+                column,
+                1,
+                text.trim_end_matches('\r'),
+                format!(
+                    "invalid UTF-8: byte 0x{:02X} is not part of a UTF-8 character (the file must be UTF-8 text)",
+                    bytes[at]
+                ),
+            ))
+        }
+    }
+}
+
 /// `c`, or U+FFFD for a control character other than a line break: bytes
 /// of a binary file must not reach the terminal as escape sequences. (One
 /// character for one: the caret stays under its column.)
@@ -179,7 +263,10 @@ fn floor_char_boundary(s: &str, mut i: usize) -> usize {
 /// location, the source line and a caret under the offending text.
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let message: String = self.message.chars().map(printable).collect();
+        let message: String = cut(&self.message, MESSAGE_CHARS)
+            .chars()
+            .map(printable)
+            .collect();
         writeln!(f, "{}: {message}", self.severity)?;
         if self.line == 0 {
             return write!(f, "  --> {}", self.file);
@@ -273,6 +360,27 @@ mod tests {
         // The caret stands under the X.
         let caret = lines[4].find('^').unwrap();
         assert_eq!(lines[3].chars().nth(caret), Some('X'));
+    }
+
+    #[test]
+    fn invalid_utf8_is_located_at_its_first_bad_byte() {
+        let bytes = b"name = \"m\"\nd = \"\xc3\xa4x\xff\"\n".to_vec();
+        let d = decode_utf8(bytes, "m.toml").unwrap_err();
+        assert_eq!(d.location(), "m.toml:2:8");
+        assert!(d.message.contains("0xFF"), "{d}");
+        assert_eq!(d.source_line, "d = \"äx\u{FFFD}\"");
+        assert_eq!(decode_utf8(b"ok".to_vec(), "x").unwrap(), "ok");
+    }
+
+    #[test]
+    fn long_tokens_are_not_echoed_whole() {
+        let token = "9".repeat(1_000_000);
+        let d = Diagnostic::error("a.cls", 1, 1, 1, "", format!("bad `{token}`"));
+        let shown = d.to_string();
+        assert!(shown.len() < 1000, "{}", shown.len());
+        assert!(shown.contains("[1000006 bytes]"), "{shown}");
+        assert!(excerpt(&token).len() < 100);
+        assert_eq!(excerpt("short"), "short");
     }
 
     #[test]

@@ -226,8 +226,12 @@ fn counts(text: &str, what: &str) -> Result<(usize, usize)> {
     })
 }
 
+/// A file read whole as UTF-8 text: bytes that are not UTF-8 are an error
+/// at the line and column of the first.
 fn read_text(path: &Path, what: &str) -> Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("cannot read {what} {}", path.display()))
+    let bytes =
+        std::fs::read(path).with_context(|| format!("cannot read {what} {}", path.display()))?;
+    kinpost_post::diag::decode_utf8(bytes, &path.to_string_lossy()).map_err(report)
 }
 
 /// Loads a surface file, with located diagnostics.

@@ -247,6 +247,12 @@ enum MachineCommand {
 enum DialectCommand {
     /// Print a built-in dialect file.
     Show { name: String },
+    /// Validate a dialect file: its settings, and every template rendered
+    /// once with sample values within the template limits.
+    Check {
+        /// Dialect file, built-in dialect name, or - for standard input.
+        file: PathBuf,
+    },
 }
 
 /// An error already reported to the user (diagnostics printed).
@@ -281,6 +287,12 @@ fn usage(message: impl Into<String>) -> anyhow::Error {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // An interrupted run leaves no temporary file behind.
+    if let Err(e) = crate::output::remove_staged_files_on_signals() {
+        note!(
+            "warning: cannot watch for signals ({e}): an interrupted run may leave a .kinpost-*.tmp file"
+        );
+    }
     // (Text still buffered is flushed here, where its error can be seen.)
     match run(cli).and_then(|()| Ok(io::stdout().flush()?)) {
         Ok(()) => ExitCode::SUCCESS,
@@ -332,6 +344,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        Command::Dialect(DialectCommand::Check { file }) => dialect_check(&file, &mut out),
         Command::Dialect(DialectCommand::Show { name }) => {
             let src = Dialect::builtin_source(&name).ok_or_else(|| {
                 anyhow!(
@@ -371,10 +384,11 @@ fn run(cli: Cli) -> Result<()> {
 /// `kinpost machine check FILE` (`-`: standard input).
 fn machine_check(file: &Path, out: &mut impl Write) -> Result<()> {
     let (name, m) = if file == Path::new("-") {
-        let mut src = String::new();
+        let mut src = Vec::new();
         io::stdin()
-            .read_to_string(&mut src)
+            .read_to_end(&mut src)
             .context("cannot read the machine file from standard input")?;
+        let src = kinpost_post::diag::decode_utf8(src, STDIN_NAME).map_err(report)?;
         (
             STDIN_NAME.to_string(),
             machine_from_source(&src, STDIN_NAME)?,
@@ -440,6 +454,33 @@ fn machine_check(file: &Path, out: &mut impl Write) -> Result<()> {
     Ok(())
 }
 
+/// `kinpost dialect check FILE` (`-`: standard input): the dialect loads
+/// (every template compiled, its variables known, and rendered once with
+/// sample values within the template limits).
+fn dialect_check(file: &Path, out: &mut impl Write) -> Result<()> {
+    let (name, d) = if file == Path::new("-") {
+        let mut src = Vec::new();
+        io::stdin()
+            .read_to_end(&mut src)
+            .context("cannot read the dialect file from standard input")?;
+        let src = kinpost_post::diag::decode_utf8(src, STDIN_NAME).map_err(report)?;
+        let d = Dialect::from_toml(&src, STDIN_NAME).map_err(report)?;
+        (STDIN_NAME.to_string(), d)
+    } else {
+        let name = file.to_string_lossy().into_owned();
+        let d = load_dialect(&name)?;
+        (name, d)
+    };
+    writeln!(
+        out,
+        "{name}: dialect `{}` is valid (templates within {} fuel and {} bytes of output)",
+        d.name(),
+        kinpost_post::nc::TEMPLATE_FUEL,
+        kinpost_post::nc::MAX_TEMPLATE_OUTPUT_BYTES
+    )?;
+    Ok(())
+}
+
 /// The name diagnostics give standard input, as `post -` does.
 const STDIN_NAME: &str = "<stdin>";
 
@@ -456,12 +497,59 @@ fn unknown_machine(name: &str) -> anyhow::Error {
     )
 }
 
-/// A built-in machine by name, or a machine file.
+/// Whether `name` names a built-in (machine or dialect) rather than a
+/// file: no path separator and no extension. Only such a name may be a
+/// built-in; any other is a file.
+fn is_plain_name(name: &str) -> bool {
+    !name.contains('/')
+        && !name.contains(std::path::MAIN_SEPARATOR)
+        && Path::new(name).extension().is_none()
+}
+
+/// Says on standard error that the built-in `name` was taken although a
+/// file of that name exists here (`./NAME` reads the file).
+fn note_builtin_over_file(what: &str, name: &str) {
+    if is_file_to_read(Path::new(name)) {
+        note!(
+            "note: `{name}` is the built-in {what}; the file {name} here is not read (give ./{name} to read it)"
+        );
+    }
+}
+
+/// A file read whole as UTF-8 text: an error names the file, and for bytes
+/// that are not UTF-8 the line and column of the first.
+/// At most `limit` bytes and one more are read: the loader refuses a
+/// larger file by its size, and a file of gigabytes is not read whole.
+fn read_text(path: &Path, what: &str, limit: usize) -> Result<String> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(limit as u64 + 1).read_to_end(&mut bytes))
+        .with_context(|| format!("cannot read {what} {}", path.display()))?;
+    if bytes.len() > limit {
+        // (Cut at the limit, perhaps inside a character: the loader
+        // refuses it by its size.)
+        return Ok(String::from_utf8_lossy(&bytes).into_owned());
+    }
+    kinpost_post::diag::decode_utf8(bytes, &path.to_string_lossy()).map_err(report)
+}
+
+/// A built-in machine by name, or a machine file. A plain name (no path
+/// separator, no extension) of a built-in machine is the built-in one, with
+/// a note when a file of that name exists here too.
 fn load_machine(name: &str) -> Result<Machine> {
     let path = Path::new(name);
+    if is_plain_name(name)
+        && let Some(m) = builtin::load(name)
+    {
+        note_builtin_over_file("machine", name);
+        return m.map_err(report);
+    }
     if is_file_to_read(path) {
-        let src = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read machine file {name}"))?;
+        let src = read_text(
+            path,
+            "machine file",
+            kinpost_post::machine::MAX_MACHINE_FILE_BYTES,
+        )?;
         return machine_from_source(&src, name);
     }
     match builtin::load(name) {
@@ -484,12 +572,41 @@ fn machine_from_source(src: &str, name: &str) -> Result<Machine> {
     Ok(machine)
 }
 
-/// A built-in dialect by name, or a dialect file.
+/// The dialect a machine file names in `[post] dialect`, as a path from
+/// the folder of that machine file when it is a relative file name (not a
+/// plain built-in name): the same command gives the same program from any
+/// folder.
+fn dialect_of_machine(machine_arg: &str, dialect: &str) -> String {
+    let machine_path = Path::new(machine_arg);
+    let from_file = !(is_plain_name(machine_arg) && builtin::load(machine_arg).is_some())
+        && is_file_to_read(machine_path);
+    if is_plain_name(dialect) || Path::new(dialect).is_absolute() || !from_file {
+        return dialect.to_string();
+    }
+    match machine_path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => {
+            dir.join(dialect).to_string_lossy().into_owned()
+        }
+        _ => dialect.to_string(),
+    }
+}
+
+/// A built-in dialect by name, or a dialect file (the same rule as
+/// [`load_machine`]).
 fn load_dialect(name: &str) -> Result<Dialect> {
     let path = Path::new(name);
+    if is_plain_name(name)
+        && let Some(d) = Dialect::builtin(name)
+    {
+        note_builtin_over_file("dialect", name);
+        return Ok(d);
+    }
     if is_file_to_read(path) {
-        let src = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read dialect file {name}"))?;
+        let src = read_text(
+            path,
+            "dialect file",
+            kinpost_post::nc::MAX_DIALECT_FILE_BYTES,
+        )?;
         return Dialect::from_toml(&src, name).map_err(report);
     }
     if let Some(d) = Dialect::builtin(name) {
@@ -534,13 +651,13 @@ fn unit_vector(text: &str, what: &str) -> Result<Vector3<f64>> {
 fn post(args: PostArgs) -> Result<()> {
     // Both outputs exist (as temporary files) before the run, so that one
     // that cannot be created leaves the other unwritten too.
-    let mut sinks = open_post_outputs(&args)?;
     let machine = load_machine(&args.machine)?;
-    let dialect_name = args
-        .dialect
-        .clone()
-        .or_else(|| machine.post.dialect.clone())
-        .unwrap_or_else(|| "csv".to_string());
+    let dialect_name = match (&args.dialect, &machine.post.dialect) {
+        (Some(d), _) => d.clone(),
+        (None, Some(d)) => dialect_of_machine(&args.machine, d),
+        (None, None) => "csv".to_string(),
+    };
+    let mut sinks = open_post_outputs(&args, &dialect_name)?;
     let dialect = load_dialect(&dialect_name)?;
     let options = PostOptions {
         cl_file: if args.input == "-" {
@@ -636,14 +753,14 @@ fn post(args: PostArgs) -> Result<()> {
 /// given), then the JSON summary (`--json`) if asked for; never both on
 /// standard output, never onto an input file (the CL, machine or dialect
 /// file) or each other.
-fn open_post_outputs(args: &PostArgs) -> Result<Vec<Sink>> {
+fn open_post_outputs(args: &PostArgs, dialect: &String) -> Result<Vec<Sink>> {
     let mut inputs = Vec::new();
     if args.input != "-" {
         inputs.push(("CL file", Path::new(&args.input)));
     }
     for (what, name) in [
         ("machine file", Some(&args.machine)),
-        ("dialect file", args.dialect.as_ref()),
+        ("dialect file", Some(dialect)),
     ] {
         if let Some(name) = name.filter(|n| Path::new(n).is_file()) {
             inputs.push((what, Path::new(name)));

@@ -31,6 +31,11 @@ const MAX_ROTARY_TRAVEL: f64 = 3600.0;
 /// through such a point solves to wrong positions.
 const MAX_COORDINATE_MM: f64 = 1e6;
 
+/// The largest machine file read: 1 MiB, hundreds of times a commented
+/// machine with a pressure table. A larger text (300 000 `[[axis]]`
+/// tables) is refused before it is parsed, in bounded time and memory.
+pub const MAX_MACHINE_FILE_BYTES: usize = 1 << 20;
+
 #[derive(Deserialize)]
 struct RawMachine {
     name: Option<Spanned<String>>,
@@ -387,6 +392,21 @@ pub fn machine_from_toml_with(
     file: &str,
     meshes: MeshFiles,
 ) -> Result<Machine, Diagnostics> {
+    if source.len() > MAX_MACHINE_FILE_BYTES {
+        return Err(Diagnostic::error(
+            file,
+            1,
+            1,
+            1,
+            source.lines().next().unwrap_or(""),
+            format!(
+                "the machine file has {} bytes, more than {MAX_MACHINE_FILE_BYTES}: a machine \
+                 file is a few kilobytes (is this a machine file?)",
+                source.len()
+            ),
+        )
+        .into());
+    }
     // Syntax first, then the keys and types of the machine file.
     if let Err(e) = source.parse::<toml::Table>() {
         return Err(toml_error(&e, file, source, true).into());
@@ -427,18 +447,23 @@ pub fn machine_from_toml_with(
         }
     };
 
-    let mut axes = Vec::with_capacity(raw.axis.len());
-    let mut direction_ok = Vec::with_capacity(raw.axis.len());
-    for a in &raw.axis {
-        let (axis, ok) = check_axis(&mut c, a, &raw.axis);
+    // Past the limit, only the axes up to it are checked (each against the
+    // others, for duplicate names): the first table past it is the error,
+    // and a file of 300 000 tables takes no quadratic work.
+    let listed = &raw.axis[..raw.axis.len().min(MAX_AXES)];
+    let mut axes = Vec::with_capacity(listed.len());
+    let mut direction_ok = Vec::with_capacity(listed.len());
+    for a in listed {
+        let (axis, ok) = check_axis(&mut c, a, listed);
         axes.push(axis);
         direction_ok.push(ok);
     }
-    if axes.len() > MAX_AXES {
+    if raw.axis.len() > MAX_AXES {
         c.error(
             raw.axis[MAX_AXES].name.span(),
             format!("a machine has at most {MAX_AXES} axes"),
         );
+        return Err(Diagnostics(c.errors));
     }
     check_axis_counts(&mut c, &raw.axis, &axes, &direction_ok);
 
@@ -837,6 +862,13 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
             c.error(o.span(), "machine_offset must be a finite number");
             0.0
         }
+        Some(o) if o.get_ref().abs() > MAX_COORDINATE_MM => {
+            c.error(
+                o.span(),
+                format!("machine_offset must lie within ±{MAX_COORDINATE_MM:e}"),
+            );
+            0.0
+        }
         Some(o) => *o.get_ref(),
         None => 0.0,
     };
@@ -847,6 +879,18 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         limits_ok = false;
         if !(lo.is_finite() && hi.is_finite() && nc_lo.is_finite() && nc_hi.is_finite()) {
             c.error(l.span(), "limits must be finite numbers");
+        } else if [lo, hi, nc_lo, nc_hi]
+            .iter()
+            .any(|v| v.abs() > MAX_COORDINATE_MM)
+        {
+            // (Tolerances and travel diagonals are computed from them:
+            // ±1e154 would make them infinite.)
+            c.error(
+                l.span(),
+                format!(
+                    "limits must lie within ±{MAX_COORDINATE_MM:e} (mm or degrees, NC and machine values)"
+                ),
+            );
         } else if lo > hi {
             c.error(
                 l.span(),
@@ -870,6 +914,11 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         let v = *f.get_ref();
         if !v.is_finite() {
             c.error(f.span(), "fixed value must be a finite number");
+        } else if v.abs() > MAX_COORDINATE_MM {
+            c.error(
+                f.span(),
+                format!("fixed value must lie within ±{MAX_COORDINATE_MM:e}"),
+            );
         } else if let Some([lo, hi]) = limits
             && limits_ok
             && (v < lo || v > hi)
@@ -1077,6 +1126,31 @@ axis = [0, 0, 1]
         assert!(e.contains("m.toml:7:13"), "{e}");
         let e = err(&GOOD.replace("direction = [1, 0, 0]", "direction = [1, 1, 0]"));
         assert!(e.contains("not a unit vector (length 1.414213562)"), "{e}");
+    }
+
+    /// Limits so large that a tolerance would become infinite, and a file
+    /// of many axis tables: errors, the latter at its first table past the
+    /// limit.
+    #[test]
+    fn huge_limits_and_many_axis_tables_are_errors() {
+        let src = crate::builtin::source("trunnion-ac").unwrap();
+        let huge = src.replacen("limits = [", "limits = [-1e154, 1e154] # was [", 1);
+        let e = machine_from_toml(&huge, "m.toml").unwrap_err().to_string();
+        assert!(e.contains("limits must lie within"), "{e}");
+        let mut many = String::from("name = \"m\"\n");
+        for i in 0..50_000 {
+            many.push_str(&format!(
+                "[[axis]]\nname = \"X{i}\"\nkind = \"linear\"\nside = \"tool\"\ndirection = [1, 0, 0]\n"
+            ));
+        }
+        let e = machine_from_toml(&many, "m.toml").unwrap_err();
+        assert_eq!(e.0.len(), 1, "{e}");
+        assert!(e.0[0].message.contains("bytes"), "{e}");
+        let few = many[..many.find("[[axis]]\nname = \"X300\"").unwrap()].to_string();
+        let e = machine_from_toml(&few, "m.toml").unwrap_err();
+        assert_eq!(e.0.len(), 1, "{e}");
+        assert_eq!(e.0[0].line, 5 * MAX_AXES + 3, "{e}");
+        assert!(e.0[0].message.contains("at most 9 axes"), "{e}");
     }
 
     #[test]

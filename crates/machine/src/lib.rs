@@ -31,7 +31,8 @@ pub mod tolerance;
 pub use at_pressure::KinematicsAtPressure;
 pub use describe::Mm;
 pub use file::{
-    MAX_MESH_BYTES, MeshFiles, StlError, machine_from_toml, machine_from_toml_with, mesh_from_stl,
+    MAX_MACHINE_FILE_BYTES, MAX_MESH_BYTES, MeshFiles, StlError, machine_from_toml,
+    machine_from_toml_with, mesh_from_stl,
 };
 pub use kinematics::BodyPoses;
 pub use kinematics::{

@@ -251,6 +251,10 @@ impl TemplateKind {
     }
 }
 
+/// The largest dialect file read: 1 MiB, hundreds of times a commented
+/// dialect; a larger text is refused before it is parsed.
+pub const MAX_DIALECT_FILE_BYTES: usize = 1 << 20;
+
 /// A parsed, validated NC dialect.
 #[derive(Clone)]
 pub struct Dialect {
@@ -317,6 +321,21 @@ impl Dialect {
     /// Parses and validates a dialect file. Every problem is reported as a
     /// diagnostic naming `file_name`, line and column.
     pub fn from_toml(source: &str, file_name: &str) -> Result<Dialect, Diagnostics> {
+        if source.len() > MAX_DIALECT_FILE_BYTES {
+            return Err(Diagnostic::error(
+                file_name,
+                1,
+                1,
+                1,
+                source.lines().next().unwrap_or(""),
+                format!(
+                    "the dialect file has {} bytes, more than {MAX_DIALECT_FILE_BYTES}: a dialect \
+                     file is a few kilobytes (is this a dialect file?)",
+                    source.len()
+                ),
+            )
+            .into());
+        }
         // serde would stop at the first unknown key or value: they are all
         // found here (the `Raw*` types let unknown keys pass), and reported
         // with the mistakes the checks below find.
@@ -505,6 +524,7 @@ impl Dialect {
                 );
             }
             check_variables(&env, kind_t, t, source, &mut err);
+            check_budget(&env, kind_t, t, source, &mut err);
             templates.insert(kind_t, t.get_ref().clone());
         }
 
@@ -744,13 +764,16 @@ impl Dialect {
     }
 
     /// Renders a template source (e.g. a machine file's header override) with
-    /// this dialect's template settings and filters.
+    /// this dialect's template settings, filters and limits; every string in
+    /// `vars` is cleaned for the dialect first ([`CommentSyntax::clean`]).
     pub fn render_template(
         &self,
         source: &str,
         vars: &BTreeMap<String, minijinja::Value>,
     ) -> Result<String, crate::NcError> {
-        template::render_str(&self.env, "template", source, vars)
+        let mut vars = vars.clone();
+        self.comment.clean_vars(&mut vars);
+        template::render_str(&self.env, "template", source, &vars)
     }
 }
 
@@ -879,6 +902,37 @@ fn check_variables(
     }
 }
 
+/// A template that goes past its budget (fuel, output, nesting) with sample
+/// values would stop a post, or run for long before it does: refused at
+/// load, where it is written.
+fn check_budget(
+    env: &Environment<'static>,
+    kind: TemplateKind,
+    t: &Spanned<String>,
+    source: &str,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    let vars = template::sample_vars("sample", kind.variables());
+    if let Some(e) = template::budget_error(env, kind.key(), &vars) {
+        err(
+            template::error_span_in_toml(source, t.span(), t.get_ref(), &e),
+            budget_message(kind, &e),
+        );
+    }
+}
+
+fn budget_message(kind: TemplateKind, e: &minijinja::Error) -> String {
+    format!(
+        "template `{}` rendered with sample values: {} (a template may run about {} \
+         instructions, make about {} MB of data and write {} bytes)",
+        kind.key(),
+        template::error_message(e),
+        template::TEMPLATE_FUEL,
+        template::TEMPLATE_FUEL * 64 / 1_000_000,
+        template::MAX_TEMPLATE_OUTPUT_BYTES,
+    )
+}
+
 /// The variables the writer gives template `kind`.
 fn given_variables(kind: TemplateKind) -> Vec<&'static str> {
     ProgramInfo::VARIABLES
@@ -921,7 +975,17 @@ pub fn check_template(kind: TemplateKind, source: &str) -> Result<(), TemplateEr
             line: Some(source[..range.start].matches('\n').count() + 1),
             range: Some(range),
         }),
-        None => Ok(()),
+        None => {
+            let vars = template::sample_vars("sample", kind.variables());
+            match template::budget_error(&env, kind.key(), &vars) {
+                Some(e) => Err(TemplateError {
+                    message: budget_message(kind, &e),
+                    range: template::error_range(source, &e),
+                    line: e.line(),
+                }),
+                None => Ok(()),
+            }
+        }
     }
 }
 

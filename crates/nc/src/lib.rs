@@ -30,19 +30,23 @@ use std::collections::BTreeMap;
 mod dialect;
 pub mod interp;
 mod reader;
+mod sanitize;
 mod template;
 mod writer;
 
 pub use dialect::{
-    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MotionWords, Numbering,
-    TemplateKind, WordFormat, check_template,
+    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
+    MotionWords, Numbering, TemplateKind, WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use kinpost_number::{FormatError, MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use minijinja::Value;
 pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
-pub use template::{TemplateError, template_span_in_toml};
-pub use writer::{NcWriter, Spindle};
+pub use template::{
+    MAX_TEMPLATE_OUTPUT_BYTES, TEMPLATE_FUEL, TEMPLATE_RECURSION_LIMIT, TemplateError,
+    template_span_in_toml,
+};
+pub use writer::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
 
 /// One machine axis as the writer and reader need it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -230,6 +234,8 @@ impl ProgramInfo {
 pub enum NcError {
     /// Writing failed.
     Io(std::io::Error),
+    /// Block numbers ran out.
+    Numbers(NumbersRunOut),
     /// A template could not be compiled or rendered.
     Template {
         /// `header`, `footer`, `tool_change`, ... or `template` for an override.
@@ -240,6 +246,16 @@ pub enum NcError {
         range: Option<std::ops::Range<usize>>,
         /// What went wrong.
         message: String,
+    },
+    /// A value that cannot stand in a program: one that would be written as
+    /// 0 or is too large to write (a spindle speed, a tool number).
+    Value {
+        /// What it is (`spindle speed`).
+        what: &'static str,
+        /// The value as given.
+        value: String,
+        /// Why it cannot be written, and what can be.
+        reason: String,
     },
     /// A line longer than the dialect's `max_line_length` that is not a
     /// comment to shorten (a CL `INSERT`, a template line).
@@ -271,6 +287,12 @@ impl std::fmt::Display for NcError {
                 }
                 write!(f, ": {message}")
             }
+            NcError::Value {
+                what,
+                value,
+                reason,
+            } => write!(f, "cannot write the {what} {value}: {reason}"),
+            NcError::Numbers(e) => e.fmt(f),
             NcError::LineTooLong {
                 source,
                 text,
@@ -293,7 +315,10 @@ impl std::error::Error for NcError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
             NcError::Io(e) => Some(e),
-            NcError::Template { .. } | NcError::LineTooLong { .. } => None,
+            NcError::Template { .. }
+            | NcError::Value { .. }
+            | NcError::Numbers(_)
+            | NcError::LineTooLong { .. } => None,
         }
     }
 }
@@ -344,8 +369,50 @@ pub enum BlockError {
     /// The dialect's `pressure` template, written with a new pressure word,
     /// failed.
     Template(NcError),
+    /// A pressure asked for that the dialect's decimals write as 0.
+    PressureRoundsToZero {
+        /// The pressure word.
+        word: String,
+        /// The pressure.
+        value: f64,
+    },
+    /// Block numbers ran out.
+    Numbers(NumbersRunOut),
     /// Writing failed.
     Io(std::io::Error),
+}
+
+/// Block numbers ran out: the number after `last` does not fit in 64 bits
+/// (a dialect's numbering without `wrap_after`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NumbersRunOut {
+    /// The last number written.
+    pub last: u64,
+}
+
+impl std::fmt::Display for NumbersRunOut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "block numbers run out: the number after {} does not fit in 64 bits \
+             (give the dialect's [numbering] a wrap_after, or a smaller start or step)",
+            self.last
+        )
+    }
+}
+
+impl std::error::Error for NumbersRunOut {}
+
+impl From<NumbersRunOut> for BlockError {
+    fn from(e: NumbersRunOut) -> Self {
+        BlockError::Numbers(e)
+    }
+}
+
+impl From<NumbersRunOut> for NcError {
+    fn from(e: NumbersRunOut) -> Self {
+        NcError::Numbers(e)
+    }
 }
 
 impl std::fmt::Display for BlockError {
@@ -356,6 +423,11 @@ impl std::fmt::Display for BlockError {
                     f,
                     "block has {got} axis values, the machine has {want} axes"
                 )
+            }
+            // (A value too large to write is shown in exponent form, not
+            // in hundreds of digits.)
+            BlockError::Value { word, value, error } if value.abs() >= 1e15 => {
+                write!(f, "cannot write {word} = {value:e}: {error}")
             }
             BlockError::Value { word, value, error } => {
                 write!(f, "cannot write {word} = {value}: {error}")
@@ -381,6 +453,11 @@ impl std::fmt::Display for BlockError {
                 "dialect `{dialect}` cannot write the pressure word `{word}`: it has no [pressure] table"
             ),
             BlockError::Template(e) => e.fmt(f),
+            BlockError::PressureRoundsToZero { word, value } => write!(
+                f,
+                "cannot write {word} = {value}: it would be written as 0 with the dialect's decimals"
+            ),
+            BlockError::Numbers(e) => e.fmt(f),
             BlockError::Io(e) => write!(f, "cannot write the NC program: {e}"),
         }
     }

@@ -8,6 +8,23 @@ use minijinja::{Environment, UndefinedBehavior, Value};
 
 use crate::NcError;
 
+/// The work one rendering of a template may do, in minijinja fuel: about
+/// one unit per instruction and one per 64 bytes of data it makes (strings
+/// joined, lists built, output). Half a million units bound a render to
+/// well under a second and about 32 MB, far beyond any header or tool
+/// change (the built-in dialects' longest render, the header, uses a few
+/// hundred). A template that needs more is an error (`OutOfFuel`), never a
+/// run without end or an allocation that aborts the process.
+pub const TEMPLATE_FUEL: u64 = 500_000;
+
+/// The most text one rendering of a template may write: 1 MiB, thousands
+/// of lines of header. More is an error.
+pub const MAX_TEMPLATE_OUTPUT_BYTES: usize = 1 << 20;
+
+/// How deep templates may nest (macros calling macros, includes): well
+/// below minijinja's own 500, so that a recursive macro stops early.
+pub const TEMPLATE_RECURSION_LIMIT: usize = 100;
+
 /// The environment every dialect uses: `trim_blocks` and `lstrip_blocks` on
 /// (block tags on their own lines leave no blank lines), undefined variables
 /// are errors, plus the `num` filter.
@@ -22,6 +39,8 @@ pub(crate) fn environment() -> Environment<'static> {
     }
     env.set_undefined_behavior(UndefinedBehavior::Strict);
     env.set_debug(true);
+    env.set_fuel(Some(TEMPLATE_FUEL));
+    env.set_recursion_limit(TEMPLATE_RECURSION_LIMIT);
     env.add_filter("num", num);
     env.add_filter("name", name);
     env.add_filter("ascii", ascii);
@@ -88,6 +107,46 @@ fn num(value: f64, decimals: Option<u32>) -> String {
     s
 }
 
+/// The text a render writes, refused past [`MAX_TEMPLATE_OUTPUT_BYTES`].
+#[derive(Default)]
+struct Bounded {
+    text: Vec<u8>,
+    over: bool,
+}
+
+impl std::io::Write for Bounded {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.text.len() + buf.len() > MAX_TEMPLATE_OUTPUT_BYTES {
+            self.over = true;
+            return Err(std::io::Error::other("template output limit"));
+        }
+        self.text.extend_from_slice(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Renders `t` within the output limit (the fuel is the environment's).
+fn render_bounded(
+    t: &minijinja::Template<'_, '_>,
+    vars: &BTreeMap<String, Value>,
+) -> Result<String, minijinja::Error> {
+    let mut out = Bounded::default();
+    match t.render_captured_to(Value::from(vars.clone()), &mut out) {
+        Ok(_) => Ok(String::from_utf8_lossy(&out.text).into_owned()),
+        Err(_) if out.over => Err(minijinja::Error::new(
+            minijinja::ErrorKind::InvalidOperation,
+            format!(
+                "the template writes more than {MAX_TEMPLATE_OUTPUT_BYTES} bytes (the limit of one template's output)"
+            ),
+        )),
+        Err(e) => Err(e),
+    }
+}
+
 /// Renders a template registered in `env`.
 pub(crate) fn render(
     env: &Environment<'static>,
@@ -95,8 +154,7 @@ pub(crate) fn render(
     vars: &BTreeMap<String, Value>,
 ) -> Result<String, NcError> {
     let t = env.get_template(name).map_err(|e| to_error(name, &e))?;
-    t.render(Value::from(vars.clone()))
-        .map_err(|e| to_error(name, &e))
+    render_bounded(&t, vars).map_err(|e| to_error(name, &e))
 }
 
 /// Renders a template given as text (e.g. a machine file override).
@@ -106,8 +164,68 @@ pub(crate) fn render_str(
     source: &str,
     vars: &BTreeMap<String, Value>,
 ) -> Result<String, NcError> {
-    env.render_named_str(name, source, Value::from(vars.clone()))
-        .map_err(|e| to_error(name, &e))
+    let t = env
+        .template_from_named_str(name, source)
+        .map_err(|e| to_error(name, &e))?;
+    render_bounded(&t, vars).map_err(|e| to_error(name, &e))
+}
+
+/// Whether `e` says a render went past its budget (fuel, output, nesting)
+/// rather than that its input was wrong.
+fn over_budget(e: &minijinja::Error) -> bool {
+    if e.kind() == minijinja::ErrorKind::OutOfFuel {
+        return true;
+    }
+    let detail = e.detail().unwrap_or("");
+    detail.contains("recursion limit") || detail.contains("more than") && detail.contains("bytes")
+}
+
+/// The values a check renders every template with once: a program name,
+/// a tool, a spindle speed, a coolant mode, a pressure, as a post would
+/// give them.
+pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<String, Value> {
+    let axes = ["X", "Y", "Z", "A", "C"].map(crate::AxisSpec::linear);
+    let info = crate::ProgramInfo {
+        program_name: "SAMPLE".into(),
+        date: "2025-01-01".into(),
+        machine: "sample".into(),
+        tool: "SAMPLE TOOL".into(),
+        tool_number: 1,
+        cl_file: "sample.cls".into(),
+        extra: BTreeMap::new(),
+    };
+    let mut vars = info.template_vars(dialect, &axes);
+    for name in extra_names {
+        let v = match *name {
+            "tool_name" => Value::from("SAMPLE TOOL"),
+            "speed" => Value::from(1000.0),
+            "clockwise" => Value::from(true),
+            "direction" => Value::from("cw"),
+            "mode" => Value::from("flood"),
+            "pressure" => Value::from(3000.0),
+            "pressure_word" => Value::from("H1"),
+            _ => Value::from(""),
+        };
+        vars.insert((*name).to_string(), v);
+    }
+    vars
+}
+
+/// Renders template `name` of `env` once with `vars` and returns the error
+/// only when it went past its budget (see [`TEMPLATE_FUEL`],
+/// [`MAX_TEMPLATE_OUTPUT_BYTES`], [`TEMPLATE_RECURSION_LIMIT`]): a
+/// template that fails on the sample values for a reason of its own (a
+/// `fail(…)` for a mode the machine lacks) is left to the post.
+pub(crate) fn budget_error(
+    env: &Environment<'static>,
+    name: &str,
+    vars: &BTreeMap<String, Value>,
+) -> Option<minijinja::Error> {
+    let t = env.get_template(name).ok()?;
+    match render_bounded(&t, vars) {
+        Err(e) if over_budget(&e) => Some(e),
+        _ => None,
+    }
 }
 
 /// The variables template `name` (source `source`) reads that it is not

@@ -10,7 +10,7 @@ use crate::dialect::{
     CommentSyntax, Dialect, DialectKind, MAX_LEAD, MAX_SUFFIX, Numbering, TemplateKind,
 };
 use crate::template;
-use crate::{AxisSpec, Block, BlockError, Motion, NcError, ProgramInfo};
+use crate::{AxisSpec, Block, BlockError, Motion, NcError, NumbersRunOut, ProgramInfo};
 use kinpost_number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 
 /// Spindle state for [`NcWriter::spindle`].
@@ -241,6 +241,8 @@ pub struct NcWriter<W: Write> {
     max_line: usize,
     numbering: Numbering,
     next_number: u64,
+    /// The number after the last one written does not fit in a `u64`.
+    numbers_exhausted: bool,
     comment: CommentSyntax,
     env: Arc<Environment<'static>>,
     dialect_name: String,
@@ -372,6 +374,7 @@ impl<W: Write> NcWriter<W> {
             max_line: dialect.block.max_line_length.unwrap_or(usize::MAX),
             numbering: dialect.numbering.clone(),
             next_number: dialect.numbering.start,
+            numbers_exhausted: false,
             comment: dialect.comment.clone(),
             env: dialect.env.clone(),
             dialect_name: dialect.name.clone(),
@@ -442,6 +445,7 @@ impl<W: Write> NcWriter<W> {
         info: &ProgramInfo,
         override_template: Option<&str>,
     ) -> Result<(), NcError> {
+        check_tool_number(info.tool_number, false)?;
         self.program_vars(info);
         if self.kind == DialectKind::Csv {
             self.csv_header()?;
@@ -475,8 +479,13 @@ impl<W: Write> NcWriter<W> {
     }
 
     /// The template variables of the program `info`, with `tcp` as it is.
+    /// Every text in them (program name, file name, tool, machine, extra
+    /// variables) is cleaned for the dialect ([`CommentSyntax::clean`]):
+    /// no text from outside puts a line break or the end of a comment into
+    /// the program.
     fn program_vars(&mut self, info: &ProgramInfo) {
         self.vars = info.template_vars(&self.dialect_name, &self.axis_specs);
+        self.comment.clean_vars(&mut self.vars);
         self.vars.insert("tcp".into(), Value::from(self.tcp_on));
     }
 
@@ -485,9 +494,13 @@ impl<W: Write> NcWriter<W> {
     /// tool-centre-point control on, it is turned off before and on again
     /// after, for the new tool (unless the dialect's `outside_tcp` leaves
     /// `tool_change` out). The next block writes every axis word.
+    /// The name is cleaned for the dialect ([`CommentSyntax::clean`]); a
+    /// tool number outside 1 ..= [`MAX_TOOL_NUMBER`] is an error.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
+        check_tool_number(number, true)?;
+        let name = self.comment.clean(name).into_owned();
         self.vars.insert("tool_number".into(), Value::from(number));
-        self.vars.insert("tool".into(), Value::from(name));
+        self.vars.insert("tool".into(), Value::from(name.as_str()));
         self.vars.insert("tool_name".into(), Value::from(name));
         self.command(TemplateKind::ToolChange, Vec::new())?;
         // The change moves the axes to where the machine changes tools, and
@@ -498,10 +511,13 @@ impl<W: Write> NcWriter<W> {
 
     /// Spindle on (`spindle_on` with `speed`, `clockwise`, `direction` =
     /// `cw`/`ccw`) or off (`spindle_off`).
+    /// A speed that writes as 0 in whole rpm (below 0.5) or above
+    /// [`MAX_SPINDLE_RPM`] (not finite included) is an error.
     pub fn spindle(&mut self, state: Spindle) -> Result<(), NcError> {
         match state {
             Spindle::Off => self.command(TemplateKind::SpindleOff, Vec::new()),
             Spindle::Cw(s) | Spindle::Ccw(s) => {
+                check_spindle_speed(s)?;
                 let cw = matches!(state, Spindle::Cw(_));
                 self.command(
                     TemplateKind::SpindleOn,
@@ -524,7 +540,10 @@ impl<W: Write> NcWriter<W> {
             // DIALECTS.md documents, whatever case the CL wrote.
             Some(m) => self.command(
                 TemplateKind::CoolantOn,
-                vec![("mode", Value::from(m.to_ascii_lowercase()))],
+                vec![(
+                    "mode",
+                    Value::from(self.comment.clean(&m.to_ascii_lowercase()).into_owned()),
+                )],
             ),
         }
     }
@@ -580,7 +599,10 @@ impl<W: Write> NcWriter<W> {
             return Ok(());
         }
         let mut all = self.vars.clone();
-        all.extend(vars.iter().map(|(k, v)| (k.clone(), v.clone())));
+        all.extend(
+            vars.iter()
+                .map(|(k, v)| (k.clone(), self.comment.clean_value(v))),
+        );
         let text = template::render_str(&self.env, "template", source, &all)?;
         self.write_lines(&text, self.numbering.commands, "template")
     }
@@ -644,7 +666,7 @@ impl<W: Write> NcWriter<W> {
             }
             let start = self.buf.len();
             if numbered && self.numbering.enabled {
-                self.push_number();
+                self.push_number()?;
             }
             let used = self.buf.len() - start + self.eol.len();
             let room = self.max_line.saturating_sub(used);
@@ -671,18 +693,10 @@ impl<W: Write> NcWriter<W> {
         }
         self.buf.clear();
         if self.numbering.enabled && self.numbering.comments {
-            self.push_number();
+            self.push_number()?;
         }
         self.buf.extend_from_slice(self.comment.prefix.as_bytes());
-        let mut body: String = text.replace(['\r', '\n'], " ");
-        if self.comment.ascii {
-            body = crate::template::ascii(&body);
-        }
-        for (from, to) in &self.comment.replace {
-            if body.contains(from.as_str()) {
-                body = body.replace(from.as_str(), to);
-            }
-        }
+        let body = self.comment.clean(text);
         let used = self.buf.len() + self.comment.suffix.len() + self.eol.len();
         let Some(room) = self.max_line.checked_sub(used) else {
             return Err(NcError::LineTooLong {
@@ -737,7 +751,15 @@ impl<W: Write> NcWriter<W> {
     }
 
     /// The next block number, with prefix and separator, into `out`.
-    fn number_into(&mut self, out: &mut Vec<u8>) {
+    /// Fails once the numbers run out: the number after the last one
+    /// written does not fit in 64 bits and the dialect does not wrap
+    /// (`wrap_after`). Numbers never repeat without a wrap.
+    fn number_into(&mut self, out: &mut Vec<u8>) -> Result<(), NumbersRunOut> {
+        if self.numbers_exhausted {
+            return Err(NumbersRunOut {
+                last: self.next_number,
+            });
+        }
         out.extend_from_slice(self.numbering.prefix.as_bytes());
         write_u64(out, self.next_number, self.numbering.digits);
         out.extend_from_slice(&self.sep);
@@ -745,18 +767,26 @@ impl<W: Write> NcWriter<W> {
             // Heidenhain-style bare numbers need a space.
             out.push(b' ');
         }
-        self.next_number = self.next_number.saturating_add(self.numbering.step);
+        match self.next_number.checked_add(self.numbering.step) {
+            Some(n) => self.next_number = n,
+            None if self.numbering.wrap_after.is_some() => {
+                self.next_number = self.numbering.start;
+            }
+            None => self.numbers_exhausted = true,
+        }
         if let Some(w) = self.numbering.wrap_after
             && self.next_number > w
         {
             self.next_number = self.numbering.start;
         }
+        Ok(())
     }
 
-    fn push_number(&mut self) {
+    fn push_number(&mut self) -> Result<(), NumbersRunOut> {
         let mut buf = std::mem::take(&mut self.buf);
-        self.number_into(&mut buf);
+        let done = self.number_into(&mut buf);
         self.buf = buf;
+        done
     }
 
     /// The line in `self.line` is longer than `max_line_length`.
@@ -843,7 +873,7 @@ impl<W: Write> NcWriter<W> {
         }
 
         // Pass 2: format.
-        self.start_line();
+        self.start_line()?;
         let line = &mut self.line;
         let mut first = true;
         if write_motion {
@@ -893,16 +923,17 @@ impl<W: Write> NcWriter<W> {
     /// Starts the motion block line: empty, or the block number when
     /// numbering is on. Returns its length.
     #[inline(always)]
-    fn start_line(&mut self) -> usize {
+    fn start_line(&mut self) -> Result<usize, BlockError> {
         self.line.len = 0;
         if self.numbering.enabled {
             let mut number = std::mem::take(&mut self.buf);
             number.clear();
-            self.number_into(&mut number);
+            let done = self.number_into(&mut number);
             self.line.put(&number);
             self.buf = number;
+            done?;
         }
-        self.line.len
+        Ok(self.line.len)
     }
 
     /// [`NcWriter::block`] (after the pressure line) for a dialect in which
@@ -914,7 +945,7 @@ impl<W: Write> NcWriter<W> {
         let write_motion = !self.motion_word(block.motion).is_empty()
             && (!self.motion_modal || self.motion_state != Some(block.motion));
         let number_before = self.next_number;
-        let mut len = self.start_line();
+        let mut len = self.start_line()?;
         let buf = &mut self.line.bytes[..];
         let mut first = true;
         if write_motion {
@@ -1023,13 +1054,25 @@ impl<W: Write> NcWriter<W> {
             Ok(n) => n,
             Err(e) => return Err(self.bad_value(index, value, e)),
         };
+        if n == 0 && value != 0.0 {
+            // (As for feeds: a pressure asked for must not be written as
+            // none.)
+            return Err(BlockError::PressureRoundsToZero {
+                word: p.name.clone(),
+                value,
+            });
+        }
         if p.word.known && p.word.last == n {
             return Ok(());
         }
         let mut number = std::mem::take(&mut self.buf);
         number.clear();
-        if self.numbering.enabled && self.numbering.commands {
-            self.number_into(&mut number);
+        if self.numbering.enabled
+            && self.numbering.commands
+            && let Err(e) = self.number_into(&mut number)
+        {
+            self.buf = number;
+            return Err(e.into());
         }
         self.line.len = 0;
         self.line.put(&number);
@@ -1148,6 +1191,53 @@ impl<W: Write> NcWriter<W> {
         self.out.flush()?;
         Ok(self.out)
     }
+}
+
+/// The fastest spindle speed a program may ask for, rpm: six digits in
+/// whole rpm, above any machining spindle (high-speed and air-turbine
+/// spindles run up to a few 100 000 rpm). A larger value is an error,
+/// not a word of hundreds of digits.
+pub const MAX_SPINDLE_RPM: f64 = 999_999.0;
+
+/// The largest tool number a program may ask for: eight digits, the
+/// longest T word of the common controllers (Fanuc `T` with eight digits;
+/// Sinumerik and Heidenhain allow fewer: their controller says so).
+pub const MAX_TOOL_NUMBER: u32 = 99_999_999;
+
+/// A spindle speed every dialect writes in whole rpm: not one that writes
+/// as 0 (below 0.5 rpm), nor one above [`MAX_SPINDLE_RPM`].
+fn check_spindle_speed(rpm: f64) -> Result<(), NcError> {
+    if rpm.is_finite() && (0.5..=MAX_SPINDLE_RPM).contains(&rpm) {
+        return Ok(());
+    }
+    let reason = if rpm.is_finite() && rpm < 0.5 && rpm > -0.5 {
+        "it would be written as S0 (whole rpm)".to_string()
+    } else {
+        format!("a spindle speed must be from 0.5 to {MAX_SPINDLE_RPM} rpm")
+    };
+    Err(NcError::Value {
+        what: "spindle speed",
+        value: rpm.to_string(),
+        reason,
+    })
+}
+
+/// A tool number from 1 (0 is "no tool" on most controllers; allowed in the
+/// header, where it means "unknown", when `change` is false) to
+/// [`MAX_TOOL_NUMBER`].
+fn check_tool_number(number: u32, change: bool) -> Result<(), NcError> {
+    if number <= MAX_TOOL_NUMBER && (number > 0 || !change) {
+        return Ok(());
+    }
+    Err(NcError::Value {
+        what: "tool number",
+        value: number.to_string(),
+        reason: if number == 0 {
+            "tool 0 unloads the spindle on most controllers: load a tool from 1".into()
+        } else {
+            format!("a tool number must be from 1 to {MAX_TOOL_NUMBER}")
+        },
+    })
 }
 
 /// `line` cut to `room` bytes, as a head and a tail to join: the end of the

@@ -76,42 +76,53 @@ fn char_column(line: &str, byte: usize) -> usize {
     line[..byte].chars().count() + 1
 }
 
+/// The fields of a CSV line, each with its character column. One pass over
+/// the line (the columns are counted as it goes): linear in the line's
+/// length however many fields it has.
 fn split_csv(line: &str) -> Vec<Field<'_>> {
     let mut out = Vec::new();
     let mut start = 0;
-    for (k, c) in line
+    // Characters before `start`.
+    let mut start_chars = 0;
+    for (chars, (k, c)) in line
         .char_indices()
         .chain(std::iter::once((line.len(), ',')))
+        .enumerate()
     {
         if c == ',' {
             let raw = &line[start..k];
-            let lead = raw.len() - raw.trim_start().len();
+            let trimmed = raw.trim_start();
+            let lead_chars = raw[..raw.len() - trimmed.len()].chars().count();
             out.push(Field {
                 text: raw.trim(),
-                column: char_column(line, start + lead),
+                column: start_chars + lead_chars + 1,
             });
             start = k + 1;
+            start_chars = chars + 1;
         }
     }
     out
 }
 
+/// The whitespace-separated fields of a line, each with its character
+/// column, in one pass.
 fn split_ws(line: &str) -> Vec<Field<'_>> {
     let mut out = Vec::new();
-    let mut start: Option<usize> = None;
-    for (k, c) in line
+    let mut start: Option<(usize, usize)> = None;
+    for (chars, (k, c)) in line
         .char_indices()
         .chain(std::iter::once((line.len(), ' ')))
+        .enumerate()
     {
         if c.is_whitespace() {
-            if let Some(s) = start.take() {
+            if let Some((s, column)) = start.take() {
                 out.push(Field {
                     text: &line[s..k],
-                    column: char_column(line, s),
+                    column,
                 });
             }
         } else if start.is_none() {
-            start = Some(k);
+            start = Some((k, chars + 1));
         }
     }
     out
@@ -787,6 +798,24 @@ mod tests {
                 .contains("`Radius` of this surface has 2 values, JM is 3"),
             "{e}"
         );
+    }
+
+    /// The columns counted in one pass agree with counting from the
+    /// start of the line, multi-byte characters and blanks included.
+    #[test]
+    fn field_columns_are_character_columns() {
+        let line = " ä, b ,  平c,,d";
+        for f in split_csv(line) {
+            let byte = f.text.as_ptr() as usize - line.as_ptr() as usize;
+            assert_eq!(f.column, char_column(line, byte), "{}", f.text);
+        }
+        let line = "  ä b\t平c  d ";
+        let fields = split_ws(line);
+        assert_eq!(fields.len(), 4);
+        for f in fields {
+            let byte = f.text.as_ptr() as usize - line.as_ptr() as usize;
+            assert_eq!(f.column, char_column(line, byte), "{}", f.text);
+        }
     }
 
     #[test]

@@ -42,6 +42,6 @@ pub mod scallop;
 
 pub use kinpost_surface::Surface;
 pub use path::{
-    ContactPoint, Direction, Pass, PathError, PathOptions, Report, Side, Spacing, Toolpath, Wheel,
-    plan,
+    ContactPoint, Direction, MAX_PASSES, MAX_PATH_POINTS, MIN_CHORD_TOLERANCE_MM, Pass, PathError,
+    PathOptions, Report, Side, Spacing, Toolpath, Wheel, plan,
 };

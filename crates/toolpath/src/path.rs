@@ -87,6 +87,32 @@ pub enum PathError {
     Options(String),
     #[error("the surface is degenerate (no normal) at u = {u:.6}, v = {v:.6}")]
     Degenerate { u: f64, v: f64 },
+    /// The options ask for more passes or CL points than a path may have,
+    /// found before the work is done.
+    #[error(
+        "the path would need about {points} CL points ({passes} passes of about {per_pass} points) \
+         for a chord tolerance of {chord_tolerance_mm} mm and a largest tool-axis turn of \
+         {max_angle_deg}°: more than {limit}; loosen them"
+    )]
+    TooManyPoints {
+        points: f64,
+        passes: usize,
+        per_pass: f64,
+        chord_tolerance_mm: f64,
+        max_angle_deg: f64,
+        limit: usize,
+    },
+    /// The step-over asks for more passes than a path may have.
+    #[error(
+        "the path would need about {passes} passes (a surface {cross_mm:.3} mm across at a \
+         step-over of {stepover_mm} mm): more than {limit}"
+    )]
+    TooManyPasses {
+        passes: f64,
+        cross_mm: f64,
+        stepover_mm: f64,
+        limit: usize,
+    },
     #[error(
         "no step-over meets the {what} after the pass at {cross:.6}: the wheel (width {width} mm) cannot cover the surface there"
     )]
@@ -175,8 +201,9 @@ impl PathOptions {
             "the wheel width must be a positive number of mm",
         )?;
         check(
-            positive(self.chord_tolerance),
-            "the chord tolerance must be a positive number of mm",
+            positive(self.chord_tolerance) && self.chord_tolerance >= MIN_CHORD_TOLERANCE_MM,
+            "the chord tolerance must be a number of mm from 1e-6 (1 nm: finer is below what a \
+             machine moves and what the chord check can tell from rounding)",
         )?;
         check(
             positive(self.max_angle_deg) && self.max_angle_deg <= 90.0,
@@ -199,8 +226,8 @@ impl PathOptions {
                 )?;
             }
             Spacing::Scallop(h) => check(
-                positive(h),
-                "the scallop height must be a positive number of mm",
+                positive(h) && h >= MIN_CHORD_TOLERANCE_MM,
+                "the scallop height must be a number of mm from 1e-6 (1 nm)",
             )?,
             Spacing::Overlap(o) => check(
                 (0.0..1.0).contains(&o),
@@ -213,6 +240,103 @@ impl PathOptions {
             "the region must be u0,u1,v0,v1 with 0 ≤ u0 < u1 ≤ 1 and 0 ≤ v0 < v1 ≤ 1",
         )
     }
+}
+
+/// The finest chord tolerance: 1 nm. Below it the deviation of a chord
+/// is lost in the rounding of the points (a pass would be cut into steps
+/// of 1e-12 of its length until the point cap), and no machine moves so
+/// finely.
+pub const MIN_CHORD_TOLERANCE_MM: f64 = 1e-6;
+
+/// The most passes a path may have.
+pub const MAX_PASSES: usize = 100_000;
+
+/// The most CL points a path may have, all passes together: 20 million
+/// points, a CL file of about 1.5 GB.
+pub const MAX_PATH_POINTS: usize = 20_000_000;
+
+/// Samples per estimated pass or cross line (see [`estimate_points`]).
+const ESTIMATE_SAMPLES: usize = 128;
+
+/// The length of the surface across the passes (the largest of a few
+/// lines at fixed pass parameter), for the number of passes a step-over
+/// asks for.
+fn cross_length(surface: &Surface, along_u: bool, s: (f64, f64), c: (f64, f64)) -> f64 {
+    let mut longest = 0.0f64;
+    for a in 0..=8 {
+        let sp = s.0 + (s.1 - s.0) * f64::from(a) / 8.0;
+        let at = |k: usize| {
+            let cp = c.0 + (c.1 - c.0) * k as f64 / ESTIMATE_SAMPLES as f64;
+            let (u, v) = if along_u { (sp, cp) } else { (cp, sp) };
+            surface.point(u, v)
+        };
+        let length: f64 = (0..ESTIMATE_SAMPLES)
+            .map(|k| (at(k + 1) - at(k)).norm())
+            .sum();
+        longest = longest.max(length);
+    }
+    longest
+}
+
+/// About how many CL points [`sample_pass`] takes on pass `pc`: along
+/// each of [`ESTIMATE_SAMPLES`] pieces, the more of its length over the
+/// chord step the curvature allows (√(8·tol/κ)) and its turn over the
+/// largest turn, and at least the four steps a pass always has.
+fn estimate_pass_points(surface: &Surface, pc: &PassCurve, options: &PathOptions) -> f64 {
+    let tol = options.chord_tolerance;
+    let max_angle = options.max_angle_deg.to_radians();
+    let frames: Vec<PassFrame> = (0..=ESTIMATE_SAMPLES)
+        .filter_map(|k| {
+            let s = pc.s0 + (pc.s1 - pc.s0) * k as f64 / ESTIMATE_SAMPLES as f64;
+            pc.frame(surface, s)
+        })
+        .collect();
+    let steps: f64 = frames
+        .windows(2)
+        .map(|w| {
+            let length = (w[1].point - w[0].point).norm();
+            let speed = w[0].ds.norm();
+            let kappa = if speed > 0.0 {
+                w[0].ds.cross(&w[0].dss).norm() / speed.powi(3)
+            } else {
+                0.0
+            };
+            let by_chord = length * (kappa / (8.0 * tol)).sqrt();
+            let by_turn = w[0].normal.angle(&w[1].normal) / max_angle;
+            by_chord.max(by_turn)
+        })
+        .sum();
+    steps.max(4.0) + 1.0
+}
+
+/// About how many CL points the passes at `crosses` take (a few passes
+/// sampled, scaled to all): refused past [`MAX_PATH_POINTS`] before any
+/// pass is sampled point by point.
+fn check_point_count(
+    surface: &Surface,
+    options: &PathOptions,
+    crosses: &[f64],
+    curve: &dyn Fn(f64) -> PassCurve,
+) -> Result<(), PathError> {
+    let stride = crosses.len().div_ceil(17).max(1);
+    let sampled: Vec<f64> = crosses
+        .iter()
+        .step_by(stride)
+        .map(|&c| estimate_pass_points(surface, &curve(c), options))
+        .collect();
+    let per_pass = sampled.iter().sum::<f64>() / sampled.len().max(1) as f64;
+    let points = per_pass * crosses.len() as f64;
+    if points > MAX_PATH_POINTS as f64 {
+        return Err(PathError::TooManyPoints {
+            points: points.round(),
+            passes: crosses.len(),
+            per_pass: per_pass.round(),
+            chord_tolerance_mm: options.chord_tolerance,
+            max_angle_deg: options.max_angle_deg,
+            limit: MAX_PATH_POINTS,
+        });
+    }
+    Ok(())
 }
 
 /// Number of pass parameters sampled when choosing the next pass.
@@ -265,6 +389,37 @@ pub fn plan(surface: &Surface, options: &PathOptions) -> Result<Toolpath, PathEr
             && limit_scallop.is_none_or(|h| g.scallop <= 0.9 * h)
     };
 
+    // A step-over that would lay more passes than a path may have is
+    // refused before the search (which would take long to find out).
+    if !matches!(options.spacing, Spacing::Scallop(_)) {
+        let across = cross_length(surface, along_u, (s0, s1), (c0, c1));
+        let passes = across / limit_stepover + 1.0;
+        if passes > MAX_PASSES as f64 {
+            return Err(PathError::TooManyPasses {
+                passes: passes.round(),
+                cross_mm: across,
+                stepover_mm: limit_stepover,
+                limit: MAX_PASSES,
+            });
+        }
+    }
+    // A scallop height that even passes 1/MAX_PASSES of the surface apart
+    // exceed somewhere needs more passes than a path may have: refused
+    // before the search.
+    if let Spacing::Scallop(h) = options.spacing {
+        let step = (c1 - c0) / MAX_PASSES as f64;
+        for k in 0..=8 {
+            let c = c0 + (c1 - c0 - step) * f64::from(k) / 8.0;
+            if !fits(c, c + step, SEARCH_BETWEEN, &samples) {
+                let across = cross_length(surface, along_u, (s0, s1), (c0, c1));
+                return Err(PathError::Options(format!(
+                    "a scallop height of {h} mm needs passes closer than 1/{MAX_PASSES} of the \
+                     surface ({:.6} mm) near the cross parameter {c:.6}: more than {MAX_PASSES} passes",
+                    across / MAX_PASSES as f64
+                )));
+            }
+        }
+    }
     // Pass positions: each the farthest that still fits, by bisection.
     let mut crosses = vec![c0];
     while let Some(&last) = crosses.last() {
@@ -292,12 +447,13 @@ pub fn plan(surface: &Surface, options: &PathOptions) -> Result<Toolpath, PathEr
             });
         }
         crosses.push(lo);
-        if crosses.len() > 100_000 {
-            return Err(PathError::Options(
-                "more than 100000 passes: the step-over is too small".into(),
-            ));
+        if crosses.len() > MAX_PASSES {
+            return Err(PathError::Options(format!(
+                "more than {MAX_PASSES} passes: the step-over is too small"
+            )));
         }
     }
+    check_point_count(surface, options, &crosses, &curve)?;
 
     // The passes, checked at their own CL points; in scallop mode a gap
     // whose fine check exceeds the limit (the search samples more
