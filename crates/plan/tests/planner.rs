@@ -12,6 +12,7 @@ use nalgebra::Vector3;
 
 /// What the sink received.
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // (a test's list)
 enum Out {
     Point {
         line: usize,
