@@ -85,7 +85,7 @@
 //! * LF or CRLF line ends, blank lines, a UTF-8 byte-order mark at the start,
 //!   any UTF-8 text in names. Invalid UTF-8 is an error naming the line.
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod number;
 mod reader;

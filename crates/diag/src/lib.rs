@@ -13,6 +13,8 @@
 //!    |      ^^^^^
 //! ```
 
+#![deny(missing_docs)]
+
 use std::fmt;
 
 mod site;
@@ -41,6 +43,7 @@ impl fmt::Display for Severity {
 /// One message about one place in one input file.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Diagnostic {
+    /// Error or warning.
     pub severity: Severity,
     /// File name as the user gave it (`-` or `<stdin>` for standard input).
     pub file: String,
@@ -156,6 +159,7 @@ impl Diagnostic {
         }
     }
 
+    /// Whether it is an error (not a warning).
     pub fn is_error(&self) -> bool {
         self.severity == Severity::Error
     }

@@ -87,6 +87,7 @@ pub struct Solution {
 }
 
 impl Solution {
+    /// Whether it lies inside the travel.
     pub fn is_valid(&self) -> bool {
         self.violation.is_none()
     }

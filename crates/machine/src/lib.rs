@@ -15,6 +15,8 @@
 //! assert!(solutions.iter().any(|s| (s.joints[0] - 459.0).abs() < 1e-9));
 //! ```
 
+#![deny(missing_docs)]
+
 pub mod angle;
 mod at_pressure;
 pub use angle::angle_between;

@@ -10,14 +10,18 @@ pub const MAX_AXES: usize = 9;
 /// Whether an axis translates or rotates what it carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AxisKind {
+    /// Translates, mm.
     Linear,
+    /// Rotates, degrees.
     Rotary,
 }
 
 /// What an axis carries: the part (a table) or the tool (a head).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Side {
+    /// Carries the part (a table).
     Workpiece,
+    /// Carries the tool (a head).
     Tool,
 }
 
@@ -26,7 +30,9 @@ pub enum Side {
 pub struct Axis {
     /// The NC address, e.g. `X` or `A`.
     pub name: String,
+    /// Linear or rotary.
     pub kind: AxisKind,
+    /// What it carries.
     pub side: Side,
     /// Unit vector in the machine frame at home. A linear axis at value `q`
     /// moves what it carries by `q·direction`; a rotary axis turns it by `q`
@@ -71,16 +77,21 @@ pub enum Wrap {
 /// file).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Prefer {
+    /// The equivalent at or above zero.
     Positive,
+    /// The equivalent at or below zero.
     Negative,
+    /// The equivalent nearest zero.
     Zero,
 }
 
 impl Axis {
+    /// Whether it rotates.
     pub fn is_rotary(&self) -> bool {
         self.kind == AxisKind::Rotary
     }
 
+    /// Whether it moves in this mode (not locked).
     pub fn is_free(&self) -> bool {
         self.fixed.is_none()
     }
@@ -167,7 +178,9 @@ pub enum OutputMode {
 /// A whole machine.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Machine {
+    /// Its name (`mts1600`).
     pub name: String,
+    /// One line about it.
     pub description: String,
     /// Axes in chain order from the machine base outwards (per side).
     pub axes: Vec<Axis>,
@@ -176,7 +189,9 @@ pub struct Machine {
     pub workpiece_rotation: Matrix3<f64>,
     /// Part frame origin at home, machine frame.
     pub workpiece_origin: Vector3<f64>,
+    /// The tool frame at home.
     pub tool: Tool,
+    /// Settings for writing its programs (`[post]`).
     pub post: PostSettings,
     /// A process axis that moves the tool point (the grinding pressure H1),
     /// if the machine has one; see [`Machine::at_pressure`].

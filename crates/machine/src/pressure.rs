@@ -59,6 +59,7 @@ pub struct PressureAxis {
     pub plane: [usize; 2],
     /// Their home directions e₁, e₂ (unit, perpendicular).
     pub directions: [Vector3<f64>; 2],
+    /// How the wheel offset depends on the pressure.
     pub model: WheelModel,
 }
 

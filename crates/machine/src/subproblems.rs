@@ -50,7 +50,9 @@ pub fn rotation_cs(w: &Vector3<f64>, c: f64, s: f64) -> Matrix3<f64> {
 pub struct Angle {
     /// Radians, in (−π, π].
     pub rad: f64,
+    /// Its cosine.
     pub cos: f64,
+    /// Its sine.
     pub sin: f64,
 }
 
@@ -193,6 +195,8 @@ struct Aligned {
 }
 
 impl Sp2 {
+    /// Subproblem 2 for rotations about the unit axes `w1` (outer) and
+    /// `w2` (inner) applied to `p`: what every solve shares, worked out once.
     pub fn new(w1: &Vector3<f64>, w2: &Vector3<f64>, p: &Vector3<f64>) -> Sp2 {
         let w12 = w1.dot(w2);
         let cross = w1.cross(w2);

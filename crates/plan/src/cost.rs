@@ -119,9 +119,13 @@ pub enum Link {
     /// `across_fold`: the tool axis may pass a fold between the points, so
     /// a branch may switch there.
     Cut {
+        /// The turn of the tool axis, degrees.
         turn_deg: f64,
+        /// Singular points lie between.
         across_singular: bool,
+        /// How much more a rotary axis may move near a fold, degrees.
         fold_deg: f64,
+        /// The tool axis may pass a fold between the points.
         across_fold: bool,
     },
 }

@@ -23,6 +23,8 @@
 //! [`solve_near`] solves a pose near a known configuration, for the
 //! planner and for the points the later stages insert.
 
+#![deny(missing_docs)]
+
 mod cost;
 mod node;
 mod planner;

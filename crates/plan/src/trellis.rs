@@ -75,7 +75,9 @@ fn add_node(
 /// A decided point: the configuration chosen and how it is reached.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Choice {
+    /// The axis values chosen.
     pub joints: Joints,
+    /// Their closed-form branch.
     pub branch: u8,
     /// The move into this point is continuous; `false` for a cut that needs
     /// a retract and reconfiguration first.
@@ -131,6 +133,7 @@ impl Trellis {
         }
     }
 
+    /// The cost model.
     pub fn costs(&self) -> &Costs {
         &self.costs
     }
@@ -140,6 +143,7 @@ impl Trellis {
         self.layers.len()
     }
 
+    /// Whether no point waits.
     pub fn is_empty(&self) -> bool {
         self.layers.is_empty()
     }

@@ -45,13 +45,29 @@ impl Ends {
 #[derive(Debug, Clone, PartialEq)]
 pub enum FitError {
     /// Too few data points for the fit.
-    TooFewPoints { have: usize, need: usize },
+    TooFewPoints {
+        /// Points given.
+        have: usize,
+        /// Points needed.
+        need: usize,
+    },
     /// Parameters not strictly increasing at this index.
-    ParametersNotIncreasing { index: usize },
+    ParametersNotIncreasing {
+        /// The index.
+        index: usize,
+    },
     /// More control points asked for than the data can determine.
-    TooManyControlPoints { asked: usize, points: usize },
+    TooManyControlPoints {
+        /// Control points asked for.
+        asked: usize,
+        /// Data points.
+        points: usize,
+    },
     /// Fewer than four control points asked for.
-    TooFewControlPoints { asked: usize },
+    TooFewControlPoints {
+        /// Control points asked for.
+        asked: usize,
+    },
     /// The linear system is singular (should not happen for valid input).
     Singular,
 }

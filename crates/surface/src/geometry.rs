@@ -12,38 +12,51 @@ use nalgebra::Vector3;
 /// Point and partial derivatives of a surface at (u, v).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Derivatives {
+    /// r(u, v).
     pub point: Vector3<f64>,
+    /// r_u.
     pub du: Vector3<f64>,
+    /// r_v.
     pub dv: Vector3<f64>,
+    /// r_uu.
     pub duu: Vector3<f64>,
+    /// r_uv.
     pub duv: Vector3<f64>,
+    /// r_vv.
     pub dvv: Vector3<f64>,
 }
 
 /// Everything about the surface at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LocalGeometry {
+    /// r(u, v).
     pub point: Vector3<f64>,
     /// Unit normal r_u × r_v / |r_u × r_v|.
     pub normal: Vector3<f64>,
     /// First fundamental form E, F, G.
     pub e: f64,
+    /// F.
     pub f: f64,
+    /// G.
     pub g: f64,
     /// Second fundamental form L, M, N (with the unit normal).
     pub l: f64,
+    /// M.
     pub m: f64,
+    /// N.
     pub n: f64,
-    /// Gaussian curvature K = (LN − M²) / (EG − F²) (seed 002 eq. 16).
+    /// Gaussian curvature K = (LN − M²) / (EG − F²) (Li, eq. 16).
     pub gaussian: f64,
     /// Mean curvature H = (EN − 2FM + GL) / (2(EG − F²)).
     pub mean: f64,
     /// Principal curvatures, k1 ≥ k2.
     pub k1: f64,
+    /// See `k1`.
     pub k2: f64,
     /// Unit principal directions in space (tangent to the surface), for k1
     /// and k2; at an umbilic any orthonormal tangent pair.
     pub dir1: Vector3<f64>,
+    /// See `dir1`.
     pub dir2: Vector3<f64>,
 }
 

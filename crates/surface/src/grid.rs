@@ -14,8 +14,11 @@ pub use kinpost_diag::{Diagnostic, Diagnostics};
 /// along the surface's u direction, columns along v.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid {
+    /// Rows (u).
     pub rows: usize,
+    /// Columns (v).
     pub cols: usize,
+    /// The points, row-major, mm.
     pub points: Vec<[f64; 3]>,
 }
 

@@ -24,6 +24,7 @@
 //! assert!((g.normal.norm() - 1.0).abs() < 1e-12);
 //! ```
 
+#![deny(missing_docs)]
 // `!(a < b)` on floats is deliberate here: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 // Band and basis arithmetic reads best with explicit indices.

@@ -41,13 +41,20 @@ pub enum Method {
     Interpolation(Ends),
     /// Least squares with a control net of `rows × cols` points
     /// (4 ≤ rows ≤ m, 4 ≤ cols ≤ n).
-    Approximation { rows: usize, cols: usize },
+    Approximation {
+        /// Control points along u.
+        rows: usize,
+        /// Control points along v.
+        cols: usize,
+    },
 }
 
 /// What a fit is asked to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FitOptions {
+    /// Interpolation or least squares.
     pub method: Method,
+    /// How the data points get their parameters.
     pub parameterisation: Parameterisation,
 }
 
@@ -65,6 +72,7 @@ impl Default for FitOptions {
 pub struct SurfaceFitError {
     /// `"u (along the grid's columns: row index)"` or similar.
     pub direction: &'static str,
+    /// What went wrong.
     pub error: FitError,
 }
 
@@ -84,6 +92,7 @@ const V_DIRECTION: &str = "v (the grid's column index)";
 pub struct FitData {
     /// Parameters of the grid rows (u) and columns (v).
     pub u: Vec<f64>,
+    /// See `u`.
     pub v: Vec<f64>,
     /// The grid, row-major (`rows = u.len()`, `cols = v.len()`).
     pub points: Vec<[f64; 3]>,
@@ -108,7 +117,9 @@ pub struct Surface {
 /// points at their parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Residual {
+    /// The largest, mm.
     pub max: f64,
+    /// The root mean square, mm.
     pub rms: f64,
     /// Grid row and column of the largest.
     pub at: (usize, usize),
@@ -307,10 +318,12 @@ impl Surface {
         &self.control
     }
 
+    /// The knot vector along u.
     pub fn knots_u(&self) -> &[f64] {
         &self.knots_u
     }
 
+    /// The knot vector along v.
     pub fn knots_v(&self) -> &[f64] {
         &self.knots_v
     }
@@ -320,6 +333,7 @@ impl Surface {
         self.method
     }
 
+    /// How the data points got their parameters, if known.
     pub fn parameterisation(&self) -> Option<Parameterisation> {
         self.parameterisation
     }

@@ -15,12 +15,15 @@ use crate::surface::Surface;
 /// Which curvature colours the mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Curvature {
+    /// K.
     Gaussian,
+    /// H.
     Mean,
 }
 
 /// Picture size in SVG user units (pixels).
 pub const WIDTH: f64 = 900.0;
+/// See [`WIDTH`].
 pub const HEIGHT: f64 = 660.0;
 const PLOT_RIGHT: f64 = 760.0;
 const MARGIN: f64 = 40.0;
@@ -120,7 +123,9 @@ impl Projection {
 pub struct Mesh {
     /// (nu + 1) × (nv + 1) points, row-major.
     pub points: Vec<Vector3<f64>>,
+    /// Quads along u.
     pub nu: usize,
+    /// Quads along v.
     pub nv: usize,
     /// Per quad: unit normal and the curvatures (Gaussian, mean) at its
     /// centre (NaN where the surface is degenerate).

@@ -30,6 +30,7 @@
 //! rapids. [`cl::write_cl`] writes the NX-style CL file, [`plot::plot_path`]
 //! an SVG of the passes.
 
+#![deny(missing_docs)]
 // `!(a < b)` on floats is deliberate here: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 // Band and basis arithmetic reads best with explicit indices.

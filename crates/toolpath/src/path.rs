@@ -41,9 +41,13 @@ pub enum Spacing {
 /// Everything `plan` needs.
 #[derive(Debug, Clone)]
 pub struct PathOptions {
+    /// The contact wheel.
     pub wheel: Wheel,
+    /// Passes along u or v.
     pub direction: Direction,
+    /// The side of the surface the wheel is on.
     pub side: Side,
+    /// How far apart the passes are.
     pub spacing: Spacing,
     /// Overlap used to cap the step-over in [`Spacing::Scallop`] mode.
     pub overlap: f64,
@@ -83,10 +87,17 @@ impl Default for PathOptions {
 /// Why no path can be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PathError {
+    /// An option value that cannot be used (the message says which).
     #[error("{0}")]
     Options(String),
+    /// The surface has no normal here.
     #[error("the surface is degenerate (no normal) at u = {u:.6}, v = {v:.6}")]
-    Degenerate { u: f64, v: f64 },
+    Degenerate {
+        /// Parameter u.
+        u: f64,
+        /// Parameter v.
+        v: f64,
+    },
     /// The options ask for more passes or CL points than a path may have,
     /// found before the work is done.
     #[error(
@@ -95,11 +106,17 @@ pub enum PathError {
          {max_angle_deg}°: more than {limit}; loosen them"
     )]
     TooManyPoints {
+        /// CL points needed, about.
         points: f64,
+        /// Passes.
         passes: usize,
+        /// CL points a pass, about.
         per_pass: f64,
+        /// The chord tolerance asked for, mm.
         chord_tolerance_mm: f64,
+        /// The largest turn asked for, degrees.
         max_angle_deg: f64,
+        /// The most a path may have.
         limit: usize,
     },
     /// The step-over asks for more passes than a path may have.
@@ -108,17 +125,25 @@ pub enum PathError {
          step-over of {stepover_mm} mm): more than {limit}"
     )]
     TooManyPasses {
+        /// Passes needed, about.
         passes: f64,
+        /// The surface's width across the passes, mm.
         cross_mm: f64,
+        /// The step-over, mm.
         stepover_mm: f64,
+        /// The most a path may have.
         limit: usize,
     },
+    /// No step-over after a pass meets the scallop or overlap asked for.
     #[error(
         "no step-over meets the {what} after the pass at {cross:.6}: the wheel (width {width} mm) cannot cover the surface there"
     )]
     NoStep {
+        /// What is asked for (`scallop height`, …).
         what: &'static str,
+        /// The pass's fixed parameter.
         cross: f64,
+        /// The wheel's width, mm.
         width: f64,
     },
 }
@@ -126,7 +151,9 @@ pub enum PathError {
 /// One CL point on the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactPoint {
+    /// Parameter u.
     pub u: f64,
+    /// Parameter v.
     pub v: f64,
     /// Contact point, surface coordinates.
     pub point: Vector3<f64>,
@@ -144,13 +171,16 @@ pub struct ContactPoint {
 pub struct Pass {
     /// The fixed parameter (v for passes along u, u for passes along v).
     pub cross: f64,
+    /// Its CL points.
     pub points: Vec<ContactPoint>,
 }
 
 /// What was planned, for the user.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Report {
+    /// Passes.
     pub passes: usize,
+    /// CL points on the surface.
     pub points: usize,
     /// Length of the feed moves on the surface (without leads), mm.
     pub length_mm: f64,
@@ -162,6 +192,7 @@ pub struct Report {
     pub interference_max: f64,
     /// Smallest and largest step-over, mm.
     pub stepover_min: f64,
+    /// See `stepover_min`.
     pub stepover_max: f64,
     /// Largest deviation of a CL segment from the surface (checked at
     /// quarter points), mm.
@@ -174,7 +205,9 @@ pub struct Report {
 /// The planned path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Toolpath {
+    /// The passes in the order the wheel travels them.
     pub passes: Vec<Pass>,
+    /// What was planned.
     pub report: Report,
 }
 

@@ -17,7 +17,9 @@ use nalgebra::Vector3;
 /// A contact wheel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelShape {
+    /// Radius, mm.
     pub radius: f64,
+    /// Width, mm.
     pub width: f64,
 }
 
@@ -26,9 +28,11 @@ pub struct WheelShape {
 pub struct PassCurve {
     /// Along u (fixed v = `cross`) or along v (fixed u = `cross`).
     pub along_u: bool,
+    /// The fixed parameter.
     pub cross: f64,
     /// The pass parameter range.
     pub s0: f64,
+    /// See `s0`.
     pub s1: f64,
     /// +1 or −1: the side of the surface the wheel is on.
     pub side: f64,
@@ -74,8 +78,11 @@ impl PassCurve {
 /// The surface along a pass at one parameter.
 #[derive(Debug, Clone, Copy)]
 pub struct PassFrame {
+    /// The point.
     pub point: Vector3<f64>,
+    /// First derivative along the pass.
     pub ds: Vector3<f64>,
+    /// Second derivative along the pass.
     pub dss: Vector3<f64>,
     /// Tool-side unit normal.
     pub normal: Vector3<f64>,
