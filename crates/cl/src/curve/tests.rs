@@ -1,0 +1,1 @@
+//! Analytic tests of arcs and NURBS curves.
