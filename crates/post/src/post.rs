@@ -9,7 +9,10 @@
 use std::io::{BufRead, Write};
 use std::time::Instant;
 
-use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units};
+use kinpost_cl::{
+    ClEvent, ClReader, CutcomSide, FeedUnit, Motion, Move, Next, SpindleDir, SpindleSpeed,
+    Statement,
+};
 use kinpost_diag::{Diagnostic, Severity};
 use kinpost_machine::{Kinematics, Machine, OutputMode, Pose};
 use kinpost_nc::{
@@ -281,6 +284,7 @@ pub fn post<R: BufRead, W: Write>(
         named: options.program_name.is_some(),
         tool_loaded: false,
         spindle_tool: None,
+        msys: None,
     };
     // The loop over the points stays small: every other statement is read
     // out of line (`statement`), so that what it does cannot crowd the
@@ -365,6 +369,22 @@ struct Reading {
     tool_loaded: bool,
     /// The tool changed to last (`None`: the header's, `tool_number`).
     spindle_tool: Option<u32>,
+    /// The first `MSYS` (origin and axes as written, mm) and its line:
+    /// every point is posted in the machine file's part frame, so a later
+    /// `MSYS` must not change it.
+    msys: Option<([f64; 9], usize)>,
+}
+
+/// The error for a CL statement the post does not act on yet (the reader
+/// gives it as an event; posting it is to come).
+#[cold]
+fn not_posted<R: BufRead>(reader: &ClReader<R>, what: &str) -> PostError {
+    reader
+        .statement_diagnostic(
+            Severity::Error,
+            format!("{what}: kinpost reads it but does not post it yet"),
+        )
+        .into()
 }
 
 /// A CL statement other than a plain `GOTO` line: `false` at `FINI`.
@@ -415,12 +435,8 @@ fn statement<R: BufRead, W: Write>(
                 mm
             });
         }
-        ClEvent::Units(units) => {
-            job.scale = match units {
-                Units::Mm => 1.0,
-                Units::Inch => 25.4,
-            };
-        }
+        // The reader gives every length in mm.
+        ClEvent::Units(_) => {}
         ClEvent::PartNo(name) => {
             if !r.named && !name.trim().is_empty() {
                 job.info.program_name = name.trim().to_string();
@@ -441,7 +457,7 @@ fn statement<R: BufRead, W: Write>(
             job.emit(Output::Comment(format!("TOOL PATH: {name}")), reader)?;
         }
         ClEvent::Comment(text) => job.emit(Output::Comment(text.trim().to_string()), reader)?,
-        ClEvent::LoadTool { number } => {
+        ClEvent::LoadTool { number, .. } => {
             job.break_segment();
             // The header loads the first tool (it knows `tool_number`).
             if !r.tool_loaded && job.setup.is_none() {
@@ -455,7 +471,12 @@ fn statement<R: BufRead, W: Write>(
             r.tool_loaded = true;
         }
         ClEvent::SelectTool { .. } => {}
-        ClEvent::Spindle { rpm, dir } => {
+        ClEvent::Spindle {
+            speed: SpindleSpeed::Rpm(rpm),
+            dir,
+            range: None,
+            max_rpm: None,
+        } => {
             job.rpm = Some(rpm);
             if let Some(per_rev) = job.feed_per_rev {
                 job.feed = Some(per_rev * rpm);
@@ -480,7 +501,61 @@ fn statement<R: BufRead, W: Write>(
         ClEvent::Pressure { word, value } => {
             job.pressure(word.as_deref(), value, reader, &mut r.warnings)?;
         }
-        ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
+        ClEvent::ToolData(_) | ClEvent::Multax(_) => {}
+        ClEvent::MachineSystem { origin, x, y, .. } => {
+            let zero = [0.0; 3];
+            let (x, y) = (x.unwrap_or(zero), y.unwrap_or(zero));
+            let v = [origin, x, y].concat().try_into().expect("nine values");
+            match r.msys {
+                None => r.msys = Some((v, line)),
+                Some((first, first_line)) => {
+                    if v.iter().zip(&first).any(|(a, b)| (a - b).abs() > 1e-6) {
+                        return Err(reader.statement_diagnostic(Severity::Error, format!(
+                            "MSYS changes the machine coordinate system of line {first_line}: kinpost posts every point in the part frame of the machine file; post the operations of each coordinate system as a program of their own"
+                        )).into());
+                    }
+                }
+            }
+        }
+        ClEvent::CoordinateSystem(frame) if frame.is_identity(1e-9) => {}
+        ClEvent::CutterCompensation {
+            side: CutcomSide::Off,
+            ..
+        } => {}
+        // Informational: the CAM system's post name, names, setups, marks,
+        // and FROM (a position, no motion).
+        ClEvent::Machine { .. }
+        | ClEvent::OperationName(_)
+        | ClEvent::Setup { .. }
+        | ClEvent::TapeMark
+        | ClEvent::From { .. } => {}
+        ClEvent::Spindle { .. } => {
+            return Err(not_posted(
+                reader,
+                "a spindle speed in surface units, a gear range or a speed limit",
+            ));
+        }
+        ClEvent::CoordinateSystem(_) => {
+            return Err(not_posted(reader, "CSYS with a rotation or an offset"));
+        }
+        ClEvent::Circle(_) => return Err(not_posted(reader, "CIRCLE (an arc)")),
+        ClEvent::Nurbs(_) => return Err(not_posted(reader, "NURBS (a spline)")),
+        ClEvent::Cycle(_) | ClEvent::CycleOff => {
+            return Err(not_posted(reader, "CYCLE (a canned cycle)"));
+        }
+        ClEvent::GoHome { .. } => return Err(not_posted(reader, "GOHOME")),
+        ClEvent::CutterCompensation { .. } => {
+            return Err(not_posted(
+                reader,
+                "CUTCOM (cutter radius compensation: the GOTOs are the part contour, not tool positions)",
+            ));
+        }
+        ClEvent::Dwell(_) => return Err(not_posted(reader, "DELAY (a dwell)")),
+        ClEvent::Stop | ClEvent::OptionalStop | ClEvent::End => {
+            return Err(not_posted(reader, "STOP, OPSTOP or END (a program stop)"));
+        }
+        ClEvent::Clamp { .. } => return Err(not_posted(reader, "CLAMP")),
+        ClEvent::Origin(_) => return Err(not_posted(reader, "ORIGIN")),
         ClEvent::Fini => return Ok(false),
     }
     Ok(true)
