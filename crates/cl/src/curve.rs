@@ -124,7 +124,8 @@ impl Arc {
             return Err(ArcError::NoTurns);
         }
         let n = norm(axis);
-        if !(n > 1e-12) {
+        // (The inputs are finite here: `n` is not NaN.)
+        if n <= 1e-12 {
             return Err(ArcError::ZeroAxis);
         }
         let axis = scale(axis, 1.0 / n);
@@ -137,7 +138,7 @@ impl Arc {
         let pe = sub(de, scale(axis, he));
         let start_radius = norm(ps);
         let end_radius = norm(pe);
-        if !(start_radius > MIN_ARC_RADIUS_MM) {
+        if start_radius <= MIN_ARC_RADIUS_MM {
             return Err(ArcError::StartOnAxis {
                 radius_mm: start_radius,
             });
@@ -408,7 +409,7 @@ impl Nurbs {
             }
         }
         let n = points.len();
-        if !(knots[n] > knots[degree]) {
+        if knots[n] <= knots[degree] {
             return Err(NurbsError::EmptyDomain);
         }
         Ok(Nurbs {
@@ -494,8 +495,9 @@ impl Nurbs {
                 } else {
                     0.0
                 };
-                for c in 0..4 {
-                    d[j][c] = (1.0 - alpha) * d[j - 1][c] + alpha * d[j][c];
+                let lower = d[j - 1];
+                for (c, v) in d[j].iter_mut().enumerate() {
+                    *v = (1.0 - alpha) * lower[c] + alpha * *v;
                 }
             }
         }

@@ -116,7 +116,7 @@ impl<R: BufRead> ClReader<R> {
                 "PITCH" => cycle.pitch_mm = Some(self.mm(value)),
                 unit => match feed_unit(unit) {
                     Some(unit) => {
-                        if !(value > 0.0) {
+                        if value <= 0.0 {
                             return Err(self.error(
                                 value_span,
                                 format!(

@@ -129,7 +129,8 @@ impl<R: BufRead> ClReader<R> {
             ));
         };
         if nx {
-            axis = scale(axis, -1.0);
+            // (`+ 0.0`: no negative zeros in the event.)
+            axis = axis.map(|v| -v + 0.0);
         }
         let centre = self.mm3([v[0], v[1], v[2]]);
         let Some(start) = self.last_point else {

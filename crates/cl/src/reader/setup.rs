@@ -172,7 +172,7 @@ impl<R: BufRead> ClReader<R> {
             _ => return Err(self.error(args, usage)),
         };
         let value = self.number(t)?;
-        if !(value >= 0.0) {
+        if value < 0.0 {
             return Err(self.error(
                 t,
                 format!("the dwell must not be negative, got `{}`", self.field(t)),

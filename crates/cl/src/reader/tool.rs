@@ -161,7 +161,7 @@ impl<R: BufRead> ClReader<R> {
                 }
                 "MAXRPM" if k < self.fields.len() => {
                     let m = self.number(self.fields[k])?;
-                    if !(m > 0.0) {
+                    if m <= 0.0 {
                         return Err(self.error(self.fields[k], "MAXRPM must be positive"));
                     }
                     max_rpm = Some(m);
@@ -175,7 +175,7 @@ impl<R: BufRead> ClReader<R> {
         }
         let (value, dir) = match speed {
             Some((value, span)) => {
-                if !(value > 0.0) {
+                if value <= 0.0 {
                     return Err(self.error(
                         span,
                         format!(
