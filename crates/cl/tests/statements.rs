@@ -76,10 +76,9 @@ fn the_reader_converts_lengths_to_mm_by_one_multiplication() {
 
 #[test]
 fn nx_circle_axis_is_clockwise_and_its_extra_values_are_kept() {
-    // From (0,10) about the origin with NX's axis 0,0,-1 to (10,0): a
-    // quarter turn counter-clockwise seen from +Z... no: NX turns
-    // clockwise about its axis, i.e. counter-clockwise about +Z, so from
-    // (0,10) the tool goes through (-7.07, 7.07) to (-10, 0).
+    // NX writes the axis 0,0,-1 and turns clockwise about it, i.e.
+    // counter-clockwise about +Z: from (0,10) about the origin the tool goes
+    // through (-7.07, 7.07) to (-10, 0), a quarter turn.
     let e = events(
         "GOTO/0,10,5,0,0,1\nCIRCLE/0,0,5,0.0000000,0.0000000,-1.0000000,10.0000,0.0600,0.5000,25.0000,1.0000\nGOTO/-10,0,5\n",
     );
