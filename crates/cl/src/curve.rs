@@ -79,12 +79,39 @@ pub enum ArcError {
     /// `turns` is zero.
     #[error("an arc makes at least one turn (TIMES must be 1 or more)")]
     NoTurns,
+    /// `turns` is more than [`MAX_ARC_TURNS`].
+    #[error("an arc of {turns} turns: at most {MAX_ARC_TURNS} are read")]
+    TooManyTurns {
+        /// The turns asked for.
+        turns: u32,
+    },
 }
 
-/// Why a sampling tolerance is refused.
+/// The most turns an arc may make (NX `TIMES`): a thread-milling helix
+/// makes a few dozen; a number beyond this is a corrupt record, and its
+/// sampling would fill memory.
+pub const MAX_ARC_TURNS: u32 = 1000;
+
+/// The most points one curve is sampled into: a tolerance that needs more
+/// is far below any machine's resolution (a mistake), refused rather than
+/// filling memory.
+pub const MAX_SAMPLE_POINTS: usize = 1 << 20;
+
+/// Why a curve cannot be sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Error)]
-#[error("the chord tolerance must be a positive finite length, got {0}")]
-pub struct ToleranceError(pub f64);
+pub enum SampleError {
+    /// The tolerance is not a positive finite length.
+    #[error("the chord tolerance must be a positive finite length, got {0}")]
+    Tolerance(f64),
+    /// The tolerance asks for more than [`MAX_SAMPLE_POINTS`] points.
+    #[error(
+        "the chord tolerance {tolerance_mm} mm needs more than {MAX_SAMPLE_POINTS} points for one curve"
+    )]
+    TooManyPoints {
+        /// The tolerance asked for.
+        tolerance_mm: f64,
+    },
+}
 
 /// A circular arc or helix between two points; see the [module](self) docs.
 #[derive(Debug, Clone, PartialEq)]
@@ -122,6 +149,9 @@ impl Arc {
         }
         if turns == 0 {
             return Err(ArcError::NoTurns);
+        }
+        if turns > MAX_ARC_TURNS {
+            return Err(ArcError::TooManyTurns { turns });
         }
         let n = norm(axis);
         // (The inputs are finite here: `n` is not NaN.)
@@ -255,7 +285,7 @@ impl Arc {
     }
 
     /// The number of chords whose sagitta stays within `tolerance_mm`.
-    pub fn segments(&self, tolerance_mm: f64) -> Result<usize, ToleranceError> {
+    pub fn segments(&self, tolerance_mm: f64) -> Result<usize, SampleError> {
         check_tolerance(tolerance_mm)?;
         let r = self.start_radius.max(self.end_radius);
         // The largest angle whose sagitta r (1 − cos(δ/2)) is the tolerance;
@@ -268,13 +298,17 @@ impl Arc {
         // (A tolerance far below the radius's rounding would ask for
         // billions of points: at least 1e-9 of the radius per chord.)
         let max_angle = max_angle.max(2.0 * (1.0 - 1e-9_f64).acos());
-        Ok(((self.sweep / max_angle).ceil() as usize).max(1))
+        let n = (self.sweep / max_angle).ceil();
+        if n > MAX_SAMPLE_POINTS as f64 {
+            return Err(SampleError::TooManyPoints { tolerance_mm });
+        }
+        Ok((n as usize).max(1))
     }
 
     /// Points along the arc after the start, the last being the end, such
     /// that the chords from the start point through them stay within
     /// `tolerance_mm` of the arc (equal angles).
-    pub fn sample(&self, tolerance_mm: f64) -> Result<Vec<Vec3>, ToleranceError> {
+    pub fn sample(&self, tolerance_mm: f64) -> Result<Vec<Vec3>, SampleError> {
         let n = self.segments(tolerance_mm)?;
         Ok((1..=n)
             .map(|k| self.point_at(k as f64 / n as f64))
@@ -282,11 +316,11 @@ impl Arc {
     }
 }
 
-fn check_tolerance(tolerance_mm: f64) -> Result<(), ToleranceError> {
+fn check_tolerance(tolerance_mm: f64) -> Result<(), SampleError> {
     if tolerance_mm.is_finite() && tolerance_mm > 0.0 {
         Ok(())
     } else {
-        Err(ToleranceError(tolerance_mm))
+        Err(SampleError::Tolerance(tolerance_mm))
     }
 }
 
@@ -511,8 +545,9 @@ impl Nurbs {
     /// `2 · degree` equal parameter steps, and a step is halved while the
     /// curve at its quarter, middle or three-quarter parameter lies farther
     /// than the tolerance from the chord (a check at three parameters of
-    /// each chord, not a bound; at most 2¹⁶ chords a step).
-    pub fn sample(&self, tolerance_mm: f64) -> Result<Vec<Vec3>, ToleranceError> {
+    /// each chord, not a bound; at most 2¹⁶ chords a step, at most
+    /// [`MAX_SAMPLE_POINTS`] in all).
+    pub fn sample(&self, tolerance_mm: f64) -> Result<Vec<Vec3>, SampleError> {
         check_tolerance(tolerance_mm)?;
         let mut out = Vec::new();
         let n = self.points.len();
@@ -526,6 +561,9 @@ impl Nurbs {
                 let u0 = a + (b - a) * s as f64 / floor as f64;
                 let u1 = a + (b - a) * (s + 1) as f64 / floor as f64;
                 self.subdivide(u0, u1, tolerance_mm, 16, &mut out);
+                if out.len() > MAX_SAMPLE_POINTS {
+                    return Err(SampleError::TooManyPoints { tolerance_mm });
+                }
             }
         }
         Ok(out)

@@ -42,6 +42,8 @@ CNTRL/2,2,2
 CNTRL/3,3,3
 CYCLE/DRILL,DEEP,RAPTO,3,FEDTO,-10,STEP,2,MMPM,100
 GOTO/5,5,0
+CYCLE / BRKCHP, DEPTH, 5, STEP, 1, MMPM, 40, CLEAR, 2, BACK, 0.2, TIMES, 3
+GOTO/6,5,0
 CYCLE/OFF
 FROM/0,0,100,0,0,1
 GOHOME
@@ -94,6 +96,12 @@ const PIECES: &[&str] = &[
     "CYCLE/DRILL,",
     "FEDTO,",
     "TIMES,",
+    "BACK,",
+    "1001",
+    "CUTCOM/LEFT,XYPLAN,",
+    "CSYS/",
+    "MSYS/",
+    "SPINDL/SFM,",
     "FROM/",
     "GOHOME",
     "$$-> ",
@@ -214,7 +222,7 @@ fn the_valid_text_is_valid() {
     {
         n += 1;
     }
-    assert_eq!(n, 43);
+    assert_eq!(n, 45);
     assert_eq!(reader.take_warnings(), vec![]);
 }
 

@@ -103,6 +103,12 @@ fn nx_helix_times() {
     let arc = c.arc([4., 0., 3.], [4., 0., 0.]).unwrap();
     assert!((arc.sweep_rad() - 4.0 * PI).abs() < 1e-12);
     assert_eq!(arc.rise_mm(), -3.0);
+    for times in ["0", "1001"] {
+        let e = error(&format!(
+            "GOTO/4,0,3,0,0,1\nCIRCLE/0,0,0,0,0,-1,4,0.06,0.5,10,0,TIMES,{times}\nGOTO/4,0,0\n"
+        ));
+        assert_eq!(e.message, "TIMES must be 1 to 1000");
+    }
 }
 
 #[test]
@@ -129,6 +135,10 @@ fn solidworks_circle_has_no_radius() {
     // The radius is the current point's distance from the axis.
     assert!((c.radius_mm - 0.8).abs() < 1e-5, "{}", c.radius_mm);
     assert_eq!(c.tolerance_mm, None);
+    assert_eq!(
+        error("GOTO/1,1,0\nCIRCLE/1,1,5,0,0,1\nGOTO/2,1,0\n").message,
+        "the current point is on the circle's axis: the arc has no radius"
+    );
 }
 
 #[test]
@@ -232,6 +242,8 @@ fn cycles_in_three_dialects() {
         dwell: None,
         feed: None,
         pitch_mm: None,
+        back_off_mm: None,
+        full_retract_every: None,
     };
     // NX: the kind may take two words.
     let e =
@@ -263,6 +275,19 @@ fn cycles_in_three_dialects() {
     assert!((c.retract_mm.unwrap() - 25.4).abs() < 1e-12);
     assert!((c.feed.unwrap().value - 101.6).abs() < 1e-12);
     assert_eq!(c.dwell, Some(Dwell::Revolutions(2.0)));
+    // Creo's chip breaking: back off 0.05 in after each peck, leave the
+    // hole after every third.
+    let e = events(
+        "UNITS / INCHES\nCYCLE / BRKCHP, DEPTH, 0.5, STEP, 0.1, IPM, 4.0, CLEAR, 0.2, BACK, 0.05, TIMES, 3\n",
+    );
+    let c = cycle(&e[1]);
+    assert!((c.back_off_mm.unwrap() - 1.27).abs() < 1e-12);
+    assert_eq!(c.full_retract_every, Some(3));
+    assert!(
+        error("CYCLE/BRKCHP,DEPTH,1,TIMES,2.5\n")
+            .message
+            .contains("number of pecks (TIMES)")
+    );
     // SOLIDWORKS CAM: INIT first; DWELL 0 is no dwell.
     let e = events(
         "CYCLE/INIT\nCYCLE/TAP,FEDTO,12.,PITCH,1.25,MMPR,1.25,RAPTO,3.,RTRCTO,25.,DWELL,0.5\n",

@@ -187,8 +187,36 @@ fn arc_samples_keep_the_chord_tolerance_with_the_fewest_chords() {
         Arc::new([1., 0., 0.], [0., 1., 0.], [0.; 3], [0., 0., 1.], 1)
             .unwrap()
             .sample(0.0),
-        Err(ToleranceError(_))
+        Err(SampleError::Tolerance(_))
     ));
+    // A tolerance a million times finer than the radius's rounding would
+    // ask for more points than anyone can use: refused.
+    let helix = Arc::new(
+        [1., 0., 0.],
+        [1., 0., 5.],
+        [0.; 3],
+        [0., 0., 1.],
+        MAX_ARC_TURNS,
+    )
+    .unwrap();
+    assert_eq!(
+        helix.sample(1e-15),
+        Err(SampleError::TooManyPoints {
+            tolerance_mm: 1e-15
+        })
+    );
+    assert_eq!(
+        Arc::new(
+            [1., 0., 0.],
+            [1., 0., 5.],
+            [0.; 3],
+            [0., 0., 1.],
+            MAX_ARC_TURNS + 1
+        ),
+        Err(ArcError::TooManyTurns {
+            turns: MAX_ARC_TURNS + 1
+        })
+    );
 }
 
 proptest! {

@@ -11,7 +11,7 @@ use crate::number::parse_number;
 use crate::{ClEvent, Cycle, CycleKind, Dwell};
 
 /// The couplet keywords a cycle may carry, for the error message.
-const KEYWORDS: &str = "FEDTO, DEPTH, RAPTO, CLEAR, RTRCTO, RETURN, STEP, INCR, 1STPECK, SUBPECK, DWELL, REV, PITCH, MMPM, IPM, MMPR, IPR";
+const KEYWORDS: &str = "FEDTO, DEPTH, RAPTO, CLEAR, RTRCTO, RETURN, STEP, INCR, 1STPECK, SUBPECK, DWELL, REV, BACK, TIMES, PITCH, MMPM, IPM, MMPR, IPR";
 
 impl<R: BufRead> ClReader<R> {
     /// `CYCLE/kind[,kind2],keyword,value,…`, `CYCLE/OFF`; SOLIDWORKS CAM's
@@ -67,6 +67,8 @@ impl<R: BufRead> ClReader<R> {
             dwell: None,
             feed: None,
             pitch_mm: None,
+            back_off_mm: None,
+            full_retract_every: None,
         };
         let mut rapto: Option<f64> = None;
         let mut clear: Option<f64> = None;
@@ -114,6 +116,13 @@ impl<R: BufRead> ClReader<R> {
                 "DWELL" => cycle.dwell = (value != 0.0).then_some(Dwell::Seconds(value)),
                 "REV" => cycle.dwell = (value != 0.0).then_some(Dwell::Revolutions(value)),
                 "PITCH" => cycle.pitch_mm = Some(self.mm(value)),
+                // Creo's chip breaking (BRKCHP): back off after each peck,
+                // leave the hole after every n pecks.
+                "BACK" => cycle.back_off_mm = (value != 0.0).then(|| self.mm(value).abs()),
+                "TIMES" => {
+                    let n = self.whole(k - 1, "number of pecks (TIMES)")?;
+                    cycle.full_retract_every = (n != 0).then_some(n);
+                }
                 unit => match feed_unit(unit) {
                     Some(unit) => {
                         if value <= 0.0 {

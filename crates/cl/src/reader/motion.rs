@@ -7,7 +7,7 @@ use std::io::BufRead;
 use kinpost_diag::Diagnostic;
 
 use super::{ClReader, PendingCircle, Span, skip_blanks};
-use crate::curve::{ARC_RADIUS_TOLERANCE_MM, Nurbs};
+use crate::curve::{ARC_RADIUS_TOLERANCE_MM, MAX_ARC_TURNS, MIN_ARC_RADIUS_MM, Nurbs};
 use crate::vector::{dot, norm, normalize, scale, sub};
 use crate::{Circle, ClEvent, FeedUnit, Statement, Units, Vec3};
 
@@ -92,8 +92,11 @@ impl<R: BufRead> ClReader<R> {
             let f = self.fields[k];
             if self.is(f, "TIMES") && k + 1 < self.fields.len() {
                 turns = self.whole(k + 1, "number of turns (TIMES)")?;
-                if turns == 0 {
-                    return Err(self.error(self.fields[k + 1], "TIMES must be 1 or more"));
+                if turns == 0 || turns > MAX_ARC_TURNS {
+                    return Err(self.error(
+                        self.fields[k + 1],
+                        format!("TIMES must be 1 to {MAX_ARC_TURNS}"),
+                    ));
                 }
                 k += 2;
             } else {
@@ -142,6 +145,12 @@ impl<R: BufRead> ClReader<R> {
         // The current point's distance from the axis.
         let d = sub(start, centre);
         let start_radius = norm(sub(d, scale(axis, dot(d, axis))));
+        if !start_radius.is_finite() {
+            return Err(self.error(
+                args,
+                "the circle's centre is too far from the current point for a finite radius",
+            ));
+        }
         let radius_mm = match radius {
             Some(r) => {
                 let r = self.mm(r);
@@ -166,6 +175,12 @@ impl<R: BufRead> ClReader<R> {
             }
             None => start_radius,
         };
+        if start_radius < MIN_ARC_RADIUS_MM {
+            return Err(self.error(
+                args,
+                "the current point is on the circle's axis: the arc has no radius",
+            ));
+        }
         let circle = Circle {
             centre,
             axis,
