@@ -47,20 +47,44 @@
 //!
 //! # What is read
 //!
+//! Every length and feed an event carries is in mm, whatever the file's
+//! units (see *Units* below). The meaning of each statement, what each CAM
+//! system writes and the sources are in the repository's
+//! `docs/cl-statements.md`.
+//!
 //! | statement | event |
 //! |---|---|
 //! | `TOOL PATH/name,word,…` | [`ClEvent::ToolPath`] |
-//! | `TLDATA/kind,v,…`, `CUTTER/v,…` | [`ClEvent::ToolData`] |
-//! | `MSYS/x,y,z[,xi,xj,xk[,yi,yj,yk]]` | [`ClEvent::MachineSystem`]; a later `MSYS` that changes it is an error |
-//! | `$$ text`, `PPRINT/text` | [`ClEvent::Comment`] |
+//! | `TLDATA/kind[,kind2…],v,…`, `CUTTER/d[,r,e,f,α,β,h]` | [`ClEvent::ToolData`] ([`ToolData`]) |
+//! | `MSYS/x,y,z[,xi,xj,xk,yi,yj,yk]` | [`ClEvent::MachineSystem`], checked orthonormal ([`FRAME_TOLERANCE`]); a cut-short record: warning |
+//! | `CSYS/` 3 × 4 matrix | [`ClEvent::CoordinateSystem`] ([`Frame::from_rows`], checked orthonormal) |
+//! | `$$ text` (Creo `$$->` continued with `$` joined), `PPRINT/text` | [`ClEvent::Comment`] |
 //! | `RAPID`, `RAPID/` | no event: the next `GOTO` is a rapid move |
-//! | `GOTO/x,y,z[,i,j,k[,u,v,w]]` | [`ClEvent::Goto`] |
+//! | `GOTO/x,y,z[,i,j,k[,u,v,w]]`, Creo's further points on lines of their own | [`ClEvent::Goto`] |
+//! | `CIRCLE/x,y,z,i,j,k[,r[,t,f,d,e]][,TIMES,n]` (SOLIDWORKS CAM 6, Creo 7, NX 11 values) | [`ClEvent::Circle`] ([`Circle`]): the next `GOTO` ends the arc; axis made right-handed |
+//! | `NURBS/` with `KNOT/…` and `CNTRL/…` records (NX) | [`ClEvent::Nurbs`] ([`Nurbs`]) |
 //! | `GODLTA/dx,dy,dz`, `GODLTA/d` (along the tool axis) | [`ClEvent::Goto`] to the last point moved by that much |
-//! | `TLAXIS/i,j,k` | no event: the tool axis of the three-value `GOTO`s that follow |
-//! | `FEDRAT/[unit,]f`, `FEDRAT/f[,unit]` | [`ClEvent::Feedrate`]; it cancels a `RAPID` no move used (with a warning) |
-//! | `LOAD/TOOL,n`, `LOADTL/n`, `SELECT/TOOL,n` | [`ClEvent::LoadTool`], [`ClEvent::SelectTool`] |
-//! | `SPINDL/rpm,RPM,CLW`, `SPINDL/OFF` | [`ClEvent::Spindle`], [`ClEvent::SpindleOff`] |
-//! | `COOLNT/mode` | [`ClEvent::Coolant`] |
+//! | `FROM/x,y,z[,i,j,k]` | [`ClEvent::From`] (also the current point and, if given, the tool axis) |
+//! | `GOHOME[/x,y,z[,i,j,k]]` | [`ClEvent::GoHome`] |
+//! | `TLAXIS/i,j,k` | no event: the tool axis of the three-value `GOTO`s that follow; other forms are APT part-program geometry: error |
+//! | `FEDRAT/[unit,]f`, `FEDRAT/f[,unit]` (`MMPM`, `IPM`, `MMPR`, `IPR`) | [`ClEvent::Feedrate`] in mm; it cancels a `RAPID` no move used (with a warning) |
+//! | `CYCLE/kind[,kind2],keyword,value,…` (NX, Creo, SOLIDWORKS CAM couplets) | [`ClEvent::Cycle`] ([`Cycle`]) |
+//! | `CYCLE/OFF` | [`ClEvent::CycleOff`] |
+//! | `CYCLE/INIT`, `CYCLE/CLEAR` (SOLIDWORKS CAM, no values) | nothing: they announce the `CYCLE` that follows |
+//! | `LOAD/TOOL,n[,ADJUST,m]`, `LOADTL/n[,ADJUST,m]` | [`ClEvent::LoadTool`] |
+//! | `SELECT/TOOL,n` | [`ClEvent::SelectTool`] |
+//! | `SPINDL/[RPM,]n[,RPM\|SFM\|SMM][,CLW\|CCLW][,RANGE,r][,MAXRPM,m]`, `SPINDL/ON` | [`ClEvent::Spindle`] ([`SpindleSpeed`]) |
+//! | `SPINDL/OFF` | [`ClEvent::SpindleOff`] |
+//! | `COOLNT/FLOOD\|MIST\|THRU\|AIR\|ON\|OFF…` | [`ClEvent::Coolant`] |
+//! | `CUTCOM/LEFT\|RIGHT\|OFF[,XYPLAN\|YZPLAN\|ZXPLAN][,n]` | [`ClEvent::CutterCompensation`] |
+//! | `DELAY/t[,REV]`, `DWELL/t` | [`ClEvent::Dwell`] |
+//! | `STOP`, `OPSTOP`, `END` | [`ClEvent::Stop`], [`ClEvent::OptionalStop`], [`ClEvent::End`] |
+//! | `MACHIN/name,…` | [`ClEvent::Machine`] |
+//! | `OPNAME/name` | [`ClEvent::OperationName`] |
+//! | `CLAMP/[ON\|OFF,]words` | [`ClEvent::Clamp`] |
+//! | `ORIGIN/x,y,z` | [`ClEvent::Origin`] |
+//! | `TMARK[/…]` | [`ClEvent::TapeMark`] |
+//! | `SETUP/START,n`, `SETUP/END,n` (SOLIDWORKS CAM) | [`ClEvent::Setup`] |
 //! | `INSERT/text` | [`ClEvent::Insert`] |
 //! | `END-OF-PATH` | [`ClEvent::EndOfPath`] |
 //! | `PARTNO/text`, `PARTNO text` | [`ClEvent::PartNo`] (one pair of enclosing quotes removed) |
@@ -68,10 +92,29 @@
 //! | `MULTAX[/ON\|/OFF]` | [`ClEvent::Multax`] |
 //! | `PRESSURE/[word,]value` (kinpost extension) | [`ClEvent::Pressure`] |
 //! | `FINI` | [`ClEvent::Fini`] |
-//! | `PAINT/…`, `TRNTYP/…`, `CSI_…`, identity `CSYS/…`, `CUTCOM/OFF` | nothing (display-only or harmless) |
-//! | `CUTCOM/LEFT\|RIGHT…` | nothing, with a warning (cutter compensation ignored) |
-//! | `CIRCLE/…`, `NURBS…`, `CYCLE/…`, non-identity `CSYS/…`, `TLAXIS` other than `i,j,k` | error: not supported yet |
+//! | `PAINT/…` (NX display records), `TRNTYP/…` (SOLIDWORKS CAM's transformation type, informational), `CSI_…` | nothing (display-only or informational) |
+//! | NX's "Information listing created by…" header with its `Date`, `Current work part`, `Node name` lines; "Tool Path Listing has N lines." | nothing (the listing around an NX CLSF) |
+//! | `KNOT/`, `CNTRL/` not after a `NURBS/` | error |
 //! | anything else | nothing, with a warning (unknown statement ignored) |
+//!
+//! # Units
+//!
+//! The reader converts every length to mm with one multiplication by
+//! [`MM_PER_INCH`] when the file is in inches (`UNITS/INCHES`, or
+//! [`ClReader::with_units`] given `Some(Units::Inch)`, the command's
+//! `--units inch`); [`ClReader::units`] says which. An inch feed (`IPM`,
+//! `IPR`) in a file that never declares its units and without
+//! [`ClReader::with_units`] is an error that names `--units`: the file's
+//! lengths would otherwise be read as mm. A `UNITS` statement that
+//! contradicts [`ClReader::with_units`] is an error too.
+//!
+//! # Arcs, curves and cycles
+//!
+//! [`ClEvent::Circle`] and [`ClEvent::Nurbs`] describe the motion to the
+//! next point: build it with [`Circle::arc`] (an [`Arc`]) or use the
+//! [`Nurbs`]; both sample to a chord tolerance. A [`ClEvent::Cycle`] stays
+//! on until [`ClEvent::CycleOff`]: the reader does not mark the `GOTO`s in
+//! between, a post treats each as a hole.
 //!
 //! # Syntax
 //!
@@ -94,7 +137,7 @@ mod reader;
 mod vector;
 mod words;
 
-pub use curve::{Arc, ArcError, Nurbs, NurbsError, ToleranceError};
+pub use curve::{Arc, ArcError, MAX_ARC_TURNS, MAX_SAMPLE_POINTS, Nurbs, NurbsError, SampleError};
 pub use frame::{FRAME_TOLERANCE, Frame, FrameError};
 pub use kinpost_diag::{Diagnostic, Severity};
 pub use number::parse_number;
@@ -268,6 +311,12 @@ pub struct Cycle {
     pub feed: Option<Feed>,
     /// Tapping pitch (mm per revolution), if given.
     pub pitch_mm: Option<f64>,
+    /// Chip breaking: how far the tool backs off after each peck (Creo
+    /// `BACK`), if given.
+    pub back_off_mm: Option<f64>,
+    /// Chip breaking: the tool leaves the hole after every this many pecks
+    /// (Creo `TIMES`), if given.
+    pub full_retract_every: Option<u32>,
 }
 
 /// The side of cutter radius compensation.
