@@ -380,7 +380,7 @@ pub enum ClEvent {
         words: Vec<String>,
     },
     /// `TLDATA/…` or `CUTTER/…`.
-    ToolData(ToolData),
+    ToolData(Box<ToolData>),
     /// `MSYS/x,y,z,xi,xj,xk,yi,yj,yk`: the machine coordinate system (NX's
     /// MCS) of the `GOTO`s that follow, in the absolute frame: origin and
     /// the directions of its X and Y axes, as written. A cut-short `MSYS`
@@ -394,7 +394,7 @@ pub enum ClEvent {
         /// Direction of the Y axis, if given.
         y: Option<Vec3>,
         /// The frame, when complete (checked orthonormal).
-        frame: Option<Frame>,
+        frame: Option<Box<Frame>>,
     },
     /// `CSYS/` with a 3 × 4 matrix: a coordinate frame ([`Frame::from_rows`]).
     CoordinateSystem(Frame),
@@ -415,7 +415,7 @@ pub enum ClEvent {
         motion: Motion,
     },
     /// `CIRCLE/…`: the next `GOTO` is reached along this circle.
-    Circle(Circle),
+    Circle(Box<Circle>),
     /// `NURBS/` with its `KNOT/` and `CNTRL/` records: the tool follows the
     /// curve from the current point (its first control point) to its end
     /// (the last control point), at the current feed.
@@ -443,7 +443,7 @@ pub enum ClEvent {
         unit: FeedUnit,
     },
     /// `CYCLE/…`: a canned cycle starts (or its parameters change).
-    Cycle(Cycle),
+    Cycle(Box<Cycle>),
     /// `CYCLE/OFF`: the canned cycle ends.
     CycleOff,
     /// `LOAD/TOOL,n[,ADJUST,m]`, `LOADTL/n[,ADJUST,m]`: tool change.

@@ -237,25 +237,25 @@ fn tool_path_any_utf8() {
 fn tool_data_and_cutter() {
     assert_eq!(
         one("TLDATA/MILL,25.0000,0.0000,75.0000,0.0000,0.0000\n"),
-        ClEvent::ToolData(ToolData {
+        ClEvent::ToolData(Box::new(ToolData {
             kind: "MILL".into(),
             words: vec![],
             values: vec![25.0, 0.0, 75.0, 0.0, 0.0],
             diameter_mm: Some(25.0),
             corner_radius_mm: Some(0.0),
             length_mm: Some(75.0),
-        })
+        }))
     );
     assert_eq!(
         one("CUTTER/6.,0,3.,0,0,0,51.\n"),
-        ClEvent::ToolData(ToolData {
+        ClEvent::ToolData(Box::new(ToolData {
             kind: "CUTTER".into(),
             words: vec![],
             values: vec![6.0, 0.0, 3.0, 0.0, 0.0, 0.0, 51.0],
             diameter_mm: Some(6.0),
             corner_radius_mm: Some(0.0),
             length_mm: Some(51.0),
-        })
+        }))
     );
     assert!(
         error("TLDATA/MILL,2x\n")
@@ -272,10 +272,10 @@ fn msys_full_short_and_cut() {
             origin: [1., 2., 3.],
             x: Some([1., 0., 0.]),
             y: Some([0., 1., 0.]),
-            frame: Some(Frame {
+            frame: Some(Box::new(Frame {
                 origin: [1., 2., 3.],
                 ..Frame::IDENTITY
-            }),
+            })),
         }
     );
     assert_eq!(
@@ -784,7 +784,7 @@ fn every_msys_is_an_event_and_the_post_decides() {
     // A second setup in another frame (NX writes one MSYS per operation):
     // a frame of its own, rotated a quarter turn about Z, Z kept.
     let e = events("MSYS/1,2,3,1,0,0,0,1,0\nGOTO/0,0,0,0,0,1\nMSYS/1,2,4,0,1,0,-1,0,0\n");
-    let ClEvent::MachineSystem { frame: Some(f), .. } = e[2] else {
+    let ClEvent::MachineSystem { frame: Some(f), .. } = &e[2] else {
         panic!("{e:?}")
     };
     assert_eq!((f.origin, f.z), ([1., 2., 4.], [0., 0., 1.]));

@@ -307,7 +307,7 @@ fn solidworks_cycles() {
     let cycles: Vec<&Cycle> = statements
         .iter()
         .filter_map(|s| match &s.event {
-            ClEvent::Cycle(c) => Some(c),
+            ClEvent::Cycle(c) => Some(&**c),
             _ => None,
         })
         .collect();

@@ -150,6 +150,6 @@ impl<R: BufRead> ClReader<R> {
             Some(clear) => Some(clear - rapto.unwrap_or(0.0)),
             None => rapto,
         };
-        Ok(Some(ClEvent::Cycle(cycle)))
+        Ok(Some(ClEvent::Cycle(Box::new(cycle))))
     }
 }

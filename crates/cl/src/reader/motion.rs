@@ -44,9 +44,9 @@ impl<R: BufRead> ClReader<R> {
         match self.goto(args) {
             Ok(event) => {
                 let line = self.segments[0].line;
-                self.held = Some(Statement { line, event });
+                self.held = Some(Box::new(Statement { line, event }));
                 self.update_slow();
-                Ok(Some(ClEvent::Circle(pending.circle)))
+                Ok(Some(ClEvent::Circle(Box::new(pending.circle))))
             }
             Err(e) => {
                 // The failed point has no effect: the arc still applies.
@@ -192,13 +192,13 @@ impl<R: BufRead> ClReader<R> {
         };
         let (line, source) = self.statement_line();
         let source = String::from_utf8_lossy(source).into_owned();
-        self.circle = Some(PendingCircle {
+        self.circle = Some(Box::new(PendingCircle {
             circle: circle.clone(),
             line,
             source,
-        });
+        }));
         self.update_goto_special();
-        Ok(ClEvent::Circle(circle))
+        Ok(ClEvent::Circle(Box::new(circle)))
     }
 
     /// `NURBS/` followed by `KNOT/` and `CNTRL/` records (NX): the current

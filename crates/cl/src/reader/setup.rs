@@ -105,7 +105,7 @@ impl<R: BufRead> ClReader<R> {
         let y = (count >= 9).then_some([v[6], v[7], v[8]]);
         let frame = match (x, y) {
             (Some(x), Some(y)) => match Frame::from_axes(origin, x, y) {
-                Ok(frame) => Some(frame),
+                Ok(frame) => Some(Box::new(frame)),
                 Err(e) => {
                     return Err(
                         self.error((self.fields[3].0, self.fields[8].1), format!("MSYS: {e}"))

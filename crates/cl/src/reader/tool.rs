@@ -47,14 +47,14 @@ impl<R: BufRead> ClReader<R> {
             "MILL" if words.is_empty() => (length(1), length(2)),
             _ => (None, None),
         };
-        Ok(ClEvent::ToolData(ToolData {
+        Ok(ClEvent::ToolData(Box::new(ToolData {
             diameter_mm: length(0),
             corner_radius_mm,
             length_mm,
             kind,
             words,
             values,
-        }))
+        })))
     }
 
     /// `LOAD/TOOL,n[,ADJUST,m]`.
