@@ -290,9 +290,13 @@ impl<R: BufRead> ClReader<R> {
     ///
     /// An `Err` is an error diagnostic (never a warning): the input cannot be
     /// posted as it is. See the type's documentation for what happens after.
+    ///
+    /// (Out of line, with [`next_move`](Self::next_move)'s body inlined in
+    /// it, for the same reason as `next_move`.)
+    #[inline(never)]
     pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
         let mut goto = Move::default();
-        Ok(match self.next_move(&mut goto)? {
+        Ok(match self.next_move_inline(&mut goto)? {
             Next::Move => Some(goto.into()),
             Next::Statement(statement) => Some(statement),
             Next::End => None,
@@ -311,6 +315,14 @@ impl<R: BufRead> ClReader<R> {
     /// `next_move_100k_lines` read 7 % slower; a call per line costs less.)
     #[inline(never)]
     pub fn next_move(&mut self, goto: &mut Move) -> Result<Next, Diagnostic> {
+        self.next_move_inline(goto)
+    }
+
+    /// The body of [`next_move`](Self::next_move), inlined into
+    /// [`next_statement`](Self::next_statement) (which turns its result into
+    /// a statement at once).
+    #[inline(always)]
+    fn next_move_inline(&mut self, goto: &mut Move) -> Result<Next, Diagnostic> {
         if self.slow {
             return self.next_slow();
         }
