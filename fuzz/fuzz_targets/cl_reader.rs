@@ -2,13 +2,19 @@
 //! tool axis, must never panic or loop, and every diagnostic must point into
 //! the input. The fast paths (whole input in memory) must read exactly what
 //! the general path (a one-byte buffer) reads. Run with
-//! `cargo +nightly fuzz run cl_reader` from the repository root.
+//! `cargo +nightly fuzz run cl_reader fuzz/corpus/cl_reader
+//! fuzz/seeds/cl_reader data/cl/nx data/cl/creo data/cl/solidworks --
+//! -max_len=8192` from the repository root (the first folder is where
+//! libFuzzer keeps what it finds; `fuzz/seeds/cl_reader` holds a file of
+//! each CAM system's forms: arcs, NURBS, cycles, frames, inch files, the NX
+//! listing frame; `-max_len` keeps the real files' starts, without it the
+//! largest file sets the input size and the runs crawl).
 
 #![no_main]
 
 use std::io::BufRead;
 
-use kinpost_cl::{ClEvent, ClReader};
+use kinpost_cl::{ClEvent, ClReader, Units};
 use libfuzzer_sys::fuzz_target;
 
 /// Everything the reader gives, in order, as text.
@@ -32,16 +38,17 @@ fuzz_target!(|data: &[u8]| {
         "the fast paths read differently from the general path"
     );
     let lines = data.split(|&b| b == b'\n').count();
-    for default_axis in [false, true] {
-        let mut reader = ClReader::new(data, "fuzz.cls");
+    for (default_axis, units) in [(false, None), (true, None), (true, Some(Units::Inch))] {
+        let mut reader = ClReader::new(data, "fuzz.cls").with_units(units);
         if default_axis {
             reader = reader.with_default_axis([0.0, 0.0, 1.0]);
         }
-        // Every call consumes at least one line.
+        // Every call consumes at least one line, but for Creo's further
+        // points after an arc: each gives the circle again, then the point.
         let mut calls = 0;
         loop {
             calls += 1;
-            assert!(calls <= lines + 1, "the reader does not advance");
+            assert!(calls <= 2 * lines + 1, "the reader does not advance");
             let result = reader.next_statement();
             for w in reader.take_warnings() {
                 assert!(w.line >= 1 && w.line <= lines && w.column >= 1);
@@ -50,10 +57,23 @@ fuzz_target!(|data: &[u8]| {
                 Ok(None) => break,
                 Ok(Some(statement)) => {
                     assert!(statement.line >= 1 && statement.line <= lines);
-                    if let ClEvent::Goto { point, axis, .. } = statement.event {
-                        assert!(point.iter().all(|v| v.is_finite()));
-                        let n: f64 = axis.iter().map(|v| v * v).sum();
-                        assert!((n - 1.0).abs() < 1e-12);
+                    match statement.event {
+                        ClEvent::Goto { point, axis, .. } => {
+                            assert!(point.iter().all(|v| v.is_finite()));
+                            let n: f64 = axis.iter().map(|v| v * v).sum();
+                            assert!((n - 1.0).abs() < 1e-12);
+                        }
+                        ClEvent::Circle(c) => {
+                            let n: f64 = c.axis.iter().map(|v| v * v).sum();
+                            assert!((n - 1.0).abs() < 1e-12);
+                            assert!(c.radius_mm > 0.0 && (1..=1000).contains(&c.turns));
+                        }
+                        ClEvent::Nurbs(curve) => {
+                            let (a, b) = curve.domain();
+                            assert!(a < b);
+                            let _ = curve.point_at(0.5 * (a + b));
+                        }
+                        _ => {}
                     }
                 }
                 Err(e) => {

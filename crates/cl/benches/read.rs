@@ -3,7 +3,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use kinpost_cl::{ClEvent, ClReader};
+use kinpost_cl::{ClEvent, ClReader, Move, Next};
 
 /// A 5-axis CL file of `lines` lines, mostly `GOTO/x,y,z,i,j,k` like NX writes.
 fn generate(lines: usize) -> String {
@@ -56,6 +56,25 @@ fn read_all(cl: &str) -> usize {
     gotos
 }
 
+/// The post's hot path: plain `GOTO` lines written into one reused [`Move`].
+fn read_moves(cl: &str) -> usize {
+    let mut reader = ClReader::new(cl.as_bytes(), "bench.cls");
+    let mut goto = Move::default();
+    let mut gotos = 0;
+    loop {
+        match reader.next_move(&mut goto).expect("valid CL") {
+            Next::Move => {
+                black_box(&goto);
+                gotos += 1;
+            }
+            Next::Statement(statement) => {
+                black_box(statement);
+            }
+            Next::End => return gotos,
+        }
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let lines = 100_000;
     let cl = generate(lines);
@@ -63,6 +82,10 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("cl");
     group.throughput(Throughput::Elements(lines as u64));
     group.bench_function("read_100k_lines", |b| b.iter(|| read_all(black_box(&cl))));
+    assert!(read_moves(&cl) > 99_000);
+    group.bench_function("next_move_100k_lines", |b| {
+        b.iter(|| read_moves(black_box(&cl)))
+    });
     group.finish();
 }
 

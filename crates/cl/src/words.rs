@@ -30,6 +30,21 @@ const KNOWN: &[&str] = &[
     "TLAXIS",
     "GODLTA",
     "LOADTL",
+    "FROM",
+    "GOHOME",
+    "STOP",
+    "OPSTOP",
+    "END",
+    "MACHIN",
+    "OPNAME",
+    "CLAMP",
+    "TMARK",
+    "ORIGIN",
+    "DELAY",
+    "DWELL",
+    "KNOT",
+    "CNTRL",
+    "SETUP",
 ];
 
 /// The known word closest to `word` (case-insensitive), if it is close enough

@@ -177,6 +177,22 @@ pub enum ProgramError {
          (5-axis output, locked axes stay locked): give every GOTO nine values, or none"
     })]
     ReferenceMismatch(bool),
+    /// A later `MSYS` changes the machine coordinate system of the first.
+    #[error(
+        "MSYS changes the machine coordinate system of line {first_line}: kinpost posts every point \
+         in the part frame of the machine file; post the operations of each coordinate system as a \
+         program of their own"
+    )]
+    MachineSystemChanged {
+        /// The line of the first `MSYS`.
+        first_line: usize,
+    },
+    /// A statement the reader understands and the post does not act on yet.
+    #[error("{what}: kinpost reads it but does not post it yet")]
+    NotPosted {
+        /// What the statement asks for.
+        what: &'static str,
+    },
 }
 
 /// Why a pressure cannot be programmed.

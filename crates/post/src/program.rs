@@ -7,7 +7,10 @@
 
 use std::io::BufRead;
 
-use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units};
+use kinpost_cl::{
+    ClEvent, ClReader, CutcomSide, FeedUnit, Motion, Move, Next, SpindleDir, SpindleSpeed,
+    Statement,
+};
 use kinpost_diag::{Diagnostic, Located, Severity};
 use kinpost_machine::tolerance::REFERENCE_SKEW_DEG;
 use kinpost_machine::{Machine, Pose};
@@ -64,8 +67,6 @@ pub struct Program<'a> {
     named: bool,
     /// The first point decided 5- or 6-axis output (`None`: no point yet).
     six_axis: Option<bool>,
-    /// Scale from CL units to mm.
-    scale: f64,
     feed: Option<f64>,
     /// The spindle speed last programmed, rpm.
     rpm: Option<f64>,
@@ -79,6 +80,10 @@ pub struct Program<'a> {
     tool_loaded: bool,
     /// The tool changed to last (`None`: the header's, `tool_number`).
     spindle_tool: Option<u32>,
+    /// The first `MSYS` (origin and axes as written, mm) and its line:
+    /// every point is posted in the machine file's part frame, so a later
+    /// `MSYS` must not change it.
+    msys: Option<([f64; 9], usize)>,
     remarked: Remarked,
     report: ProgramReport,
 }
@@ -125,7 +130,6 @@ impl<'a> Program<'a> {
             },
             named: config.program_name.is_some(),
             six_axis: None,
-            scale: 1.0,
             feed: None,
             rpm: None,
             feed_per_rev: None,
@@ -133,6 +137,7 @@ impl<'a> Program<'a> {
             uncompensated: Vec::new(),
             tool_loaded: false,
             spindle_tool: None,
+            msys: None,
             remarked: Remarked::default(),
             report: ProgramReport {
                 warnings,
@@ -219,12 +224,8 @@ impl<'a> Program<'a> {
                 self.goto(&goto, reader, sink)?;
             }
             ClEvent::Feedrate { value, unit } => self.feedrate(value, unit, reader)?,
-            ClEvent::Units(units) => {
-                self.scale = match units {
-                    Units::Mm => 1.0,
-                    Units::Inch => 25.4,
-                };
-            }
+            // The reader gives every length in mm.
+            ClEvent::Units(_) => {}
             ClEvent::PartNo(name) => self.name(&name),
             ClEvent::ToolPath { name, words } => {
                 self.name(&name);
@@ -239,9 +240,14 @@ impl<'a> Program<'a> {
             ClEvent::Comment(text) => {
                 self.command(Command::Comment(text.trim().to_string()), reader, sink)?
             }
-            ClEvent::LoadTool { number } => self.load_tool(number, reader, sink)?,
+            ClEvent::LoadTool { number, .. } => self.load_tool(number, reader, sink)?,
             ClEvent::SelectTool { .. } => {}
-            ClEvent::Spindle { rpm, dir } => {
+            ClEvent::Spindle {
+                speed: SpindleSpeed::Rpm(rpm),
+                dir,
+                range: None,
+                max_rpm: None,
+            } => {
                 self.rpm = Some(rpm);
                 if let Some(per_rev) = self.feed_per_rev {
                     self.feed = Some(per_rev * rpm);
@@ -266,10 +272,56 @@ impl<'a> Program<'a> {
             ClEvent::Insert(text) => self.command(Command::Insert(text), reader, sink)?,
             ClEvent::EndOfPath => sink.break_segment(),
             ClEvent::Pressure { word, value } => self.pressure(word.as_deref(), value, reader)?,
-            ClEvent::ToolData { .. } | ClEvent::MachineSystem { .. } | ClEvent::Multax(_) => {}
+            ClEvent::ToolData(_) | ClEvent::Multax(_) => {}
+            ClEvent::MachineSystem { origin, x, y, .. } => {
+                self.machine_system(origin, x, y, line, reader)?
+            }
+            ClEvent::CoordinateSystem(frame) if frame.is_identity(1e-9) => {}
+            ClEvent::CutterCompensation {
+                side: CutcomSide::Off,
+                ..
+            } => {}
+            // Informational: the CAM system's post name, names, setups, marks,
+            // and FROM (a position, no motion).
+            ClEvent::Machine { .. }
+            | ClEvent::OperationName(_)
+            | ClEvent::Setup { .. }
+            | ClEvent::TapeMark
+            | ClEvent::From { .. } => {}
             ClEvent::Fini => return Ok(false),
+            other => return Err(not_posted(reader, &other)),
         }
         Ok(true)
+    }
+
+    /// `MSYS`: the first is the part frame the CL was written in; a later
+    /// one must not change it (every point is posted in the machine file's
+    /// part frame).
+    fn machine_system<R: BufRead>(
+        &mut self,
+        origin: [f64; 3],
+        x: Option<[f64; 3]>,
+        y: Option<[f64; 3]>,
+        line: usize,
+        reader: &ClReader<R>,
+    ) -> Result<(), PostError> {
+        let zero = [0.0; 3];
+        let (x, y) = (x.unwrap_or(zero), y.unwrap_or(zero));
+        let mut v = [0.0; 9];
+        v[..3].copy_from_slice(&origin);
+        v[3..6].copy_from_slice(&x);
+        v[6..].copy_from_slice(&y);
+        match self.msys {
+            None => self.msys = Some((v, line)),
+            Some((first, first_line)) => {
+                if v.iter().zip(&first).any(|(a, b)| (a - b).abs() > 1e-6) {
+                    return Err(
+                        locate(reader, ProgramError::MachineSystemChanged { first_line }).into(),
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 
     /// `FEDRAT/…`: the feed rate of the moves that follow, per minute.
@@ -387,10 +439,8 @@ impl<'a> Program<'a> {
         reader: &ClReader<R>,
         sink: &mut S,
     ) -> Result<(), PostError> {
-        let s = self.scale;
-        let [x, y, z] = goto.point;
         let pose = Pose {
-            point: Vector3::new(x * s, y * s, z * s),
+            point: Vector3::from(goto.point),
             axis: Vector3::from(goto.axis),
             reference: goto.reference.map(Vector3::from),
         };
@@ -480,4 +530,31 @@ fn reference_remark(
                 off.abs().to_degrees()
             )
         })
+}
+
+/// The error for a CL statement the post does not act on yet (the reader
+/// gives it as an event).
+#[cold]
+fn not_posted<R: BufRead>(reader: &ClReader<R>, event: &ClEvent) -> PostError {
+    let what = match event {
+        ClEvent::Spindle { .. } => {
+            "a spindle speed in surface units, a gear range or a speed limit"
+        }
+        ClEvent::CoordinateSystem(_) => "CSYS with a rotation or an offset",
+        ClEvent::Circle(_) => "CIRCLE (an arc)",
+        ClEvent::Nurbs(_) => "NURBS (a spline)",
+        ClEvent::Cycle(_) | ClEvent::CycleOff => "CYCLE (a canned cycle)",
+        ClEvent::GoHome { .. } => "GOHOME",
+        ClEvent::CutterCompensation { .. } => {
+            "CUTCOM (cutter radius compensation: the GOTOs are the part contour, not tool positions)"
+        }
+        ClEvent::Dwell(_) => "DELAY (a dwell)",
+        ClEvent::Stop | ClEvent::OptionalStop | ClEvent::End => {
+            "STOP, OPSTOP or END (a program stop)"
+        }
+        ClEvent::Clamp { .. } => "CLAMP",
+        ClEvent::Origin(_) => "ORIGIN",
+        _ => "this statement",
+    };
+    locate(reader, ProgramError::NotPosted { what }).into()
 }

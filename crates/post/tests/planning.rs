@@ -1172,7 +1172,8 @@ fn a_feed_per_revolution_follows_the_spindle_speed() {
         lintol_mm: Some(0.0),
         ..Default::default()
     };
-    let cl = "FEDRAT/MMPM,500\nGOTO/0,0,50,0,0,1\nSPINDL/RPM,2000,CLW\nFEDRAT/MMPR,0.1\n\
+    // (UNITS/MM: an inch feed in a file of undeclared units is an error.)
+    let cl = "UNITS/MM\nFEDRAT/MMPM,500\nGOTO/0,0,50,0,0,1\nSPINDL/RPM,2000,CLW\nFEDRAT/MMPR,0.1\n\
               GOTO/0,0,10\nSPINDL/RPM,3000,CLW\nGOTO/0,0,5\nFEDRAT/IPR,0.01\nGOTO/0,0,4\n\
               FEDRAT/300\nGOTO/0,0,1\n";
     let (csv, summary) = post_csv(&m, cl, &options).unwrap();

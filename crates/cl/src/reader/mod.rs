@@ -1,12 +1,27 @@
 //! The streaming CL reader.
+//!
+//! This module reads lines into logical statements (the fast paths for plain
+//! lines, `$` continuations, comments) and dispatches each statement to the
+//! module of its family: [`motion`] (`GOTO`, `CIRCLE`, `NURBS`, `FROM`, …),
+//! [`cycle`] (`CYCLE`), [`tool`] (tools, spindle, coolant, cutter
+//! compensation) and [`setup`] (units, frames and the rest).
+
+mod cycle;
+mod motion;
+mod setup;
+mod tool;
 
 use std::io::BufRead;
 
 use kinpost_diag::{Diagnostic, Severity};
 
 use crate::number::{PLAIN_CHUNK, parse_number, plain_number, scan_number};
+use crate::vector::{cross, normalize};
 use crate::words::suggest;
-use crate::{ClEvent, FeedUnit, Motion, Move, Next, SpindleDir, Statement, Units, Vec3};
+use crate::{
+    Circle, ClEvent, MM_PER_INCH, Motion, Move, Next, SpindleDir, SpindleSpeed, Statement, Units,
+    Vec3,
+};
 
 /// A byte range in the logical statement text.
 type Span = (usize, usize);
@@ -41,19 +56,29 @@ enum Begin {
 enum Read {
     /// End of input.
     Eof,
-    /// A `$$` comment line.
+    /// A `$$` comment (joined over `$` continuation lines) and its first line.
     Comment(usize, String),
     /// A logical statement, now in `text` / `segments`.
     Statement,
+}
+
+/// A `CIRCLE` waiting for the `GOTO` that ends it.
+#[derive(Debug, Clone)]
+struct PendingCircle {
+    circle: Circle,
+    /// The line of the `CIRCLE` statement.
+    line: usize,
+    /// Its first physical line, for an error about it made later.
+    source: String,
 }
 
 /// Streaming reader of NX CLSF / APT text: one [`Statement`] at a time.
 ///
 /// The reader keeps the modal state of the CL file: the current tool axis and
 /// reference direction (a three-value `GOTO` repeats them), the one-shot
-/// `RAPID`, and the units (for `FEDRAT` without a unit). It allocates nothing
-/// per `GOTO` line: lines are read into a reused buffer and numbers are parsed
-/// in place.
+/// `RAPID`, the units (every length of every event is in mm), a `CIRCLE`
+/// waiting for its end point. It allocates nothing per plain `GOTO` line:
+/// lines are read into a reused buffer and numbers are parsed in place.
 ///
 /// **Errors** ([`Severity::Error`]) are returned by
 /// [`next_statement`](Self::next_statement) and mean the input cannot be
@@ -62,9 +87,8 @@ enum Read {
 /// list every error), except after an I/O error, after which it reports end
 /// of input.
 ///
-/// **Warnings** (unknown statements, a cut-short `MSYS`, ignored cutter
-/// compensation, …) are collected in order and handed out, drained, by
-/// [`take_warnings`](Self::take_warnings).
+/// **Warnings** (unknown statements, a cut-short `MSYS`, …) are collected in
+/// order and handed out, drained, by [`take_warnings`](Self::take_warnings).
 ///
 /// The reader is also an [`Iterator`] over `Result<Statement, Diagnostic>`.
 pub struct ClReader<R> {
@@ -86,19 +110,49 @@ pub struct ClReader<R> {
     line: usize,
     /// Set after an I/O error.
     finished: bool,
+    /// The hot path must step aside: `finished`, a held statement or a line
+    /// read ahead (kept equal to their disjunction by `update_slow`).
+    slow: bool,
+    /// A statement to hand out before reading on (the `GOTO` of a Creo
+    /// continuation point after its repeated `CIRCLE`).
+    held: Option<Box<Statement>>,
+    /// A physical line read ahead (after `NURBS` records) and its number:
+    /// the next statement starts with it.
+    pending_line: Option<(Vec<u8>, usize)>,
     warnings: Vec<Diagnostic>,
     axis: Option<Vec3>,
     reference: Option<Vec3>,
     /// A tool axis far from unit length was reported.
     axis_length_noted: bool,
-    /// The point of the last `GOTO` (CL units), for `GODLTA`.
+    /// The current point (mm): the last `GOTO`, `FROM`, `GOHOME` or the end
+    /// of a `NURBS`; the start of a `CIRCLE`, `NURBS` or `GODLTA`.
     last_point: Option<Vec3>,
-    /// The first `MSYS` (origin and axes as given) and its line: a later
-    /// one must not change it.
-    msys: Option<([f64; 9], usize, usize)>,
+    /// The last `FROM` point (mm), for a bare `GOHOME`.
+    from: Option<Vec3>,
     rapid: bool,
+    /// The file's length units (as declared, given, or assumed mm).
     units: Units,
-    spindle: Option<(f64, SpindleDir)>,
+    /// The units were declared by a `UNITS` statement or given by the caller.
+    units_known: bool,
+    /// The units the caller gave (`--units`), if any.
+    units_given: Option<Units>,
+    /// mm per length unit of the file: 1 or 25.4.
+    scale: f64,
+    spindle: Option<(SpindleSpeed, SpindleDir)>,
+    /// A `GOTO` needs more than the plain case: inch lengths or a circle to
+    /// end (kept equal to `scale != 1 || circle.is_some()`).
+    goto_special: bool,
+    /// A `CIRCLE` waiting for its end point.
+    circle: Option<Box<PendingCircle>>,
+    /// The circle of the `GOTO` statement just read, if it ended an arc: a
+    /// Creo continuation point (a bare `x, y, z` line) follows it too.
+    arc_goto: Option<Box<PendingCircle>>,
+    /// The number of values of the last statement if it was a `GOTO` (a
+    /// Creo continuation line takes the same shape), else 0.
+    goto_count: usize,
+    /// Inside the header NX writes before a CLSF saved from its Information
+    /// window.
+    listing_header: bool,
 }
 
 impl<R: BufRead> ClReader<R> {
@@ -115,15 +169,26 @@ impl<R: BufRead> ClReader<R> {
             fields: Vec::with_capacity(16),
             line: 0,
             finished: false,
+            slow: false,
+            held: None,
+            pending_line: None,
             warnings: Vec::new(),
             axis: None,
             reference: None,
             axis_length_noted: false,
             last_point: None,
-            msys: None,
+            from: None,
             rapid: false,
             units: Units::Mm,
+            units_known: false,
+            units_given: None,
+            scale: 1.0,
             spindle: None,
+            goto_special: false,
+            circle: None,
+            arc_goto: None,
+            goto_count: 0,
+            listing_header: false,
         }
     }
 
@@ -141,6 +206,19 @@ impl<R: BufRead> ClReader<R> {
         self
     }
 
+    /// Sets the length units of a file that does not declare them (the
+    /// `--units` option): `None` (the default) takes an undeclared file as
+    /// mm but refuses inch feeds (`FEDRAT/IPM`, `IPR`) in it. A `UNITS`
+    /// statement that contradicts the given units is an error.
+    pub fn with_units(mut self, units: Option<Units>) -> Self {
+        self.units_given = units;
+        if let Some(units) = units {
+            self.set_units(units);
+            self.units_known = true;
+        }
+        self
+    }
+
     /// The file name given to [`new`](Self::new).
     pub fn file_name(&self) -> &str {
         &self.file
@@ -151,9 +229,16 @@ impl<R: BufRead> ClReader<R> {
         self.axis
     }
 
-    /// The current units (`Mm` until a `UNITS` statement says otherwise).
+    /// The file's length units so far (`Mm` until a `UNITS` statement or
+    /// [`with_units`](Self::with_units) says otherwise). Events carry mm
+    /// whatever the file's units.
     pub fn units(&self) -> Units {
         self.units
+    }
+
+    /// The current point (mm), if any.
+    pub fn current_point(&self) -> Option<Vec3> {
+        self.last_point
     }
 
     /// The number of physical lines read so far.
@@ -205,9 +290,13 @@ impl<R: BufRead> ClReader<R> {
     ///
     /// An `Err` is an error diagnostic (never a warning): the input cannot be
     /// posted as it is. See the type's documentation for what happens after.
+    ///
+    /// (Out of line, with [`next_move`](Self::next_move)'s body inlined in
+    /// it, for the same reason as `next_move`.)
+    #[inline(never)]
     pub fn next_statement(&mut self) -> Result<Option<Statement>, Diagnostic> {
         let mut goto = Move::default();
-        Ok(match self.next_move(&mut goto)? {
+        Ok(match self.next_move_inline(&mut goto)? {
             Next::Move => Some(goto.into()),
             Next::Statement(statement) => Some(statement),
             Next::End => None,
@@ -220,10 +309,22 @@ impl<R: BufRead> ClReader<R> {
     /// ([`Next::Move`]); every other statement, and a `GOTO` of any other
     /// shape, comes as a [`Statement`]. (A move returned inside the
     /// statement enum was copied from place to place on its way.)
-    #[inline(always)]
+    ///
+    /// (Out of line on purpose: inlined into its caller's loop, the parser's
+    /// state competed with the caller's for registers and the bench
+    /// `next_move_100k_lines` read 7 % slower; a call per line costs less.)
+    #[inline(never)]
     pub fn next_move(&mut self, goto: &mut Move) -> Result<Next, Diagnostic> {
-        if self.finished {
-            return Ok(Next::End);
+        self.next_move_inline(goto)
+    }
+
+    /// The body of [`next_move`](Self::next_move), inlined into
+    /// [`next_statement`](Self::next_statement) (which turns its result into
+    /// a statement at once).
+    #[inline(always)]
+    fn next_move_inline(&mut self, goto: &mut Move) -> Result<Next, Diagnostic> {
+        if self.slow {
+            return self.next_slow();
         }
         // Everything but a plain `GOTO` line is left to
         // `next_statement_general`, out of line, so that this stays small.
@@ -238,6 +339,30 @@ impl<R: BufRead> ClReader<R> {
                 None => Next::End,
             }),
         }
+    }
+
+    /// `next_move` when the hot path steps aside: at the end, with a held
+    /// statement, or with a line read ahead.
+    #[cold]
+    #[inline(never)]
+    fn next_slow(&mut self) -> Result<Next, Diagnostic> {
+        if self.finished {
+            return Ok(Next::End);
+        }
+        if let Some(statement) = self.held.take() {
+            self.update_slow();
+            return Ok(Next::Statement(*statement));
+        }
+        // A line read ahead: the general path takes it first.
+        self.clear_statement();
+        Ok(match self.next_statement_general(Begin::Lines, [0.0; 9])? {
+            Some(statement) => Next::Statement(statement),
+            None => Next::End,
+        })
+    }
+
+    fn update_slow(&mut self) {
+        self.slow = self.finished || self.held.is_some() || self.pending_line.is_some();
     }
 
     /// [`next_statement`](Self::next_statement) after `begin_statement`
@@ -259,7 +384,7 @@ impl<R: BufRead> ClReader<R> {
                 Begin::Lines => self.read_lines()?,
             };
             match read {
-                Read::Eof => return Ok(None),
+                Read::Eof => return self.end_of_input(),
                 Read::Comment(line, text) => {
                     return Ok(Some(Statement {
                         line,
@@ -273,11 +398,42 @@ impl<R: BufRead> ClReader<R> {
                     }
                 }
             }
-            if self.finished {
-                return Ok(None);
+            if self.slow {
+                // A statement held or a line read ahead by `interpret`.
+                if let Some(statement) = self.held.take() {
+                    self.update_slow();
+                    return Ok(Some(*statement));
+                }
+                if self.finished {
+                    return Ok(None);
+                }
+                self.clear_statement();
+                begun = Begin::Lines;
+                continue;
             }
             begun = self.begin_statement(&mut values)?;
         }
+    }
+
+    /// The end of the input: an arc still waiting for its end is an error.
+    #[cold]
+    fn end_of_input(&mut self) -> Result<Option<Statement>, Diagnostic> {
+        if let Some(pending) = self.circle.take() {
+            self.update_goto_special();
+            let width = pending.source.trim_end().chars().count().max(1);
+            return Err(Diagnostic::error(
+                &self.file,
+                pending.line,
+                1,
+                width,
+                pending.source,
+                format!(
+                    "the CIRCLE at line {} has no end point: the file ends before the GOTO that ends the arc",
+                    pending.line
+                ),
+            ));
+        }
+        Ok(None)
     }
 
     /// The move of a plain `GOTO` line read by `begin_statement` (its
@@ -300,7 +456,40 @@ impl<R: BufRead> ClReader<R> {
         Ok(())
     }
 
+    /// Sets the length units (and the scale to mm).
+    fn set_units(&mut self, units: Units) {
+        self.units = units;
+        self.scale = match units {
+            Units::Mm => 1.0,
+            Units::Inch => MM_PER_INCH,
+        };
+        self.update_goto_special();
+    }
+
+    fn update_goto_special(&mut self) {
+        self.goto_special = self.scale != 1.0 || self.circle.is_some();
+    }
+
+    /// A length of the file in mm.
+    fn mm(&self, v: f64) -> f64 {
+        v * self.scale
+    }
+
+    /// A point of the file in mm.
+    fn mm3(&self, p: Vec3) -> Vec3 {
+        [p[0] * self.scale, p[1] * self.scale, p[2] * self.scale]
+    }
+
     // ----- lines -----
+
+    /// Forgets the current statement.
+    #[inline(always)]
+    fn clear_statement(&mut self) {
+        self.raw.clear();
+        self.text.clear();
+        self.segments.clear();
+        self.text_in_raw = None;
+    }
 
     /// The logical statement text.
     #[inline(always)]
@@ -328,10 +517,7 @@ impl<R: BufRead> ClReader<R> {
     /// before.
     #[inline(always)]
     fn begin_statement(&mut self, values: &mut [f64; 9]) -> Result<Begin, Diagnostic> {
-        self.raw.clear();
-        self.text.clear();
-        self.segments.clear();
-        self.text_in_raw = None;
+        self.clear_statement();
         match self.input.fill_buf() {
             Ok(buf) => {
                 if let Some(PlainGoto { count, end, next }) = plain_goto(buf, values) {
@@ -376,78 +562,124 @@ impl<R: BufRead> ClReader<R> {
         Ok(Begin::Lines)
     }
 
+    /// Appends the next physical line to `raw` (the line read ahead first),
+    /// without its line end and, on line 1, a byte-order mark: its number and
+    /// its range in `raw`. `None` at the end of the input.
+    fn read_physical(&mut self) -> Result<Option<(usize, usize, usize)>, Diagnostic> {
+        let mut start = self.raw.len();
+        if let Some((bytes, line)) = self.pending_line.take() {
+            self.update_slow();
+            self.raw.extend_from_slice(&bytes);
+            return Ok(Some((line, start, self.raw.len())));
+        }
+        match read_line_bounded(&mut self.input, &mut self.raw, MAX_STATEMENT_BYTES) {
+            Ok(None) => {
+                self.line += 1;
+                return Err(self.too_long(format!(
+                    "the statement on line {} is longer than {MAX_STATEMENT_BYTES} bytes \
+                     (its lines and `$` continuations): a CL statement is a line or a few; \
+                     is this a CL file?",
+                    self.segments.first().map_or(self.line, |s| s.line)
+                )));
+            }
+            Ok(Some(0)) => return Ok(None),
+            Ok(Some(_)) => {}
+            Err(e) => return Err(self.read_error(e)),
+        }
+        self.line += 1;
+        let mut end = self.raw.len();
+        if self.raw[end - 1] == b'\n' {
+            end -= 1;
+        }
+        if end > start && self.raw[end - 1] == b'\r' {
+            end -= 1;
+        }
+        self.raw.truncate(end);
+        if self.line == 1 && self.raw[start..].starts_with(b"\xEF\xBB\xBF") {
+            start += 3;
+        }
+        // (Trailing CRs are blanks at the end of a line, as on the fast
+        // path.)
+        let content = trim_end_ascii(&self.raw[start..end]);
+        if let Some(at) = self.raw[start..start + content]
+            .iter()
+            .position(|&b| b == b'\r')
+        {
+            return Err(self.carriage_return(start, end, at));
+        }
+        Ok(Some((self.line, start, end)))
+    }
+
     /// Reads physical lines until a logical statement is complete (the
     /// general path, after `begin_statement`).
     fn read_lines(&mut self) -> Result<Read, Diagnostic> {
+        // The lines of a `$$` comment continued with `$` (Creo `$$->`).
+        let mut comment: Option<(usize, String)> = None;
+        let mut comment_lines = 0usize;
         loop {
-            let mut start = self.raw.len();
-            if self.segments.len() >= MAX_STATEMENT_LINES {
+            // (Lines of a continued comment count as the statement's.)
+            let lines = self.segments.len() + comment.as_ref().map_or(0, |_| comment_lines);
+            if lines >= MAX_STATEMENT_LINES {
                 // (At the line that would be one too many.)
                 self.line += 1;
+                let first = self
+                    .segments
+                    .first()
+                    .map_or_else(|| comment.as_ref().map_or(self.line, |c| c.0), |s| s.line);
                 return Err(self.too_long(format!(
-                    "the statement that starts on line {} goes on over more than {MAX_STATEMENT_LINES} \
-                     lines (`$` continuations): a CL statement is a line or a few",
-                    self.segments[0].line
+                    "the statement that starts on line {first} goes on over more than {MAX_STATEMENT_LINES} \
+                     lines (`$` continuations): a CL statement is a line or a few"
                 )));
             }
-            match read_line_bounded(&mut self.input, &mut self.raw, MAX_STATEMENT_BYTES) {
-                Ok(None) => {
-                    self.line += 1;
-                    return Err(self.too_long(format!(
-                        "the statement on line {} is longer than {MAX_STATEMENT_BYTES} bytes \
-                         (its lines and `$` continuations): a CL statement is a line or a few; \
-                         is this a CL file?",
-                        self.segments.first().map_or(self.line, |s| s.line)
-                    )));
+            let Some((line_no, start, end)) = self.read_physical()? else {
+                if let Some((line, text)) = comment {
+                    return Ok(Read::Comment(line, text));
                 }
-                Ok(Some(0)) => {
-                    let Some(last) = self.segments.last() else {
-                        return Ok(Read::Eof);
-                    };
-                    // Point at the `$` that promised a continuation.
-                    let at = last.text_end;
-                    return Err(self.diag(
-                        Severity::Error,
-                        (at, at + 1),
-                        "the statement continues (`$`) past the end of the file",
-                    ));
-                }
-                Ok(Some(_)) => {}
-                Err(e) => return Err(self.read_error(e)),
-            }
-            self.line += 1;
-            let mut end = self.raw.len();
-            if self.raw[end - 1] == b'\n' {
-                end -= 1;
-            }
-            if end > start && self.raw[end - 1] == b'\r' {
-                end -= 1;
-            }
-            self.raw.truncate(end);
-            if self.line == 1 && self.raw.starts_with(b"\xEF\xBB\xBF") {
-                start += 3;
-            }
-            // (Trailing CRs are blanks at the end of a line, as on the fast
-            // path.)
-            let content = trim_end_ascii(&self.raw[start..end]);
-            if let Some(at) = self.raw[start..start + content]
-                .iter()
-                .position(|&b| b == b'\r')
-            {
-                return Err(self.carriage_return(start, end, at));
+                let Some(last) = self.segments.last() else {
+                    return Ok(Read::Eof);
+                };
+                // Point at the `$` that promised a continuation.
+                let at = last.text_end;
+                return Err(self.diag(
+                    Severity::Error,
+                    (at, at + 1),
+                    "the statement continues (`$`) past the end of the file",
+                ));
+            };
+            if comment.is_some() {
+                comment_lines += 1;
             }
             let line = match std::str::from_utf8(&self.raw[start..end]) {
                 Ok(line) => line,
-                Err(e) => return Err(self.invalid_utf8(start, end, e)),
+                Err(e) => return Err(self.invalid_utf8(line_no, start, end, e)),
             };
+            if let Some((first, mut text)) = comment.take() {
+                // A line of a continued comment.
+                let (body, continued) = comment_continues(line.trim());
+                if !text.is_empty() && !body.is_empty() {
+                    text.push(' ');
+                }
+                text.push_str(body);
+                if !continued {
+                    return Ok(Read::Comment(first, text));
+                }
+                comment = Some((first, text));
+                self.raw.truncate(start);
+                continue;
+            }
             let mut body = line;
             if line.as_bytes().contains(&b'$')
                 && let Some(p) = line.find("$$")
             {
                 if line[..p].trim().is_empty() {
                     if self.segments.is_empty() {
-                        let comment = line[p + 2..].trim().to_string();
-                        return Ok(Read::Comment(self.line, comment));
+                        let (text, continued) = comment_continues(line[p + 2..].trim());
+                        if !continued {
+                            return Ok(Read::Comment(line_no, text.to_string()));
+                        }
+                        comment = Some((line_no, text.to_string()));
+                        self.raw.truncate(start);
+                        continue;
                     }
                     // A comment line inside a continued statement.
                     self.raw.truncate(start);
@@ -463,7 +695,7 @@ impl<R: BufRead> ClReader<R> {
             let text_start = self.text.len();
             self.text.push_str(body);
             self.segments.push(Segment {
-                line: self.line,
+                line: line_no,
                 raw_start: start,
                 raw_end: end,
                 text_start,
@@ -475,10 +707,50 @@ impl<R: BufRead> ClReader<R> {
         }
     }
 
+    /// Reads the next physical line as a further line of the current
+    /// statement if `belongs` says so (its text, trimmed at a `$$` comment
+    /// and at the end): true if it was taken. Otherwise the line is kept
+    /// for the next statement. (The records of `NURBS`.)
+    fn take_line_if(&mut self, belongs: impl Fn(&str) -> bool) -> Result<bool, Diagnostic> {
+        let Some((line_no, start, end)) = self.read_physical()? else {
+            return Ok(false);
+        };
+        let taken = match std::str::from_utf8(&self.raw[start..end]) {
+            Ok(line) => {
+                let body = line.find("$$").map_or(line, |p| &line[..p]).trim_end();
+                if belongs(body.trim_start()) {
+                    let text_start = self.text.len() + 1;
+                    // (Each record its own line of `text`, for the spans.)
+                    self.text.push('\n');
+                    self.text.push_str(body);
+                    self.segments.push(Segment {
+                        line: line_no,
+                        raw_start: start,
+                        raw_end: end,
+                        text_start,
+                        text_end: self.text.len(),
+                    });
+                    true
+                } else {
+                    false
+                }
+            }
+            Err(_) => false,
+        };
+        if !taken {
+            let bytes = self.raw[start..end].to_vec();
+            self.raw.truncate(start);
+            self.pending_line = Some((bytes, line_no));
+            self.update_slow();
+        }
+        Ok(taken)
+    }
+
     /// The error for a failed read; the reader then reports end of input.
     #[cold]
     fn read_error(&mut self, e: std::io::Error) -> Diagnostic {
         self.finished = true;
+        self.update_slow();
         Diagnostic::error(
             &self.file,
             self.line + 1,
@@ -528,13 +800,19 @@ impl<R: BufRead> ClReader<R> {
         )
     }
 
-    fn invalid_utf8(&self, start: usize, end: usize, e: std::str::Utf8Error) -> Diagnostic {
+    fn invalid_utf8(
+        &self,
+        line: usize,
+        start: usize,
+        end: usize,
+        e: std::str::Utf8Error,
+    ) -> Diagnostic {
         let bytes = &self.raw[start..end];
         let valid = e.valid_up_to();
         let column = String::from_utf8_lossy(&bytes[..valid]).chars().count() + 1;
         Diagnostic::error(
             &self.file,
-            self.line,
+            line,
             column,
             1,
             String::from_utf8_lossy(bytes),
@@ -594,11 +872,16 @@ impl<R: BufRead> ClReader<R> {
         if start == b.len() {
             return Ok(None);
         }
+        if matches!(b[start], b'0'..=b'9' | b'-' | b'+' | b'.') {
+            // A line of numbers: a further point of the GOTO before (Creo).
+            return self.continuation_point(start);
+        }
         let mut word_end = start;
         while word_end < b.len() && is_word_byte(b[word_end]) {
             word_end += 1;
         }
         if word_end - start >= 4 && b[start..start + 4].eq_ignore_ascii_case(b"CSI_") {
+            self.goto_count = 0;
             return Ok(None); // CAMWorks display / tool-library records
         }
         let mut key = [0u8; 12];
@@ -629,7 +912,19 @@ impl<R: BufRead> ClReader<R> {
         let args: Span = (if slash { after + 1 } else { after }, b.len());
         let has_args = skip_blanks(b, args.0) < args.1;
 
+        // Any statement but a GOTO ends a multi-point GOTO.
+        if key != b"GOTO" {
+            self.goto_count = 0;
+            self.arc_goto = None;
+        }
+        if self.listing_header && !matches!(key, b"DATE" | b"CURRENT" | b"NODE") {
+            self.listing_header = false;
+        }
         if tool_path {
+            if !slash && nx_listing_footer(&self.text()[args.0..]) {
+                return Ok(None);
+            }
+            self.no_pending_circle(word)?;
             return self.tool_path(args).map(Some);
         }
         // Statements that take arguments after a slash.
@@ -649,6 +944,23 @@ impl<R: BufRead> ClReader<R> {
                 | b"PRESSURE"
                 | b"CSYS"
                 | b"MULTAX"
+                | b"CIRCLE"
+                | b"CYCLE"
+                | b"FROM"
+                | b"GOHOME"
+                | b"CUTCOM"
+                | b"DELAY"
+                | b"DWELL"
+                | b"MACHIN"
+                | b"CLAMP"
+                | b"ORIGIN"
+                | b"SETUP"
+                | b"KNOT"
+                | b"CNTRL"
+                | b"TLAXIS"
+                | b"GODLTA"
+                | b"LOADTL"
+                | b"OPNAME"
         );
         if needs_slash && !slash && has_args {
             let name = self.text()[word.0..word.1].to_ascii_uppercase();
@@ -660,83 +972,96 @@ impl<R: BufRead> ClReader<R> {
                 self.rapid = true;
                 Ok(None)
             }
-            b"FEDRAT" => {
-                let feed = self.fedrat(args)?;
-                // APT: a feed rate cancels a RAPID that no move has used.
-                if std::mem::take(&mut self.rapid) {
-                    self.warn(
-                        (word.0, args.1),
-                        "FEDRAT after RAPID: the next move is at this feed, not rapid",
-                    );
-                }
-                Ok(Some(feed))
-            }
+            b"FEDRAT" => self.fedrat(word, args).map(Some),
+            b"CIRCLE" => self.circle(word, args).map(Some),
+            b"NURBS" => self.nurbs(word, args).map(Some),
+            b"KNOT" | b"CNTRL" => Err(self.error(
+                word,
+                format!(
+                    "`{}` outside a NURBS: KNOT and CNTRL records follow a NURBS/ statement",
+                    self.text()[word.0..word.1].to_ascii_uppercase()
+                ),
+            )),
+            b"FROM" => self.from(word, args).map(Some),
+            b"GOHOME" => self.gohome(word, args).map(Some),
             b"TLAXIS" => self.tlaxis(word, args),
             b"GODLTA" => self.godlta(word, args).map(Some),
-            b"LOADTL" => Ok(Some(ClEvent::LoadTool {
-                number: self.loadtl(word, args)?,
-            })),
+            b"CYCLE" => self.cycle(word, args),
+            b"LOADTL" => self.loadtl(word, args).map(Some),
             b"TLDATA" => self.tool_data(args, false).map(Some),
             b"CUTTER" => self.tool_data(args, true).map(Some),
-            b"MSYS" => self.msys(args),
-            b"LOAD" => Ok(Some(ClEvent::LoadTool {
-                number: self.tool_number("LOAD", word, args)?,
-            })),
-            b"SELECT" => Ok(Some(ClEvent::SelectTool {
-                number: self.tool_number("SELECT", word, args)?,
-            })),
+            b"MSYS" => self.msys(args).map(Some),
+            b"CSYS" => self.csys(word, args).map(Some),
+            b"LOAD" => self.load(word, args).map(Some),
+            b"SELECT" => self.select(word, args).map(Some),
             b"SPINDL" => self.spindle(args).map(Some),
             b"COOLNT" => self.coolant(args).map(Some),
+            b"CUTCOM" => self.cutcom(word, args).map(Some),
             b"INSERT" => Ok(Some(ClEvent::Insert(
                 self.text()[args.0..].trim_end().to_string(),
             ))),
             b"PPRINT" => Ok(Some(ClEvent::Comment(
                 self.text()[args.0..].trim().to_string(),
             ))),
-            b"END-OF-PATH" => Ok(Some(ClEvent::EndOfPath)),
+            b"END-OF-PATH" => {
+                self.no_pending_circle(word)?;
+                Ok(Some(ClEvent::EndOfPath))
+            }
             b"PARTNO" => Ok(Some(ClEvent::PartNo(
                 unquote(self.text()[args.0..].trim()).to_string(),
             ))),
             b"UNITS" | b"UNIT" => self.units_statement(word, args).map(Some),
             b"MULTAX" => self.multax(args).map(Some),
             b"PRESSURE" => self.pressure(word, args).map(Some),
-            b"FINI" => Ok(Some(ClEvent::Fini)),
+            b"FINI" => {
+                self.no_pending_circle(word)?;
+                self.bare(word, args, ClEvent::Fini)
+            }
+            b"STOP" => self.bare(word, args, ClEvent::Stop),
+            b"OPSTOP" => self.bare(word, args, ClEvent::OptionalStop),
+            b"END" => self.bare(word, args, ClEvent::End),
+            b"TMARK" => Ok(Some(ClEvent::TapeMark)),
+            b"DELAY" | b"DWELL" => self.delay(word, args).map(Some),
+            b"MACHIN" => self.machin(word, args).map(Some),
+            b"OPNAME" => Ok(Some(ClEvent::OperationName(
+                unquote(self.text()[args.0..].trim()).to_string(),
+            ))),
+            b"CLAMP" => self.clamp(args).map(Some),
+            b"ORIGIN" => self.origin(word, args).map(Some),
+            b"SETUP" => self.setup(word, args).map(Some),
+            // Display records of NX and the transformation type of
+            // SOLIDWORKS CAM (see the crate documentation).
             b"PAINT" | b"TRNTYP" => Ok(None),
-            b"CSYS" => self.csys(word, args),
-            b"CUTCOM" => {
-                self.split(args);
-                let off = self.fields.first().is_some_and(|&f| self.is(f, "OFF"));
-                if !off {
-                    self.warn(
-                        (word.0, args.1),
-                        "cutter compensation ignored: the GOTO points are used as tool positions",
-                    );
-                }
+            b"INFORMATION"
+                if self.text()[start..].starts_with("Information listing created by") =>
+            {
+                self.listing_header = true;
                 Ok(None)
             }
-            b"CIRCLE" => Err(self.error(
-                word,
-                "CIRCLE is not supported yet; have the CAM system output arcs as GOTO points (linearized)",
-            )),
-            b"NURBS" => Err(self.error(
-                word,
-                "NURBS is not supported yet; have the CAM system output GOTO points instead",
-            )),
-            b"CYCLE" => {
-                self.split(args);
-                if self.fields.len() == 1 && self.is(self.fields[0], "OFF") {
-                    return Ok(None);
-                }
-                Err(self.error(
-                    word,
-                    "CYCLE is not supported yet; have the CAM system output canned cycles as GOTO moves",
-                ))
+            b"DATE" | b"CURRENT" | b"NODE"
+                if self.listing_header && nx_listing_line(&self.text()[start..]) =>
+            {
+                Ok(None)
             }
             _ => {
                 self.unknown(word);
                 Ok(None)
             }
         }
+    }
+
+    /// A statement that takes no arguments.
+    fn bare(
+        &mut self,
+        word: Span,
+        args: Span,
+        event: ClEvent,
+    ) -> Result<Option<ClEvent>, Diagnostic> {
+        if skip_blanks(self.text_bytes(), args.0) < args.1 {
+            let name = self.text()[word.0..word.1].to_ascii_uppercase();
+            return Err(self.error(args, format!("`{name}` takes no arguments")));
+        }
+        Ok(Some(event))
     }
 
     fn unknown(&mut self, word: Span) {
@@ -821,9 +1146,9 @@ impl<R: BufRead> ClReader<R> {
         })
     }
 
-    /// A `GOTO` with `count` values (the first 9 in `v`): its point, tool
-    /// axis and motion, the new modal state set (the reference direction is
-    /// then `self.reference`).
+    /// A `GOTO` with `count` values (the first 9 in `v`, in the file's
+    /// units): its point (mm), tool axis and motion, the new modal state set
+    /// (the reference direction is then `self.reference`).
     #[inline(always)]
     fn goto_move(
         &mut self,
@@ -834,7 +1159,24 @@ impl<R: BufRead> ClReader<R> {
         if !matches!(count, 3 | 6 | 9) {
             return Err(self.goto_count_error(args, count));
         }
-        let point = [v[0], v[1], v[2]];
+        let mut point = [v[0], v[1], v[2]];
+        if self.goto_special {
+            point = self.special_point(args, point)?;
+        }
+        self.finish_move(args, point, v, count)
+    }
+
+    /// The rest of [`goto_move`](Self::goto_move), from the point in mm
+    /// (checked against a waiting arc): the tool axis and reference
+    /// direction of `v` (`count` values), then the new modal state.
+    #[inline(always)]
+    fn finish_move(
+        &mut self,
+        args: Span,
+        point: Vec3,
+        v: [f64; 9],
+        count: usize,
+    ) -> Result<(Vec3, Vec3, Motion), Diagnostic> {
         let axis = if count >= 6 {
             let n2 = v[3] * v[3] + v[4] * v[4] + v[5] * v[5];
             if !(AXIS_LENGTH2.0..=AXIS_LENGTH2.1).contains(&n2) && !self.axis_length_noted {
@@ -881,12 +1223,56 @@ impl<R: BufRead> ClReader<R> {
         // (The reference direction is kept as it is unless given.)
         self.axis = Some(axis);
         self.last_point = Some(point);
+        self.goto_count = count;
+        if self.circle.is_some() || self.arc_goto.is_some() {
+            self.arc_transition();
+        }
         let motion = if std::mem::take(&mut self.rapid) {
             Motion::Rapid
         } else {
             Motion::Feed
         };
         Ok((point, axis, motion))
+    }
+
+    /// After a `GOTO`: the arc it ended (if any) is the one a Creo further
+    /// point continues; an earlier one is over (out of line: the plain case
+    /// has neither).
+    #[cold]
+    #[inline(never)]
+    fn arc_transition(&mut self) {
+        self.arc_goto = self.circle.take();
+        self.update_goto_special();
+    }
+
+    /// The point of a `GOTO` in mm, and the check of the arc it ends (out
+    /// of line: the plain case is mm without an arc).
+    #[cold]
+    #[inline(never)]
+    fn special_point(&mut self, args: Span, point: Vec3) -> Result<Vec3, Diagnostic> {
+        let point = self.mm3(point);
+        if let Some(pending) = &self.circle {
+            let start = self
+                .last_point
+                .expect("a CIRCLE is only read after a point");
+            if self.rapid {
+                return Err(self.error(
+                    args,
+                    format!(
+                        "RAPID before the GOTO that ends the CIRCLE of line {}: an arc is a feed move",
+                        pending.line
+                    ),
+                ));
+            }
+            if let Err(e) = pending.circle.arc(start, point) {
+                let line = pending.line;
+                return Err(self.error(
+                    args,
+                    format!("this GOTO cannot end the CIRCLE of line {line}: {e}"),
+                ));
+            }
+        }
+        Ok(point)
     }
 
     /// The error for a `GOTO` with `count` values, not 3, 6 or 9 (out of
@@ -939,52 +1325,6 @@ impl<R: BufRead> ClReader<R> {
         self.error((self.fields[first].0, self.fields[first + 2].1), message)
     }
 
-    fn fedrat(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let mut value: Option<(f64, Span)> = None;
-        let mut unit: Option<FeedUnit> = None;
-        for k in 0..self.fields.len() {
-            let f = self.fields[k];
-            if self.is_word(f) {
-                let u = match self.field(f).to_ascii_uppercase().as_str() {
-                    "MMPM" => FeedUnit::Mmpm,
-                    "IPM" => FeedUnit::Ipm,
-                    "MMPR" => FeedUnit::Mmpr,
-                    "IPR" => FeedUnit::Ipr,
-                    other => {
-                        return Err(self.error(
-                            f,
-                            format!("unknown feed unit `{other}`; expected MMPM, IPM, MMPR or IPR"),
-                        ));
-                    }
-                };
-                if unit.is_some() {
-                    return Err(self.error(f, "FEDRAT has two units"));
-                }
-                unit = Some(u);
-            } else {
-                if value.is_some() {
-                    return Err(self.error(f, "FEDRAT has two feed values"));
-                }
-                value = Some((self.number(f)?, f));
-            }
-        }
-        let Some((value, span)) = value else {
-            return Err(self.error(args, "FEDRAT without a feed value"));
-        };
-        if value <= 0.0 {
-            return Err(self.error(
-                span,
-                format!("the feed rate must be positive, got `{}`", self.field(span)),
-            ));
-        }
-        let unit = unit.unwrap_or(match self.units {
-            Units::Mm => FeedUnit::Mmpm,
-            Units::Inch => FeedUnit::Ipm,
-        });
-        Ok(ClEvent::Feedrate { value, unit })
-    }
-
     fn tool_path(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
         self.split(args);
         let mut fields = self.fields.iter().map(|&f| self.field(f).to_string());
@@ -993,354 +1333,17 @@ impl<R: BufRead> ClReader<R> {
         Ok(ClEvent::ToolPath { name, words })
     }
 
-    fn tool_data(&mut self, args: Span, cutter: bool) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let mut first = 0;
-        let kind = if cutter {
-            "CUTTER".to_string()
-        } else if let Some(&f) = self.fields.first().filter(|&&f| self.is_word(f)) {
-            first = 1;
-            self.field(f).to_string()
-        } else {
-            String::new()
-        };
-        let mut values = Vec::with_capacity(self.fields.len());
-        for k in first..self.fields.len() {
-            values.push(self.number(self.fields[k])?);
-        }
-        Ok(ClEvent::ToolData { kind, values })
-    }
-
-    fn msys(&mut self, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
-        self.split(args);
-        let mut count = self.fields.len();
-        // A record cut short often keeps its trailing comma.
-        if count > 1 && self.fields[count - 1].0 == self.fields[count - 1].1 {
-            count -= 1;
-        }
-        let mut v = [0.0; 9];
-        for (k, value) in v.iter_mut().enumerate().take(count) {
-            *value = self.number(self.fields[k])?;
-        }
-        if count < 3 {
-            return Err(self.error(args, "MSYS needs at least the origin x,y,z"));
-        }
-        // Every GOTO is posted in the machine file's part frame: a second
-        // coordinate system would put the points after it elsewhere.
-        let line = self.statement_line().0;
-        match self.msys {
-            None => self.msys = Some((v, count, line)),
-            Some((first, first_count, first_line)) => {
-                let n = count.min(first_count).min(v.len());
-                if (0..n).any(|k| (v[k] - first[k]).abs() > 1e-6) {
-                    return Err(self.error(
-                        args,
-                        format!(
-                            "MSYS changes the machine coordinate system of line {first_line}: kinpost posts every point in the part frame of the machine file; post the operations of each coordinate system as a program of their own"
-                        ),
-                    ));
-                }
-            }
-        }
-        let origin = [v[0], v[1], v[2]];
-        let x = (count >= 6).then_some([v[3], v[4], v[5]]);
-        let y = (count >= 9).then_some([v[6], v[7], v[8]]);
-        if count != 3 && count != 9 {
-            let detail = match count {
-                4 | 5 => "only the origin is used",
-                6..=8 => {
-                    "the line looks cut short: the origin and the X axis are used, the Y axis is missing"
-                }
-                _ => "the values after the ninth are ignored",
-            };
-            self.warn(
-                args,
-                format!("MSYS has {count} values, expected 3 or 9; {detail}"),
-            );
-        }
-        Ok(Some(ClEvent::MachineSystem { origin, x, y }))
-    }
-
-    /// `TLAXIS/i,j,k`: the tool axis of the three-value `GOTO`s that follow.
-    fn tlaxis(&mut self, word: Span, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
-        self.split(args);
-        if self.fields.len() != 3 || self.fields.iter().any(|&f| self.is_word(f)) {
-            return Err(self.error(
-                (word.0, args.1),
-                "only `TLAXIS/i,j,k` is supported (a fixed tool axis); have the CAM system output the tool axis in each GOTO",
-            ));
-        }
-        let mut v = [0.0; 3];
-        for (value, &f) in v.iter_mut().zip(&self.fields) {
-            *value = self.number(f)?;
-        }
-        match normalize(v) {
-            Some(axis) => {
-                self.axis = Some(axis);
-                Ok(None)
-            }
-            None => Err(self.error(args, "the tool axis (i,j,k) is zero or not finite")),
-        }
-    }
-
-    /// `GODLTA/dx,dy,dz` (a move by that much) or `GODLTA/d` (along the
-    /// tool axis): a `GOTO` relative to the last point, tool axis kept.
-    fn godlta(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let (Some(last), Some(axis)) = (self.last_point, self.axis) else {
-            return Err(self.error(
-                (word.0, args.1),
-                "GODLTA before any GOTO: a relative move needs a point to start from",
-            ));
-        };
-        let mut d = [0.0; 3];
-        match self.fields.len() {
-            1 => {
-                let t = self.number(self.fields[0])?;
-                d = axis.map(|a| a * t);
-            }
-            3 => {
-                for (value, &f) in d.iter_mut().zip(&self.fields) {
-                    *value = self.number(f)?;
-                }
-            }
-            n => {
-                return Err(self.error(
-                    args,
-                    format!(
-                        "GODLTA has {n} values, expected 1 (along the tool axis) or 3 (dx,dy,dz)"
-                    ),
-                ));
-            }
-        }
-        // A three-value GOTO to the moved point.
-        let mut v = [0.0; 9];
-        for k in 0..3 {
-            v[k] = last[k] + d[k];
-        }
-        let (point, axis, motion) = self.goto_move(args, v, 3)?;
-        Ok(ClEvent::Goto {
-            point,
-            axis,
-            reference: self.reference,
-            motion,
-        })
-    }
-
-    /// `LOADTL/n[,…]` (CATIA, Fusion, Mastercam APT): `LOAD/TOOL,n`.
-    fn loadtl(&mut self, word: Span, args: Span) -> Result<u32, Diagnostic> {
-        self.split(args);
-        if self.fields.is_empty() {
-            return Err(self.error(word, "expected `LOADTL/n`"));
-        }
-        self.tool_number_field(0, args)
-    }
-
-    /// Field `k` (split already) as a tool number; the fields after it are
-    /// ignored with a warning.
-    fn tool_number_field(&mut self, k: usize, args: Span) -> Result<u32, Diagnostic> {
-        let f = self.fields[k];
-        let n = self.number(f)?;
-        if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
-            return Err(self.error(
-                f,
-                format!(
-                    "the tool number must be a whole number from 0 to {}, got `{}`",
-                    u32::MAX,
-                    self.field(f)
-                ),
-            ));
-        }
-        if let Some(next) = self.fields.get(k + 1) {
-            let rest = (next.0, args.1);
-            let text = self.text()[rest.0..rest.1].trim().to_string();
-            self.warn(rest, format!("`{text}` after the tool number ignored"));
-        }
-        Ok(n as u32)
-    }
-
-    fn tool_number(&mut self, name: &str, word: Span, args: Span) -> Result<u32, Diagnostic> {
-        self.split(args);
-        let usage = format!("expected `{name}/TOOL,n`");
-        let Some(&first) = self.fields.first() else {
-            return Err(self.error(word, usage));
-        };
-        if !self.is(first, "TOOL") {
-            return Err(self.error(first, usage));
-        }
-        if self.fields.len() < 2 {
-            return Err(self.error(
-                (first.1, first.1),
-                format!("{usage}: the tool number is missing"),
-            ));
-        }
-        self.tool_number_field(1, args)
-    }
-
-    fn spindle(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let mut rpm: Option<(f64, Span)> = None;
-        let mut dir: Option<SpindleDir> = None;
-        for k in 0..self.fields.len() {
-            let f = self.fields[k];
-            if self.is_word(f) {
-                match self.field(f).to_ascii_uppercase().as_str() {
-                    "OFF" => return Ok(ClEvent::SpindleOff),
-                    "ON" | "RPM" => {}
-                    "CLW" => dir = Some(SpindleDir::Clockwise),
-                    "CCLW" => dir = Some(SpindleDir::CounterClockwise),
-                    "SFM" | "SMM" => {
-                        return Err(self.error(
-                            f,
-                            "constant surface speed (SFM/SMM) is not supported; give the speed in RPM",
-                        ));
-                    }
-                    _ => {
-                        let text = self.field(f).to_string();
-                        self.warn(f, format!("`{text}` in SPINDL ignored"));
-                    }
-                }
-            } else if rpm.is_none() {
-                rpm = Some((self.number(f)?, f));
-            } else {
-                let text = self.field(f).to_string();
-                self.warn(f, format!("`{text}` in SPINDL ignored"));
-            }
-        }
-        let (rpm, dir) = match rpm {
-            Some((value, span)) => {
-                if value <= 0.0 {
-                    return Err(self.error(
-                        span,
-                        format!(
-                            "the spindle speed must be positive, got `{}` (use SPINDL/OFF to stop it)",
-                            self.field(span)
-                        ),
-                    ));
-                }
-                (value, dir.unwrap_or(SpindleDir::Clockwise))
-            }
-            None => match self.spindle {
-                Some((value, last)) => (value, dir.unwrap_or(last)),
-                None => {
-                    return Err(self.error(
-                        args,
-                        "SPINDL without a speed, and no earlier speed to restart",
-                    ));
-                }
-            },
-        };
-        self.spindle = Some((rpm, dir));
-        Ok(ClEvent::Spindle { rpm, dir })
-    }
-
-    fn coolant(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let Some(&first) = self.fields.first() else {
-            return Ok(ClEvent::Coolant {
-                on: true,
-                mode: "ON".to_string(),
-            });
-        };
-        let on = !self.fields.iter().any(|&f| self.is(f, "OFF"));
-        // The mode is the first word that is not ON: `COOLNT/ON,MIST` is
-        // mist, as `COOLNT/MIST` is.
-        let mode = self
-            .fields
-            .iter()
-            .find(|&&f| !self.is(f, "ON") && !self.is(f, "OFF"))
-            .map_or(first, |&f| f);
-        Ok(ClEvent::Coolant {
-            on,
-            mode: self.field(mode).to_ascii_uppercase(),
-        })
-    }
-
-    fn units_statement(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let units = match self.fields.as_slice() {
-            [f] => match self.field(*f).to_ascii_uppercase().as_str() {
-                "MM" | "MILLIMETERS" | "MILLIMETRES" => Units::Mm,
-                "IN" | "INCH" | "INCHES" => Units::Inch,
-                _ => {
-                    return Err(self.error(
-                        *f,
-                        format!("unknown units `{}`; expected MM or INCHES", self.field(*f)),
-                    ));
-                }
-            },
-            [] => return Err(self.error(word, "expected `UNITS/MM` or `UNITS/INCHES`")),
-            [_, second, ..] => {
-                return Err(self.error((second.0, args.1), "expected `UNITS/MM` or `UNITS/INCHES`"));
-            }
-        };
-        // The last point (for `GODLTA`) is kept in the units it was
-        // written in: into the new ones, as the deltas that follow are.
-        if let Some(p) = &mut self.last_point {
-            match (self.units, units) {
-                (Units::Inch, Units::Mm) => *p = p.map(|v| v * 25.4),
-                (Units::Mm, Units::Inch) => *p = p.map(|v| v / 25.4),
-                _ => {}
-            }
-        }
-        self.units = units;
-        Ok(ClEvent::Units(units))
-    }
-
-    fn multax(&mut self, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        match self.fields.as_slice() {
-            [] => Ok(ClEvent::Multax(true)),
-            [f] if self.is(*f, "ON") => Ok(ClEvent::Multax(true)),
-            [f] if self.is(*f, "OFF") => Ok(ClEvent::Multax(false)),
-            _ => Err(self.error(args, "expected `MULTAX`, `MULTAX/ON` or `MULTAX/OFF`")),
-        }
-    }
-
-    fn pressure(&mut self, word: Span, args: Span) -> Result<ClEvent, Diagnostic> {
-        self.split(args);
-        let (name, f) = match self.fields.as_slice() {
-            [f] => (None, *f),
-            [w, f] if self.is_word(*w) => (Some(self.field(*w).to_string()), *f),
-            [] => return Err(self.error(word, "expected `PRESSURE/[word,]value`")),
-            _ => return Err(self.error(args, "expected `PRESSURE/[word,]value`")),
-        };
-        let value = self.number(f)?;
-        if value < 0.0 {
-            return Err(self.error(
-                f,
-                format!("the pressure must not be negative, got `{}`", self.field(f)),
-            ));
-        }
-        Ok(ClEvent::Pressure { word: name, value })
-    }
-
-    /// `CSYS/` with the identity matrix is a no-op; any other matrix would
-    /// have to transform the following GOTOs, which is not supported.
-    fn csys(&mut self, word: Span, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
-        self.split(args);
-        if self.fields.len() != 12 {
-            return Err(self.error(
-                if self.fields.is_empty() { word } else { args },
-                format!(
-                    "CSYS has {} values, expected 12 (a 3x4 matrix)",
-                    self.fields.len()
-                ),
-            ));
-        }
-        const IDENTITY: [f64; 12] = [1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0.];
-        for (k, expected) in IDENTITY.iter().enumerate() {
-            if (self.number(self.fields[k])? - expected).abs() > 1e-9 {
-                return Err(self.error(
-                    args,
-                    "CSYS with a non-identity matrix is not supported yet (the following GOTOs would have to be transformed); output the tool path in one coordinate system",
-                ));
-            }
-        }
-        Ok(None)
-    }
-
     // ----- fields -----
+
+    /// Makes `text` hold the statement (a plain line is only in `raw`), so
+    /// that further lines can be appended.
+    fn own_text(&mut self) {
+        if let Some(len) = self.text_in_raw.take() {
+            self.text.clear();
+            self.text
+                .push_str(std::str::from_utf8(&self.raw[..len]).expect("statement text is UTF-8"));
+        }
+    }
 
     /// Splits `args` at commas into trimmed fields (`self.fields`). Blank
     /// arguments give no field; an empty field between commas is a
@@ -1397,6 +1400,11 @@ impl<R: BufRead> ClReader<R> {
             .is_some_and(|c| c.is_ascii_alphabetic())
     }
 
+    /// Field `f` as an upper-case word.
+    fn word(&self, f: Span) -> String {
+        self.field(f).to_ascii_uppercase()
+    }
+
     fn number(&self, f: Span) -> Result<f64, Diagnostic> {
         let text = self.field(f);
         if let Some(v) = parse_number(text) {
@@ -1414,6 +1422,29 @@ impl<R: BufRead> ClReader<R> {
             format!("malformed number `{text}`")
         };
         Err(self.error(f, message))
+    }
+
+    /// The numbers of fields `range` (split already).
+    fn numbers(&self, range: std::ops::Range<usize>) -> Result<Vec<f64>, Diagnostic> {
+        range.map(|k| self.number(self.fields[k])).collect()
+    }
+
+    /// Field `k` (split already) as a whole number from 0 to `u32::MAX`;
+    /// `what` names it in the error.
+    fn whole(&self, k: usize, what: &str) -> Result<u32, Diagnostic> {
+        let f = self.fields[k];
+        let n = self.number(f)?;
+        if !(n >= 0.0 && n <= f64::from(u32::MAX) && n.fract() == 0.0) {
+            return Err(self.error(
+                f,
+                format!(
+                    "the {what} must be a whole number from 0 to {}, got `{}`",
+                    u32::MAX,
+                    self.field(f)
+                ),
+            ));
+        }
+        Ok(n as u32)
     }
 }
 
@@ -1437,6 +1468,40 @@ impl<R> std::fmt::Debug for ClReader<R> {
             .field("units", &self.units)
             .finish_non_exhaustive()
     }
+}
+
+/// Whether a comment's text continues on the next line (Creo ends a long
+/// `$$->` comment with `,  $`): the text without the `$`, and whether it
+/// does. A `$` right after other text (`$$ 5$`) is text.
+fn comment_continues(text: &str) -> (&str, bool) {
+    match text.strip_suffix('$') {
+        Some(body)
+            if body.is_empty() || body.ends_with(|c: char| c == ',' || c.is_whitespace()) =>
+        {
+            (body.trim_end(), true)
+        }
+        _ => (text, false),
+    }
+}
+
+/// Whether `rest` (after `TOOL PATH`) is the footer NX writes after a CLSF
+/// listed in its Information window: `Listing has 11294 lines.`
+fn nx_listing_footer(rest: &str) -> bool {
+    rest.trim()
+        .strip_prefix("Listing has ")
+        .and_then(|r| r.strip_suffix(" lines."))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|c| c.is_ascii_digit()))
+}
+
+/// Whether `line` is one of the lines of the header NX writes above a CLSF
+/// listed in its Information window (after `Information listing created
+/// by`): `Date`, `Current work part`, `Node name`, each followed by a tab
+/// or blanks.
+fn nx_listing_line(line: &str) -> bool {
+    ["Date", "Current work part", "Node name"].iter().any(|k| {
+        line.strip_prefix(k)
+            .is_some_and(|rest| rest.starts_with(['\t', ' ']))
+    })
 }
 
 fn make(
@@ -1706,34 +1771,3 @@ fn unquote(text: &str) -> &str {
 /// CAM systems write seven or more decimals (lengths within 1e-6 of 1); a
 /// length off by more than 0.1 % is a hand-made or garbled vector.
 const AXIS_LENGTH2: (f64, f64) = (0.998, 1.002);
-
-/// `v` scaled to unit length; `None` if it is (nearly) zero or not finite.
-fn normalize(v: Vec3) -> Option<Vec3> {
-    let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    if n2 == 1.0 {
-        return Some(v); // already unit length, e.g. 0,0,1
-    }
-    // The usual case: no overflow or underflow in the squares (also false
-    // for NaN and infinity); one square root, three correctly rounded
-    // divisions.
-    if n2 > 1e-200 && n2 < 1e200 {
-        let n = n2.sqrt();
-        return Some([v[0] / n, v[1] / n, v[2] / n]);
-    }
-    // Scale first so that huge or tiny components neither overflow nor vanish.
-    let m = v[0].abs().max(v[1].abs()).max(v[2].abs());
-    if !(m.is_finite() && m > 1e-300) {
-        return None;
-    }
-    let s = [v[0] / m, v[1] / m, v[2] / m];
-    let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-    Some([s[0] / n, s[1] / n, s[2] / n])
-}
-
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
