@@ -434,3 +434,163 @@ pub fn triangle_offset_span(
     }
     span
 }
+
+// ---------------------------------------------------------------------------
+// Certain bounds without square roots or divisions, for the fast removal.
+//
+// The fast removal (`crate::stock`) skips a solid on a ray when the span it
+// would compute there certainly starts at or above a level m (the top of the
+// ray's material, or the start of a span already found that reaches the
+// top): such a span changes nothing. "Certainly" is about the *computed*
+// span, bits and all, so the skip gives the same stock as evaluating every
+// span. The tests below use the very coefficients (a, b, c) and
+// discriminant that [`quadratic_le0`] computes, then decide with products
+// and sums only, each compared with a margin that bounds its rounding.
+
+/// Unit roundoff of f64 (half an ulp of 1).
+const U: f64 = f64::EPSILON / 2.0;
+/// A margin of 32 u: every rounded product, sum or quotient below is within
+/// (1 + u) of its exact value, and at most a handful of them are chained
+/// before a margin is applied.
+const SLACK: f64 = 32.0 * U;
+/// An absolute floor under every margin: errors of results in the
+/// subnormal range (far below any length in mm).
+const TINY: f64 = 1e-290;
+
+/// A certain lower bound of the exact value of the rounded `x`, where `x`
+/// is the result of one rounded operation on exact operands whose
+/// magnitudes sum to at most `scale`.
+#[inline(always)]
+fn lower(x: f64, scale: f64) -> f64 {
+    x - SLACK * scale - TINY
+}
+
+/// A certain upper bound, likewise.
+#[inline(always)]
+fn upper(x: f64, scale: f64) -> f64 {
+    x + SLACK * scale + TINY
+}
+
+/// Whether `y ≥ m·√d` certainly holds (d ≥ 0; `y`, `m`, `d` taken as
+/// exact): y ≥ 0 and (m ≤ 0 or y² ≥ m²·d), or y < 0, m < 0 and y² ≤ m²·d.
+/// The relation grows with y, so a certain lower bound of a rounded y may
+/// stand for it.
+#[inline(always)]
+fn at_least_times_sqrt(y: f64, m: f64, d: f64) -> bool {
+    let m2 = m * m;
+    let rhs = m2 * d;
+    // m2 and rhs: two roundings, |rhs| within (1 + u)² of m²·d.
+    let (rhs_lo, rhs_hi) = (lower(rhs, rhs), upper(rhs, rhs));
+    let y2 = y * y;
+    let (y2_lo, y2_hi) = (lower(y2, y2), upper(y2, y2));
+    if y >= 0.0 {
+        m <= 0.0 || y2_lo >= rhs_hi
+    } else {
+        m < 0.0 && y2_hi <= rhs_lo
+    }
+}
+
+/// Whether the lower end of the span [`quadratic_le0`]`(a, b, c)` computes
+/// is certainly ≥ `m`, or that span certainly empty. `false`: not certain
+/// (then the span must be computed).
+///
+/// With d the computed discriminant b² − a·c (the same float as
+/// `quadratic_le0`'s), s = fl(√d) and |q| = fl(|b| + s) lie within (1 ± u)
+/// and (1 ± 2.01u) of √d and Q = |b| + √d, so the two computed roots are
+/// within a relative 3.1u of X₁ = σ·Q/a and X₂ = σ·c/Q (σ = −sign b; the
+/// lower root is the smaller). Both are ≥ m when both X are ≥ m' = m +
+/// 32u·|m| (x − 3.1u·|x| grows with x), and X ≥ m' is decided without the
+/// root by squaring ([`at_least_times_sqrt`]):
+/// * b < 0: Q/a ≥ m' ⇐ |b| ≥ a·m'; c/Q ≥ m' ⇔ c − m'|b| ≥ m'·√d;
+/// * b > 0: −Q/a ≥ m' ⇔ −a·m' − |b| ≥ √d; −c/Q ≥ m' ⇔ −c − m'|b| ≥ m'·√d.
+///
+/// Every sum and product here is rounded once or twice, and every
+/// comparison widened by 32u of the magnitudes involved ([`lower`],
+/// [`upper`]).
+#[inline(always)]
+pub(crate) fn quadratic_lo_at_least(a: f64, b: f64, c: f64, m: f64) -> bool {
+    // The same branch as `quadratic_le0`, from the same floats.
+    if a <= 1e-15 * (b.abs() + c.abs()).max(1e-300) || a == 0.0 {
+        return false;
+    }
+    let d = b * b - a * c;
+    if d < 0.0 {
+        // `quadratic_le0` returns None: nothing to cut.
+        return true;
+    }
+    if b == 0.0 || !m.is_finite() {
+        return false;
+    }
+    // m' ≥ m + 32u·|m| (rounded up twice more: m is the larger term).
+    let m1 = upper(m + SLACK * m.abs(), m.abs());
+    let bb = b.abs();
+    let am = a * m1;
+    if b < 0.0 {
+        // Q/a ≥ m' ⇐ |b| ≥ a·m'.
+        if !(bb >= upper(am, am.abs())) {
+            return false;
+        }
+        // c − m'|b| ≥ m'·√d.
+        let mb = m1 * bb;
+        let y = c - mb;
+        let scale = c.abs() + 2.0 * mb.abs();
+        at_least_times_sqrt(lower(y, scale), m1, d)
+    } else {
+        // −a·m' − |b| ≥ √d (m = 1 in `at_least_times_sqrt`).
+        let z = -am - bb;
+        let zs = 2.0 * (am.abs() + bb);
+        if !(lower(z, zs) >= 0.0 && at_least_times_sqrt(lower(z, zs), 1.0, d)) {
+            return false;
+        }
+        // −c − m'|b| ≥ m'·√d.
+        let mb = m1 * bb;
+        let y = -c - mb;
+        let scale = c.abs() + 2.0 * mb.abs();
+        at_least_times_sqrt(lower(y, scale), m1, d)
+    }
+}
+
+/// Whether the span [`piece_span`] computes for the line `l` in a cylinder
+/// or sphere piece certainly starts at or above `m` (or is empty); `false`
+/// for the other pieces (not certain).
+#[inline(always)]
+pub(crate) fn piece_lo_at_least(piece: &Piece, l: &Local, m: f64) -> bool {
+    match *piece {
+        // The span is the radial span met with the slab: it starts no lower
+        // than the radial span.
+        Piece::Cylinder { r, .. } => quadratic_lo_at_least(l.a, l.b, l.c - r * r, m),
+        Piece::Sphere { zc, r } => {
+            let zr = l.z0 - zc;
+            quadratic_lo_at_least(l.a + l.dz * l.dz, l.b + zr * l.dz, l.c + zr * zr - r * r, m)
+        }
+        Piece::Cone { .. } | Piece::RoundedDisc { .. } => false,
+    }
+}
+
+/// Whether [`capsule_span`] certainly starts at or above `m` (or is empty):
+/// the hull of two spheres and a cylinder starts at the lowest of them.
+#[inline(always)]
+pub(crate) fn capsule_lo_at_least(
+    o: &Vector3<f64>,
+    d: &Vector3<f64>,
+    c0: &Vector3<f64>,
+    v: &Vector3<f64>,
+    r: f64,
+    m: f64,
+) -> bool {
+    // The same coefficients as `capsule_span`.
+    let sphere = |c: &Vector3<f64>| {
+        let oc = o - c;
+        quadratic_lo_at_least(1.0, oc.dot(d), oc.norm_squared() - r * r, m)
+    };
+    if !(sphere(c0) && sphere(&(c0 + v))) {
+        return false;
+    }
+    let len = v.norm();
+    if len > 0.0 {
+        let w = v / len;
+        let l = Local::new(o, d, c0, &w);
+        return quadratic_lo_at_least(l.a, l.b, l.c - r * r, m);
+    }
+    true
+}

@@ -5,7 +5,10 @@ use rayon::prelude::*;
 
 use crate::clip::{Aabb, piece_in_box, swept_in_box};
 use crate::dexel::{Ray, Segment, UNCUT, subtract};
-use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
+use crate::kernel::{
+    Local, Span, capsule_lo_at_least, capsule_span, cylinder_sweep_span, piece_lo_at_least,
+    piece_span,
+};
 use crate::tolerance::{
     DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION,
 };
@@ -102,6 +105,7 @@ pub struct Stock {
     families: [Family; 3],
     initial_volume: f64,
     last: Option<(Tool, ToolPose)>,
+    removal: Removal,
 }
 
 /// How a move was cut.
@@ -111,6 +115,20 @@ pub struct MoveCut {
     pub samples: u64,
     /// Whether the move was swept analytically (a pure translation).
     pub analytic: bool,
+}
+
+/// How a cut visits the rays. Both give the same stock, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Removal {
+    /// Skips, ray by ray, a solid whose span certainly changes nothing: it
+    /// starts at or above the top of the ray's material, or above the start
+    /// of a span already found that reaches the top (a test with products
+    /// and sums only, see `kernel::quadratic_lo_at_least`).
+    #[default]
+    Fast,
+    /// Computes the span of every solid on every ray within its bounds: the
+    /// straightforward path, the reference the fast one is tested against.
+    Reference,
 }
 
 /// A solid the cut removes, with its bounds.
@@ -164,6 +182,30 @@ impl Bounded {
                 r,
                 v,
             } => cylinder_sweep_span(o, d, origin, axis, *z0, *z1, *r, v),
+        }
+    }
+
+    /// Whether [`Bounded::span`] certainly starts at or above `m` (or is
+    /// empty); `false` when not certain.
+    #[inline]
+    fn lo_at_least(
+        &self,
+        o: &Vector3<f64>,
+        d: &Vector3<f64>,
+        kuv: (usize, usize, usize),
+        m: f64,
+    ) -> bool {
+        match &self.solid {
+            Solid::Piece {
+                piece,
+                origin,
+                axis,
+            } => {
+                let (k, u, v) = kuv;
+                piece_lo_at_least(piece, &Local::along(k, u, v, o[u], o[v], origin, axis), m)
+            }
+            Solid::Capsule { c0, v, r } => capsule_lo_at_least(o, d, c0, v, *r, m),
+            Solid::CylinderSweep { .. } => false,
         }
     }
 }
@@ -250,6 +292,7 @@ impl Stock {
             families: [family(0), family(1), family(2)],
             initial_volume: 0.0,
             last: None,
+            removal: Removal::Fast,
         })
     }
 
@@ -297,6 +340,16 @@ impl Stock {
             self.origin,
             std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution),
         )
+    }
+
+    /// How cuts visit the rays ([`Removal::Fast`] unless set).
+    pub fn removal(&self) -> Removal {
+        self.removal
+    }
+
+    /// Chooses how cuts visit the rays; both give the same stock.
+    pub fn set_removal(&mut self, removal: Removal) {
+        self.removal = removal;
     }
 
     /// The ray spacing, mm.
@@ -555,9 +608,19 @@ impl Stock {
     }
 
     /// Subtracts the union of the solids from every ray that crosses their
-    /// bounds. Rows of rays run in parallel; every ray is handled alone, so
-    /// the result does not depend on the thread count.
+    /// bounds, by the chosen [`Removal`].
     fn remove(&mut self, solids: &[Bounded], id: u32) {
+        match self.removal {
+            Removal::Fast => self.remove_fast(solids, id),
+            Removal::Reference => self.remove_reference(solids, id),
+        }
+    }
+
+    /// The straightforward removal: every solid's span on every ray within
+    /// the solid's bounds, united and subtracted. Rows of rays run in
+    /// parallel; every ray is handled alone, so the result does not depend
+    /// on the thread count.
+    fn remove_reference(&mut self, solids: &[Bounded], id: u32) {
         if solids.is_empty() {
             return;
         }
@@ -625,6 +688,124 @@ impl Stock {
                 });
         }
     }
+
+    /// The fast removal: the same stock as [`Stock::remove_reference`], bit
+    /// for bit, computing fewer spans. On each ray the solids are visited
+    /// last first (the most advanced sample of a move is the deepest on most
+    /// rays it meets) and a solid is skipped when its span certainly starts
+    /// at or above m: the top of the ray's material, lowered to the start of
+    /// every span found that reaches the top. Such a span adds nothing to
+    /// the union of the spans within the material, and the subtraction
+    /// depends on nothing else: a union's pieces that miss the material
+    /// (first, last) are no-ops in [`subtract`], and a piece that reaches
+    /// beyond an end of the material acts as if it ended there.
+    fn remove_fast(&mut self, solids: &[Bounded], id: u32) {
+        let Some((lo, hi)) = solids_bounds(solids) else {
+            return;
+        };
+        let (origin, h, counts) = (self.origin, self.resolution, self.counts);
+        for f in &mut self.families {
+            let (k, u, v, nu) = (f.axis, f.u, f.v, f.nu);
+            let (Some((u0, u1)), Some((v0, v1))) = (
+                index_range(origin[u], h, counts[u], lo[u], hi[u]),
+                index_range(origin[v], h, counts[v], lo[v], hi[v]),
+            ) else {
+                continue;
+            };
+            if hi[k] < origin[k] || lo[k] > origin[k] + counts[k] as f64 * h {
+                continue;
+            }
+            let mut d = Vector3::zeros();
+            d[k] = 1.0;
+            let kuv = (k, u, v);
+            f.rays[v0 * nu..(v1 + 1) * nu]
+                .par_chunks_mut(nu)
+                .enumerate()
+                .for_each_init(
+                    || (Vec::new(), Vec::with_capacity(8)),
+                    |(active, spans): &mut (Vec<(usize, usize, usize)>, Vec<Span>), (jv, row)| {
+                        let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
+                        let pu_at = |iu: usize| origin[u] + (iu as f64 + 0.5) * h;
+                        // The solids that meet this row, last first, with
+                        // the rays within their bounds (the reference's test
+                        // lo ≤ pu ≤ hi, pu growing with the index).
+                        active.clear();
+                        let (mut a_min, mut b_max) = (usize::MAX, 0);
+                        for (si, s) in solids.iter().enumerate().rev() {
+                            if pv < s.lo[v] || pv > s.hi[v] {
+                                continue;
+                            }
+                            let a = (u0..=u1).find(|&iu| pu_at(iu) >= s.lo[u]);
+                            let b = (u0..=u1).rev().find(|&iu| pu_at(iu) <= s.hi[u]);
+                            if let (Some(a), Some(b)) = (a, b)
+                                && a <= b
+                            {
+                                active.push((si, a, b));
+                                a_min = a_min.min(a);
+                                b_max = b_max.max(b);
+                            }
+                        }
+                        if active.is_empty() {
+                            return;
+                        }
+                        let mut o = Vector3::zeros();
+                        o[v] = pv;
+                        for iu in a_min..=b_max {
+                            let ray = &mut row[iu];
+                            if ray.is_empty() {
+                                continue;
+                            }
+                            o[u] = pu_at(iu);
+                            let (first, last) = (ray[0].lo, ray[ray.len() - 1].hi);
+                            let mut m = last;
+                            spans.clear();
+                            for &(si, a, b) in active.iter() {
+                                let s = &solids[si];
+                                if iu < a
+                                    || iu > b
+                                    || s.hi[k] <= first
+                                    || s.lo[k] >= last
+                                    || s.lo_at_least(&o, &d, kuv, m)
+                                {
+                                    continue;
+                                }
+                                if let Some(sp) = s.span(&o, &d, kuv) {
+                                    if sp.hi >= last && sp.lo < m {
+                                        m = sp.lo;
+                                    }
+                                    spans.push(sp);
+                                }
+                            }
+                            remove_spans(ray, spans, id);
+                        }
+                    },
+                );
+        }
+    }
+}
+
+/// The union of the solids' bounds.
+fn solids_bounds(solids: &[Bounded]) -> Option<([f64; 3], [f64; 3])> {
+    if solids.is_empty() {
+        return None;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for s in solids {
+        for i in 0..3 {
+            lo[i] = lo[i].min(s.lo[i]);
+            hi[i] = hi[i].max(s.hi[i]);
+        }
+    }
+    Some((lo, hi))
+}
+
+/// Index range of the rays of a lattice axis (origin `o`, spacing `h`,
+/// `n` rays) whose coordinate is in [lo, hi].
+fn index_range(o: f64, h: f64, n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
+    let a = ((lo - o) / h - 0.5).ceil().max(0.0);
+    let b = ((hi - o) / h - 0.5).floor().min(n as f64 - 1.0);
+    (a <= b).then_some((a as usize, b as usize))
 }
 
 /// Subtracts the union of the spans from the ray.
