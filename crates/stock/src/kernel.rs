@@ -477,22 +477,20 @@ fn upper(x: f64, scale: f64) -> f64 {
 /// stand for it.
 #[inline(always)]
 fn at_least_times_sqrt(y: f64, m: f64, d: f64) -> bool {
-    let m2 = m * m;
-    let rhs = m2 * d;
-    // m2 and rhs: two roundings, |rhs| within (1 + u)² of m²·d.
-    let (rhs_lo, rhs_hi) = (lower(rhs, rhs), upper(rhs, rhs));
+    let rhs = (m * m) * d;
+    // Two roundings: within (1 + u)² of m²·d.
+    let (rhs_lo, rhs_hi) = (lower(rhs, rhs.abs()), upper(rhs, rhs.abs()));
     let y2 = y * y;
     let (y2_lo, y2_hi) = (lower(y2, y2), upper(y2, y2));
-    if y >= 0.0 {
-        m <= 0.0 || y2_lo >= rhs_hi
-    } else {
-        m < 0.0 && y2_hi <= rhs_lo
-    }
+    let pos = (y >= 0.0) & ((m <= 0.0) | (y2_lo >= rhs_hi));
+    let neg = (y < 0.0) & (m < 0.0) & (y2_hi <= rhs_lo);
+    pos | neg
 }
 
 /// Whether the lower end of the span [`quadratic_le0`]`(a, b, c)` computes
 /// is certainly ≥ `m`, or that span certainly empty. `false`: not certain
-/// (then the span must be computed).
+/// (then the span must be computed). Written without branches, to be
+/// vectorized.
 ///
 /// With d the computed discriminant b² − a·c (the same float as
 /// `quadratic_le0`'s), s = fl(√d) and |q| = fl(|b| + s) lie within (1 ± u)
@@ -509,88 +507,44 @@ fn at_least_times_sqrt(y: f64, m: f64, d: f64) -> bool {
 /// [`upper`]).
 #[inline(always)]
 pub(crate) fn quadratic_lo_at_least(a: f64, b: f64, c: f64, m: f64) -> bool {
-    // The same branch as `quadratic_le0`, from the same floats.
-    if a <= 1e-15 * (b.abs() + c.abs()).max(1e-300) || a == 0.0 {
-        return false;
-    }
+    // The same branch as `quadratic_le0`, from the same floats: the linear
+    // case is not decided here.
+    let lin = (a <= 1e-15 * (b.abs() + c.abs()).max(1e-300)) | (a == 0.0);
     let d = b * b - a * c;
-    if d < 0.0 {
-        // `quadratic_le0` returns None: nothing to cut.
-        return true;
-    }
-    if b == 0.0 || !m.is_finite() {
-        return false;
-    }
-    // m' ≥ m + 32u·|m| (rounded up twice more: m is the larger term).
+    // `quadratic_le0` returns None: nothing to cut.
+    let none = d < 0.0;
+    // m' ≥ m + 32u·|m|.
     let m1 = upper(m + SLACK * m.abs(), m.abs());
     let bb = b.abs();
     let am = a * m1;
-    if b < 0.0 {
-        // Q/a ≥ m' ⇐ |b| ≥ a·m'.
-        if !(bb >= upper(am, am.abs())) {
-            return false;
-        }
-        // c − m'|b| ≥ m'·√d.
-        let mb = m1 * bb;
-        let y = c - mb;
-        let scale = c.abs() + 2.0 * mb.abs();
-        at_least_times_sqrt(lower(y, scale), m1, d)
-    } else {
-        // −a·m' − |b| ≥ √d (m = 1 in `at_least_times_sqrt`).
-        let z = -am - bb;
-        let zs = 2.0 * (am.abs() + bb);
-        if !(lower(z, zs) >= 0.0 && at_least_times_sqrt(lower(z, zs), 1.0, d)) {
-            return false;
-        }
-        // −c − m'|b| ≥ m'·√d.
-        let mb = m1 * bb;
-        let y = -c - mb;
-        let scale = c.abs() + 2.0 * mb.abs();
-        at_least_times_sqrt(lower(y, scale), m1, d)
-    }
+    let mb = m1 * bb;
+    let scale = c.abs() + 2.0 * mb.abs();
+    // b < 0: |b| ≥ a·m' and c − m'|b| ≥ m'·√d.
+    let neg = (b < 0.0)
+        & (bb >= upper(am, am.abs()))
+        & at_least_times_sqrt(lower(c - mb, scale), m1, d);
+    // b > 0: −a·m' − |b| ≥ √d and −c − m'|b| ≥ m'·√d.
+    let z = lower(-am - bb, 2.0 * (am.abs() + bb));
+    let pos = (b > 0.0)
+        & (z >= 0.0)
+        & at_least_times_sqrt(z, 1.0, d)
+        & at_least_times_sqrt(lower(-c - mb, scale), m1, d);
+    !lin & (none | ((m.abs() < f64::INFINITY) & (neg | pos)))
 }
 
-/// Whether the span [`piece_span`] computes for the line `l` in a cylinder
-/// or sphere piece certainly starts at or above `m` (or is empty); `false`
-/// for the other pieces (not certain).
+/// Whether `kernel::slab(z0, dz, zlo, zhi)` certainly starts at or above
+/// `m`, or is certainly empty. For dz = 0 the slab is everything or nothing,
+/// decided by the same comparisons; otherwise its lower end is the rounded
+/// quotient a₀/dz (a₀ = zlo − z0, dz > 0) or −(z0 − zhi)/dz (dz < 0), at
+/// least m when the exact quotient is (m is a float): a₀ ≥ m·dz, or
+/// z0 − zhi ≥ −m·dz, products bounded with [`upper`].
 #[inline(always)]
-pub(crate) fn piece_lo_at_least(piece: &Piece, l: &Local, m: f64) -> bool {
-    match *piece {
-        // The span is the radial span met with the slab: it starts no lower
-        // than the radial span.
-        Piece::Cylinder { r, .. } => quadratic_lo_at_least(l.a, l.b, l.c - r * r, m),
-        Piece::Sphere { zc, r } => {
-            let zr = l.z0 - zc;
-            quadratic_lo_at_least(l.a + l.dz * l.dz, l.b + zr * l.dz, l.c + zr * zr - r * r, m)
-        }
-        Piece::Cone { .. } | Piece::RoundedDisc { .. } => false,
-    }
-}
-
-/// Whether [`capsule_span`] certainly starts at or above `m` (or is empty):
-/// the hull of two spheres and a cylinder starts at the lowest of them.
-#[inline(always)]
-pub(crate) fn capsule_lo_at_least(
-    o: &Vector3<f64>,
-    d: &Vector3<f64>,
-    c0: &Vector3<f64>,
-    v: &Vector3<f64>,
-    r: f64,
-    m: f64,
-) -> bool {
-    // The same coefficients as `capsule_span`.
-    let sphere = |c: &Vector3<f64>| {
-        let oc = o - c;
-        quadratic_lo_at_least(1.0, oc.dot(d), oc.norm_squared() - r * r, m)
-    };
-    if !(sphere(c0) && sphere(&(c0 + v))) {
-        return false;
-    }
-    let len = v.norm();
-    if len > 0.0 {
-        let w = v / len;
-        let l = Local::new(o, d, c0, &w);
-        return quadratic_lo_at_least(l.a, l.b, l.c - r * r, m);
-    }
-    true
+pub(crate) fn slab_lo_at_least(z0: f64, dz: f64, zlo: f64, zhi: f64, m: f64) -> bool {
+    let a0 = zlo - z0;
+    let a1 = z0 - zhi;
+    let empty_flat = (dz == 0.0) & !((a0 <= 0.0) & (a1 <= 0.0));
+    let md = m * dz;
+    let up = (dz > 0.0) & (a0 >= upper(md, md.abs()));
+    let down = (dz < 0.0) & (a1 >= upper(-md, md.abs()));
+    empty_flat | ((m.abs() < f64::INFINITY) & (up | down))
 }

@@ -85,6 +85,7 @@ pub mod mesh;
 pub mod output;
 pub mod process;
 pub mod report;
+mod row;
 pub mod stock;
 pub mod tolerance;
 pub mod tool;

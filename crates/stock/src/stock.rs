@@ -4,11 +4,9 @@ use nalgebra::{Point3, Unit, Vector3};
 use rayon::prelude::*;
 
 use crate::clip::{Aabb, piece_in_box, swept_in_box};
-use crate::dexel::{Ray, Segment, UNCUT, subtract};
-use crate::kernel::{
-    Local, Span, capsule_lo_at_least, capsule_span, cylinder_sweep_span, piece_lo_at_least,
-    piece_span,
-};
+use crate::dexel::{Ray, Segment, UNCUT, remove_spans};
+use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
+use crate::row::{Active, Capsule, RowFrame, RowSolid, RowSolids, Scratch, cut_row};
 use crate::tolerance::{
     DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION,
 };
@@ -185,27 +183,32 @@ impl Bounded {
         }
     }
 
-    /// Whether [`Bounded::span`] certainly starts at or above `m` (or is
-    /// empty); `false` when not certain.
-    #[inline]
-    fn lo_at_least(
-        &self,
-        o: &Vector3<f64>,
-        d: &Vector3<f64>,
-        kuv: (usize, usize, usize),
-        m: f64,
-    ) -> bool {
-        match &self.solid {
+    /// The solid's batch kernel for rays along `d` (a unit axis).
+    fn row_solid(&self, d: &Vector3<f64>) -> RowSolid {
+        match self.solid {
             Solid::Piece {
-                piece,
+                piece: Piece::Cylinder { z0, z1, r },
                 origin,
                 axis,
-            } => {
-                let (k, u, v) = kuv;
-                piece_lo_at_least(piece, &Local::along(k, u, v, o[u], o[v], origin, axis), m)
-            }
-            Solid::Capsule { c0, v, r } => capsule_lo_at_least(o, d, c0, v, *r, m),
-            Solid::CylinderSweep { .. } => false,
+            } => RowSolid::Cylinder {
+                origin: origin.into(),
+                axis: axis.into(),
+                z0,
+                z1,
+                r,
+            },
+            Solid::Piece {
+                piece: Piece::Sphere { zc, r },
+                origin,
+                axis,
+            } => RowSolid::Sphere {
+                origin: origin.into(),
+                axis: axis.into(),
+                zc,
+                r,
+            },
+            Solid::Capsule { c0, v, r } => RowSolid::Capsule(Capsule::new(&c0, &v, r, d)),
+            _ => RowSolid::Other,
         }
     }
 }
@@ -718,66 +721,48 @@ impl Stock {
             let mut d = Vector3::zeros();
             d[k] = 1.0;
             let kuv = (k, u, v);
+            let prepared: Vec<RowSolid> = solids.iter().map(|s| s.row_solid(&d)).collect();
+            let along: Vec<(f64, f64)> = solids.iter().map(|s| (s.lo[k], s.hi[k])).collect();
+            let other = |i: usize, pu: f64, pv: f64| {
+                let mut o = Vector3::zeros();
+                o[u] = pu;
+                o[v] = pv;
+                solids[i].span(&o, &d, kuv)
+            };
+            let row_solids = RowSolids {
+                prepared: &prepared,
+                along: &along,
+                other: &other,
+            };
             f.rays[v0 * nu..(v1 + 1) * nu]
                 .par_chunks_mut(nu)
+                .with_min_len(8)
                 .enumerate()
                 .for_each_init(
-                    || (Vec::new(), Vec::with_capacity(8)),
-                    |(active, spans): &mut (Vec<(usize, usize, usize)>, Vec<Span>), (jv, row)| {
-                        let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
+                    || (Vec::new(), Scratch::default()),
+                    |(active, scratch): &mut (Vec<Active>, Scratch), (jv, row)| {
+                        let frame = RowFrame {
+                            k,
+                            u,
+                            v,
+                            origin_u: origin[u],
+                            h,
+                            pv: origin[v] + ((v0 + jv) as f64 + 0.5) * h,
+                        };
                         let pu_at = |iu: usize| origin[u] + (iu as f64 + 0.5) * h;
                         // The solids that meet this row, last first, with
                         // the rays within their bounds (the reference's test
-                        // lo ≤ pu ≤ hi, pu growing with the index).
+                        // lo ≤ pu ≤ hi; pu grows with the index).
                         active.clear();
-                        let (mut a_min, mut b_max) = (usize::MAX, 0);
                         for (si, s) in solids.iter().enumerate().rev() {
-                            if pv < s.lo[v] || pv > s.hi[v] {
+                            if frame.pv < s.lo[v] || frame.pv > s.hi[v] {
                                 continue;
                             }
-                            let a = (u0..=u1).find(|&iu| pu_at(iu) >= s.lo[u]);
-                            let b = (u0..=u1).rev().find(|&iu| pu_at(iu) <= s.hi[u]);
-                            if let (Some(a), Some(b)) = (a, b)
-                                && a <= b
-                            {
-                                active.push((si, a, b));
-                                a_min = a_min.min(a);
-                                b_max = b_max.max(b);
+                            if let Some((a, b)) = rays_within(&pu_at, u0, u1, s.lo[u], s.hi[u]) {
+                                active.push(Active { solid: si, a, b });
                             }
                         }
-                        if active.is_empty() {
-                            return;
-                        }
-                        let mut o = Vector3::zeros();
-                        o[v] = pv;
-                        for iu in a_min..=b_max {
-                            let ray = &mut row[iu];
-                            if ray.is_empty() {
-                                continue;
-                            }
-                            o[u] = pu_at(iu);
-                            let (first, last) = (ray[0].lo, ray[ray.len() - 1].hi);
-                            let mut m = last;
-                            spans.clear();
-                            for &(si, a, b) in active.iter() {
-                                let s = &solids[si];
-                                if iu < a
-                                    || iu > b
-                                    || s.hi[k] <= first
-                                    || s.lo[k] >= last
-                                    || s.lo_at_least(&o, &d, kuv, m)
-                                {
-                                    continue;
-                                }
-                                if let Some(sp) = s.span(&o, &d, kuv) {
-                                    if sp.hi >= last && sp.lo < m {
-                                        m = sp.lo;
-                                    }
-                                    spans.push(sp);
-                                }
-                            }
-                            remove_spans(ray, spans, id);
-                        }
+                        cut_row(&frame, row, active, &row_solids, id, scratch);
                     },
                 );
         }
@@ -800,6 +785,37 @@ fn solids_bounds(solids: &[Bounded]) -> Option<([f64; 3], [f64; 3])> {
     Some((lo, hi))
 }
 
+/// The first and last index in [a, b] whose coordinate `at(i)` (growing
+/// with i) is within [lo, hi]: a guess from the spacing, then corrected by
+/// the comparisons themselves.
+fn rays_within(
+    at: &impl Fn(usize) -> f64,
+    a: usize,
+    b: usize,
+    lo: f64,
+    hi: f64,
+) -> Option<(usize, usize)> {
+    // Binary searches for the first index with at(i) ≥ lo and the last with
+    // at(i) ≤ hi.
+    let first = {
+        let (mut l, mut r) = (a, b + 1);
+        while l < r {
+            let mid = l + (r - l) / 2;
+            if at(mid) >= lo { r = mid } else { l = mid + 1 }
+        }
+        l
+    };
+    let last = {
+        let (mut l, mut r) = (a, b + 1);
+        while l < r {
+            let mid = l + (r - l) / 2;
+            if at(mid) <= hi { l = mid + 1 } else { r = mid }
+        }
+        l.checked_sub(1)?
+    };
+    (first <= b && last >= first && last >= a).then_some((first, last))
+}
+
 /// Index range of the rays of a lattice axis (origin `o`, spacing `h`,
 /// `n` rays) whose coordinate is in [lo, hi].
 fn index_range(o: f64, h: f64, n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
@@ -808,26 +824,6 @@ fn index_range(o: f64, h: f64, n: usize, lo: f64, hi: f64) -> Option<(usize, usi
     (a <= b).then_some((a as usize, b as usize))
 }
 
-/// Subtracts the union of the spans from the ray.
-fn remove_spans(ray: &mut Ray, spans: &mut [Span], id: u32) {
-    match spans.len() {
-        0 => {}
-        1 => subtract(ray, spans[0].lo, spans[0].hi, id),
-        _ => {
-            spans.sort_by(|a, b| a.lo.total_cmp(&b.lo));
-            let mut cur = spans[0];
-            for s in &spans[1..] {
-                if s.lo <= cur.hi {
-                    cur.hi = cur.hi.max(s.hi);
-                } else {
-                    subtract(ray, cur.lo, cur.hi, id);
-                    cur = *s;
-                }
-            }
-            subtract(ray, cur.lo, cur.hi, id);
-        }
-    }
-}
 
 fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
     let n = (distance / step).ceil().max(1.0);
