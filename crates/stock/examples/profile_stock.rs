@@ -7,7 +7,8 @@
 //! ```
 //!
 //! Arguments: `wheel` or `ball`, the number of moves, the thread count,
-//! and optionally the first move (default 0). Prints the time of the cut
+//! optionally the first move (default 0) and `reference` for the
+//! straightforward removal ([`kinpost_stock::Removal::Reference`]). Prints the time of the cut
 //! alone and a checksum of the stock (the same for any thread count).
 
 use std::time::Instant;
@@ -26,6 +27,9 @@ fn main() {
         _ => program::wheel_5axis(),
     };
     let mut stock = program::stock(0.05);
+    if args.get(5).is_some_and(|a| a == "reference") {
+        stock.set_removal(kinpost_stock::Removal::Reference);
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

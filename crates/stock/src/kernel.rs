@@ -516,20 +516,20 @@ pub(crate) fn quadratic_lo_at_least(a: f64, b: f64, c: f64, m: f64) -> bool {
     // m' ≥ m + 32u·|m|.
     let m1 = upper(m + SLACK * m.abs(), m.abs());
     let bb = b.abs();
+    let neg = b < 0.0;
     let am = a * m1;
-    let mb = m1 * bb;
-    let scale = c.abs() + 2.0 * mb.abs();
-    // b < 0: |b| ≥ a·m' and c − m'|b| ≥ m'·√d.
-    let neg = (b < 0.0)
-        & (bb >= upper(am, am.abs()))
-        & at_least_times_sqrt(lower(c - mb, scale), m1, d);
-    // b > 0: −a·m' − |b| ≥ √d and −c − m'|b| ≥ m'·√d.
+    // X₁: b < 0: |b| ≥ a·m'; b > 0: −a·m' − |b| ≥ √d.
     let z = lower(-am - bb, 2.0 * (am.abs() + bb));
-    let pos = (b > 0.0)
-        & (z >= 0.0)
-        & at_least_times_sqrt(z, 1.0, d)
-        & at_least_times_sqrt(lower(-c - mb, scale), m1, d);
-    !lin & (none | ((m.abs() < f64::INFINITY) & (neg | pos)))
+    let first = if neg {
+        bb >= upper(am, am.abs())
+    } else {
+        (b > 0.0) & at_least_times_sqrt(z, 1.0, d)
+    };
+    // X₂: σ·c − m'|b| ≥ m'·√d.
+    let mb = m1 * bb;
+    let y = lower(if neg { c } else { -c } - mb, c.abs() + 2.0 * mb.abs());
+    let second = at_least_times_sqrt(y, m1, d);
+    !lin & (none | ((m.abs() < f64::INFINITY) & first & second))
 }
 
 /// Whether `kernel::slab(z0, dz, zlo, zhi)` certainly starts at or above

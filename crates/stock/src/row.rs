@@ -236,103 +236,14 @@ fn capsule_line(o: &[f64; 3], k: &Capsule) -> (f64, f64, f64) {
     (z0, dot(&pp, &k.dp), dot(&pp, &pp))
 }
 
-/// The exact span of a cylinder piece on one ray.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn exact_cylinder<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
-    pv: f64,
-    origin: &[f64; 3],
-    axis: &[f64; 3],
-    z0: f64,
-    z1: f64,
-    r: f64,
-) -> Opt {
-    let (lz, b, c) = along::<K, U, V>(pu, pv, origin, axis);
-    let dz = axis[K];
-    cylinder(lz, dz, 1.0 - dz * dz, b, c, z0, z1, r)
-}
-
-/// The quadratic (a, b, c) of a sphere piece on one ray.
-#[inline(always)]
-fn sphere_quadratic<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
-    pv: f64,
-    origin: &[f64; 3],
-    axis: &[f64; 3],
-    zc: f64,
-    r: f64,
-) -> (f64, f64, f64) {
-    let (lz, b, c) = along::<K, U, V>(pu, pv, origin, axis);
-    let dz = axis[K];
-    let zr = lz - zc;
-    (1.0 - dz * dz + dz * dz, b + zr * dz, c + zr * zr - r * r)
-}
-
-/// The exact span of a capsule on one ray.
-#[inline(always)]
-fn exact_capsule<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
-    pv: f64,
-    k: &Capsule,
-) -> Opt {
-    let o = ray_origin::<K, U, V>(pu, pv);
-    let (b0, c0) = capsule_sphere(&o, &k.c0, &k.d, k.r);
-    let (b1, c1) = capsule_sphere(&o, &k.c1, &k.d, k.r);
-    let mut span = hull(quadratic_le0(1.0, b0, c0), quadratic_le0(1.0, b1, c1));
-    if k.len > 0.0 {
-        let (lz, b, c) = capsule_line(&o, k);
-        span = hull(span, cylinder(lz, k.dz, k.a, b, c, 0.0, k.len, k.r));
-    }
-    span
-}
-
-/// Whether a cylinder piece's span on one ray certainly starts at or above
-/// `m`: the span is the slab met with the radial span, so it starts no
-/// lower than either.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn skip_cylinder<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
-    pv: f64,
-    origin: &[f64; 3],
-    axis: &[f64; 3],
-    z0: f64,
-    z1: f64,
-    r: f64,
-    m: f64,
-) -> bool {
-    let (lz, b, c) = along::<K, U, V>(pu, pv, origin, axis);
-    let dz = axis[K];
-    slab_lo_at_least(lz, dz, z0, z1, m) | quadratic_lo_at_least(1.0 - dz * dz, b, c - r * r, m)
-}
-
-/// Whether a capsule's span on one ray certainly starts at or above `m`:
-/// the hull starts at the lowest of its parts.
-#[inline(always)]
-fn skip_capsule<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
-    pv: f64,
-    k: &Capsule,
-    m: f64,
-) -> bool {
-    let o = ray_origin::<K, U, V>(pu, pv);
-    let (b0, c0) = capsule_sphere(&o, &k.c0, &k.d, k.r);
-    let (b1, c1) = capsule_sphere(&o, &k.c1, &k.d, k.r);
-    let spheres = quadratic_lo_at_least(1.0, b0, c0, m) & quadratic_lo_at_least(1.0, b1, c1, m);
-    let (lz, b, c) = capsule_line(&o, k);
-    let line = !(k.len > 0.0)
-        | slab_lo_at_least(lz, k.dz, 0.0, k.len, m)
-        | quadratic_lo_at_least(k.a, b, c - k.r * k.r, m);
-    spheres & line
-}
-
 /// Scratch buffers of a row, kept by each thread from row to row.
 #[derive(Default)]
 pub(crate) struct Scratch {
+    pu: Vec<f64>,
     first: Vec<f64>,
     last: Vec<f64>,
     m: Vec<f64>,
+    q: Coefficients,
     flags: Vec<bool>,
     need: Vec<u32>,
     out: Vec<Opt>,
@@ -415,6 +326,179 @@ fn cut_row_any(
     }
 }
 
+/// The coefficients of one solid on the rays of its range.
+#[inline(always)]
+fn coefficients<const K: usize, const U: usize, const V: usize>(
+    s: &RowSolid,
+    pu: &[f64],
+    pv: f64,
+    q: &mut Coefficients,
+) {
+    let n = pu.len();
+    q.resize(n);
+    match *s {
+        RowSolid::Cylinder {
+            origin, axis, r, ..
+        } => {
+            for j in 0..n {
+                let (lz, b, c) = along::<K, U, V>(pu[j], pv, &origin, &axis);
+                (q.z[j], q.b[j], q.c[j]) = (lz, b, c - r * r);
+            }
+        }
+        RowSolid::Sphere {
+            origin,
+            axis,
+            zc,
+            r,
+        } => {
+            let dz = axis[K];
+            for j in 0..n {
+                let (lz, b, c) = along::<K, U, V>(pu[j], pv, &origin, &axis);
+                let zr = lz - zc;
+                (q.b[j], q.c[j]) = (b + zr * dz, c + zr * zr - r * r);
+            }
+        }
+        RowSolid::Capsule(ref k) => {
+            for j in 0..n {
+                let o = ray_origin::<K, U, V>(pu[j], pv);
+                (q.b0[j], q.c0[j]) = capsule_sphere(&o, &k.c0, &k.d, k.r);
+                (q.b1[j], q.c1[j]) = capsule_sphere(&o, &k.c1, &k.d, k.r);
+                let (lz, b, c) = capsule_line(&o, k);
+                (q.z[j], q.b[j], q.c[j]) = (lz, b, c - k.r * k.r);
+            }
+        }
+        RowSolid::Other => {}
+    }
+}
+
+/// Per-ray coefficients of a solid: for a piece, `Local`'s z0 (cylinder),
+/// b and c of its quadratic (c already less r²); for a capsule, the two
+/// spheres' (b, c) and the segment cylinder's (z0, b, c − r²).
+#[derive(Default)]
+struct Coefficients {
+    z: Vec<f64>,
+    b: Vec<f64>,
+    c: Vec<f64>,
+    b0: Vec<f64>,
+    c0: Vec<f64>,
+    b1: Vec<f64>,
+    c1: Vec<f64>,
+}
+
+impl Coefficients {
+    fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.z,
+            &mut self.b,
+            &mut self.c,
+            &mut self.b0,
+            &mut self.c0,
+            &mut self.b1,
+            &mut self.c1,
+        ] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+    }
+}
+
+/// Whether each ray of the range needs the solid's span: within the
+/// solid's extent along the ray (the reference's test) and not certainly
+/// starting at or above the ray's m.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn flag<const K: usize>(
+    s: &RowSolid,
+    q: &Coefficients,
+    (lo_k, hi_k): (f64, f64),
+    first: &[f64],
+    last: &[f64],
+    m: &[f64],
+    flags: &mut [bool],
+) {
+    let n = flags.len();
+    let gate = |j: usize| !(hi_k <= first[j] || lo_k >= last[j]);
+    match *s {
+        RowSolid::Cylinder {
+            axis, z0, z1, ..
+        } => {
+            let dz = axis[K];
+            let a = 1.0 - dz * dz;
+            for j in 0..n {
+                let skip = slab_lo_at_least(q.z[j], dz, z0, z1, m[j])
+                    | quadratic_lo_at_least(a, q.b[j], q.c[j], m[j]);
+                flags[j] = gate(j) & !skip;
+            }
+        }
+        RowSolid::Sphere { axis, .. } => {
+            let dz = axis[K];
+            let a = 1.0 - dz * dz + dz * dz;
+            for j in 0..n {
+                flags[j] = gate(j) & !quadratic_lo_at_least(a, q.b[j], q.c[j], m[j]);
+            }
+        }
+        RowSolid::Capsule(ref k) => {
+            for j in 0..n {
+                // The hull starts at the lowest of its parts.
+                let spheres = quadratic_lo_at_least(1.0, q.b0[j], q.c0[j], m[j])
+                    & quadratic_lo_at_least(1.0, q.b1[j], q.c1[j], m[j]);
+                let line = !(k.len > 0.0)
+                    | slab_lo_at_least(q.z[j], k.dz, 0.0, k.len, m[j])
+                    | quadratic_lo_at_least(k.a, q.b[j], q.c[j], m[j]);
+                flags[j] = gate(j) & !(spheres & line);
+            }
+        }
+        RowSolid::Other => {
+            for j in 0..n {
+                flags[j] = gate(j);
+            }
+        }
+    }
+}
+
+/// The exact spans of the rays `need` (indices into the coefficients).
+#[inline(always)]
+fn exact<const K: usize>(s: &RowSolid, q: &Coefficients, need: &[u32], out: &mut [Opt]) {
+    match *s {
+        RowSolid::Cylinder {
+            axis, z0, z1, ..
+        } => {
+            let dz = axis[K];
+            let a = 1.0 - dz * dz;
+            for (o, &j) in out.iter_mut().zip(need) {
+                let j = j as usize;
+                let axial = slab(q.z[j], dz, z0, z1);
+                let radial = quadratic_le0(a, q.b[j], q.c[j]);
+                *o = meet(axial, radial);
+            }
+        }
+        RowSolid::Sphere { axis, .. } => {
+            let dz = axis[K];
+            let a = 1.0 - dz * dz + dz * dz;
+            for (o, &j) in out.iter_mut().zip(need) {
+                let j = j as usize;
+                *o = quadratic_le0(a, q.b[j], q.c[j]);
+            }
+        }
+        RowSolid::Capsule(ref k) => {
+            for (o, &j) in out.iter_mut().zip(need) {
+                let j = j as usize;
+                let mut span = hull(
+                    quadratic_le0(1.0, q.b0[j], q.c0[j]),
+                    quadratic_le0(1.0, q.b1[j], q.c1[j]),
+                );
+                if k.len > 0.0 {
+                    let axial = slab(q.z[j], k.dz, 0.0, k.len);
+                    let radial = quadratic_le0(k.a, q.b[j], q.c[j]);
+                    span = hull(span, meet(axial, radial));
+                }
+                *o = span;
+            }
+        }
+        RowSolid::Other => {}
+    }
+}
+
 #[inline(always)]
 fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     frame: &RowFrame,
@@ -428,11 +512,11 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
         return;
     };
     let b_max = active.iter().map(|s| s.b).max().unwrap_or(a_min);
-    let n = b_max + 1 - a_min;
     let sc = scratch;
     sc.first.clear();
     sc.last.clear();
-    for ray in &row[a_min..=b_max] {
+    sc.pu.clear();
+    for (iu, ray) in row[a_min..=b_max].iter().enumerate() {
         // An empty ray: no solid passes the test against its ends.
         let (f, l) = match (ray.first(), ray.last()) {
             (Some(f), Some(l)) => (f.lo, l.hi),
@@ -440,64 +524,37 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
         };
         sc.first.push(f);
         sc.last.push(l);
+        sc.pu
+            .push(frame.origin_u + ((a_min + iu) as f64 + 0.5) * frame.h);
     }
     sc.m.clear();
     sc.m.extend_from_slice(&sc.last);
-    sc.flags.clear();
-    sc.flags.resize(n, false);
     sc.found.clear();
-    let (pv, ou, h) = (frame.pv, frame.origin_u, frame.h);
-    let pu_at = |j: usize| ou + ((a_min + j) as f64 + 0.5) * h;
+    let pv = frame.pv;
     for act in active {
         let (j0, j1) = (act.a - a_min, act.b - a_min);
-        let (lo_k, hi_k) = solids.along[act.solid];
         let s = &solids.prepared[act.solid];
-        // Which rays need the span: within the solid's extent along the
-        // ray (the reference's test) and not certainly above m.
-        let first = &sc.first[j0..=j1];
-        let last = &sc.last[j0..=j1];
-        let m = &sc.m[j0..=j1];
-        let flags = &mut sc.flags[j0..=j1];
-        macro_rules! flag {
-            (|$pu:ident, $m:ident| $skip:expr) => {
-                for j in 0..flags.len() {
-                    let $pu = pu_at(j0 + j);
-                    let $m = m[j];
-                    let gate = !(hi_k <= first[j] || lo_k >= last[j]);
-                    flags[j] = gate & !$skip;
-                }
-            };
-        }
-        match *s {
-            RowSolid::Cylinder {
-                origin,
-                axis,
-                z0,
-                z1,
-                r,
-            } => flag!(|pu, mj| skip_cylinder::<K, U, V>(pu, pv, &origin, &axis, z0, z1, r, mj)),
-            RowSolid::Sphere {
-                origin,
-                axis,
-                zc,
-                r,
-            } => flag!(|pu, mj| {
-                let (qa, qb, qc) = sphere_quadratic::<K, U, V>(pu, pv, &origin, &axis, zc, r);
-                quadratic_lo_at_least(qa, qb, qc, mj)
-            }),
-            RowSolid::Capsule(ref k) => flag!(|pu, mj| skip_capsule::<K, U, V>(pu, pv, k, mj)),
-            RowSolid::Other => flag!(|_pu, _mj| false),
-        }
+        coefficients::<K, U, V>(s, &sc.pu[j0..=j1], pv, &mut sc.q);
+        sc.flags.clear();
+        sc.flags.resize(j1 + 1 - j0, false);
+        flag::<K>(
+            s,
+            &sc.q,
+            solids.along[act.solid],
+            &sc.first[j0..=j1],
+            &sc.last[j0..=j1],
+            &sc.m[j0..=j1],
+            &mut sc.flags,
+        );
         sc.need.clear();
-        for (j, &f) in flags.iter().enumerate() {
+        for (j, &f) in sc.flags.iter().enumerate() {
             if f {
-                sc.need.push((j0 + j) as u32);
+                sc.need.push(j as u32);
             }
         }
         if sc.need.is_empty() {
             continue;
         }
-        // Their exact spans.
         sc.out.clear();
         sc.out.resize(
             sc.need.len(),
@@ -507,57 +564,23 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                 some: false,
             },
         );
-        let need = &sc.need;
-        let out = &mut sc.out;
-        macro_rules! exact {
-            (|$pu:ident| $span:expr) => {
-                for i in 0..need.len() {
-                    let $pu = pu_at(need[i] as usize);
-                    out[i] = $span;
-                }
-            };
-        }
-        match *s {
-            RowSolid::Cylinder {
-                origin,
-                axis,
-                z0,
-                z1,
-                r,
-            } => exact!(|pu| exact_cylinder::<K, U, V>(pu, pv, &origin, &axis, z0, z1, r)),
-            RowSolid::Sphere {
-                origin,
-                axis,
-                zc,
-                r,
-            } => exact!(|pu| {
-                let (qa, qb, qc) = sphere_quadratic::<K, U, V>(pu, pv, &origin, &axis, zc, r);
-                quadratic_le0(qa, qb, qc)
-            }),
-            RowSolid::Capsule(ref k) => exact!(|pu| exact_capsule::<K, U, V>(pu, pv, k)),
-            RowSolid::Other => {
-                for i in 0..need.len() {
-                    let sp = (solids.other)(act.solid, pu_at(need[i] as usize), pv);
-                    out[i] = match sp {
-                        Some(sp) => Opt {
-                            lo: sp.lo,
-                            hi: sp.hi,
-                            some: true,
-                        },
-                        None => Opt {
-                            lo: 0.0,
-                            hi: 0.0,
-                            some: false,
-                        },
+        if let RowSolid::Other = s {
+            for (o, &j) in sc.out.iter_mut().zip(&sc.need) {
+                if let Some(sp) = (solids.other)(act.solid, sc.pu[j0 + j as usize], pv) {
+                    *o = Opt {
+                        lo: sp.lo,
+                        hi: sp.hi,
+                        some: true,
                     };
                 }
             }
+        } else {
+            exact::<K>(s, &sc.q, &sc.need, &mut sc.out);
         }
         // Keep them; a span that reaches the ray's top lowers its m.
-        for (i, &j) in need.iter().enumerate() {
-            let o = out[i];
+        for (o, &j) in sc.out.iter().zip(&sc.need) {
             if o.some {
-                let j = j as usize;
+                let j = j0 + j as usize;
                 sc.found.push((j as u32, Span { lo: o.lo, hi: o.hi }));
                 if o.hi >= sc.last[j] && o.lo < sc.m[j] {
                     sc.m[j] = o.lo;
