@@ -81,6 +81,7 @@ pub mod contour;
 pub mod design;
 pub mod dexel;
 pub mod kernel;
+mod lanes;
 pub mod mesh;
 pub mod output;
 pub mod process;

@@ -1,27 +1,39 @@
 //! The fast removal along one row of rays.
 //!
 //! [`crate::stock`]'s fast removal hands each row of rays (one family, one
-//! `v` index) to [`cut_row`]. The solids are visited one after the other,
-//! last first; for each, every ray within its bounds gets a *skip test*
-//! (does the span this solid would compute there certainly start at or above
-//! the ray's level m?) and the rays that fail it get their exact span, which
-//! lowers m where it reaches the ray's top. Both passes are plain loops over
-//! the rays of the solid's range, written without branches so that the
-//! compiler vectorizes them; [`cut_row`] runs them compiled for AVX2 when the
-//! processor has it (the same operations in the same order: the same bits on
-//! every processor, see [`exact`]).
+//! index across the row) to [`cut_row`]. Each ray keeps a level m, at first
+//! the top of its material (`last`). The solids are visited one after the
+//! other (last sample first: on most rays it meets, the most advanced
+//! sample of a move is the deepest); for each, the rays within its bounds
+//! are taken four at a time ([`crate::lanes`]): a *skip test* asks whether
+//! the span the solid would compute there certainly starts at or above m,
+//! without a root or a quotient ([`quadratic_lo_at_least`]), and the rays
+//! that fail it get their exact span, with the operations, in the order, of
+//! [`crate::kernel`]'s scalar functions. A span that reaches the ray's top
+//! lowers m to its start. At the end, a ray whose spans all reached the top
+//! loses (m, top); a ray with a span that ends inside its material (rare for
+//! the family along the tool: a wheel's hole through a side ray) is cut by
+//! the reference procedure, every span computed.
 //!
-//! Why skipping such a span changes nothing, bit for bit: the subtraction of
-//! a union of spans from a ray depends only on the union within the ray's
-//! material (first, last) (pieces that miss it are no-ops in
-//! [`crate::dexel::subtract`], a piece that reaches past an end acts as if it
-//! ended there), and a span that starts at or above m adds nothing there: m
-//! is the ray's top, or the start of a span found that reaches the top.
+//! Why this is the reference's stock, bit for bit: the subtraction of a
+//! union of spans from a ray ([`remove_spans`]) depends only on the union
+//! within the ray's material (first, last): pieces that miss it are no-ops
+//! in [`subtract`], and a piece that reaches past an end acts as if it ended
+//! there (no piece is kept beyond it). A span that starts at or above m adds
+//! nothing within the material: m is the top, or the start of a span that
+//! reaches the top. If all spans that meet the material reach its top, their
+//! union within it is [m, top), so `subtract(m, +∞)` is the reference's cut.
+//!
+//! [`cut_row`] runs compiled for AVX2 when the processor has it, else for
+//! the x86-64 baseline (or any other target): the same operations on the
+//! same lanes, so the same bits on every processor and for any thread count
+//! (each ray is cut alone).
 
 use nalgebra::Vector3;
 
-use crate::dexel::{Ray, remove_spans};
-use crate::kernel::{Span, quadratic_lo_at_least, slab_lo_at_least};
+use crate::dexel::{Ray, remove_spans, subtract};
+use crate::kernel::Span;
+use crate::lanes::{F, M, W};
 
 /// A solid prepared for the rays along axis `K` of one family: the
 /// constants of its span, taken from the same expressions as
@@ -93,38 +105,38 @@ impl Capsule {
 /// What a row needs beyond its solids: where its rays are.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct RowFrame {
-    /// Ray axis and the two others (u the row's index).
+    /// The rays' axis (the row runs along the first other axis).
     pub k: usize,
-    pub u: usize,
-    pub v: usize,
-    /// Lattice origin along u, spacing, and the row's v coordinate.
+    /// Lattice origin along the row, spacing, and the row's coordinate on
+    /// the second other axis.
     pub origin_u: f64,
     pub h: f64,
     pub pv: f64,
 }
 
-#[inline(always)]
-fn sel(c: bool, a: f64, b: f64) -> f64 {
-    if c { a } else { b }
-}
 
-/// A span as three values: ends and whether it exists.
+/// A span on four rays: its ends and whether it exists.
 #[derive(Clone, Copy)]
 struct Opt {
-    lo: f64,
-    hi: f64,
-    some: bool,
+    lo: F,
+    hi: F,
+    some: M,
 }
 
-/// `kernel::linear_le0`, without branches.
 #[inline(always)]
-fn linear_le0(a0: f64, a1: f64) -> Opt {
-    let q = -a0 / a1;
-    let (pos, neg) = (a1 > 0.0, a1 < 0.0);
+fn s(x: f64) -> F {
+    F::splat(x)
+}
+
+/// `kernel::linear_le0`: t with a0 + a1·t ≤ 0.
+#[inline(always)]
+fn linear_le0(a0: F, a1: F) -> Opt {
+    let q = (-a0) / a1;
+    let (pos, neg) = (a1.gt(s(0.0)), a1.lt(s(0.0)));
     Opt {
-        lo: sel(neg, q, f64::NEG_INFINITY),
-        hi: sel(pos, q, f64::INFINITY),
-        some: pos | neg | (a0 <= 0.0),
+        lo: neg.select(q, s(f64::NEG_INFINITY)),
+        hi: pos.select(q, s(f64::INFINITY)),
+        some: pos | neg | a0.le(s(0.0)),
     }
 }
 
@@ -136,7 +148,7 @@ fn meet(a: Opt, b: Opt) -> Opt {
     Opt {
         lo,
         hi,
-        some: a.some & b.some & (lo <= hi),
+        some: a.some & b.some & lo.le(hi),
     }
 }
 
@@ -145,96 +157,300 @@ fn meet(a: Opt, b: Opt) -> Opt {
 fn hull(a: Opt, b: Opt) -> Opt {
     let both = a.some & b.some;
     Opt {
-        lo: sel(both, a.lo.min(b.lo), sel(a.some, a.lo, b.lo)),
-        hi: sel(both, a.hi.max(b.hi), sel(a.some, a.hi, b.hi)),
+        lo: both.select(a.lo.min(b.lo), a.some.select(a.lo, b.lo)),
+        hi: both.select(a.hi.max(b.hi), a.some.select(a.hi, b.hi)),
         some: a.some | b.some,
     }
 }
 
-/// `kernel::slab`.
+/// `kernel::slab`: t with lo ≤ z0 + dz·t ≤ hi.
 #[inline(always)]
-fn slab(z0: f64, dz: f64, lo: f64, hi: f64) -> Opt {
-    meet(linear_le0(lo - z0, -dz), linear_le0(z0 - hi, dz))
+fn slab(z0: F, dz: f64, lo: f64, hi: f64) -> Opt {
+    meet(linear_le0(s(lo) - z0, s(-dz)), linear_le0(z0 - s(hi), s(dz)))
 }
 
-/// `kernel::quadratic_le0`, without branches.
+/// `kernel::quadratic_le0`: t with a·t² + 2b·t + c ≤ 0.
 #[inline(always)]
-fn quadratic_le0(a: f64, b: f64, c: f64) -> Opt {
-    let lin = (a <= 1e-15 * (b.abs() + c.abs()).max(1e-300)) | (a == 0.0);
-    let l = linear_le0(c, 2.0 * b);
+fn quadratic_le0(a: F, b: F, c: F) -> Opt {
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(s(0.0));
+    let l = linear_le0(c, s(2.0) * b);
     let disc = b * b - a * c;
-    let s = disc.sqrt();
-    let q = -(b + s.copysign(b));
-    let qz = q == 0.0;
+    let sq = disc.sqrt();
+    let q = -(b + sq.copysign(b));
+    let qz = q.eq(s(0.0));
     let (r1, r2) = (q / a, c / q);
     Opt {
-        lo: sel(lin, l.lo, sel(qz, 0.0, r1.min(r2))),
-        hi: sel(lin, l.hi, sel(qz, 0.0, r1.max(r2))),
-        some: (lin & l.some) | (!lin & !(disc < 0.0)),
+        lo: lin.select(l.lo, qz.select(s(0.0), r1.min(r2))),
+        hi: lin.select(l.hi, qz.select(s(0.0), r1.max(r2))),
+        some: (lin & l.some) | (!lin & !disc.lt(s(0.0))),
     }
 }
 
-/// `kernel::cylinder` on the line (z0, dz, a, b, c) of `Local`.
+// ---------------------------------------------------------------------------
+// The skip tests: certain bounds without roots or quotients.
+//
+// They decide whether a span, *as computed* (bits and all), starts at or
+// above m, from the very coefficients the exact kernels use; sums and
+// products only, each compared with a margin that bounds its rounding.
+
+/// Unit roundoff of f64 (half an ulp of 1).
+const U: f64 = f64::EPSILON / 2.0;
+/// A margin of 32 u: every rounded product or sum below is within (1 + u)
+/// of its exact value, and at most a handful are chained before a margin
+/// is applied.
+const SLACK: f64 = 32.0 * U;
+/// An absolute floor under every margin: errors of results in the
+/// subnormal range (far below any length in mm).
+const TINY: f64 = 1e-290;
+
+/// A certain lower bound of the exact value of the rounded `x`, where `x`
+/// is the result of one or two rounded operations on exact operands whose
+/// magnitudes sum to at most `scale`.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn cylinder(z0: f64, dz: f64, a: f64, b: f64, c: f64, zlo: f64, zhi: f64, r: f64) -> Opt {
-    let axial = slab(z0, dz, zlo, zhi);
-    let radial = quadratic_le0(a, b, c - r * r);
-    meet(axial, radial)
+fn lower(x: F, scale: F) -> F {
+    x - s(SLACK) * scale - s(TINY)
 }
 
-/// `Local::along` for the ray through `pu` (axis `U`), `pv` (axis `V`)
+/// A certain upper bound, likewise.
+#[inline(always)]
+fn upper(x: F, scale: F) -> F {
+    x + s(SLACK) * scale + s(TINY)
+}
+
+/// Whether the lower end of the span [`quadratic_le0`]`(a, b, c)` computes
+/// is certainly ≥ `m`, or that span certainly empty (lanes set); a clear
+/// lane is "not certain".
+///
+/// Let d be the computed discriminant (the float `quadratic_le0` computes,
+/// d = b² − a·c + e with |e| ≤ 2.01u(b² + |a·c|)), Q = |b| + √d and σ =
+/// −sign b. The computed s = fl(√d) and |q| = fl(|b| + s) are within (1 ±
+/// u) and (1 ± 2.01u) of √d and Q, so the computed roots q/a and c/q are
+/// within a relative 3.1u of X₁ = σ·Q/a and X₂ = σ·c/Q, and their minimum
+/// (the span's start) is ≥ m when both X are ≥ m' = m + 32u·|m| (x − 3.1u·|x|
+/// grows with x; the float m' is rounded up). With g(t) = a·t² + 2b·t + c:
+/// * b < 0: X₁ ≥ m' ⇐ |b| ≥ a·m'; X₂ ≥ m' ⇔ Y = c − m'|b| ≥ m'·√d, that is
+///   Y ≥ 0 and (m' ≤ 0, or Y² − m'²d = c·g(m') − m'²e ≥ 0: with c ≥ m'|b| >
+///   0, c·g(m') ≥ m'²·|e| suffices);
+/// * b > 0: X₁ ≥ m' ⇔ Z = −a·m' − |b| ≥ √d, that is Z ≥ 0 and Z² − d =
+///   a·g(m') − e ≥ 0; X₂ ≥ m' ⇔ −c − m'|b| ≥ m'·√d, implied by −c − m'|b|
+///   ≥ 0 (m' < 0 here, as Z ≥ 0 needs).
+///
+/// No root, no quotient: every product and sum is rounded, and every
+/// comparison is made between a certain lower and a certain upper bound
+/// ([`lower`], [`upper`], margins of 32u of the magnitudes involved). The
+/// linear case of `quadratic_le0` (a negligible) and b = 0 are not decided.
+#[inline(always)]
+fn quadratic_lo_at_least(a: F, b: F, c: F, m: F) -> M {
+    let zero = s(0.0);
+    // The same branch as `quadratic_le0`, from the same floats.
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(zero);
+    let (bb2, ac) = (b * b, a * c);
+    let d = bb2 - ac;
+    // `quadratic_le0` returns None: nothing to cut.
+    let none = d.lt(zero);
+    // A bound of |e|: 2.01u(b² + |a·c|) from the rounded b² and a·c, with
+    // room for their own rounding.
+    let e = s(4.0 * U) * (bb2 + ac.abs());
+    let m1 = upper(m + s(SLACK) * m.abs(), m.abs());
+    let bb = b.abs();
+    let neg = b.lt(zero);
+    let am = a * m1;
+    let mb = m1 * bb;
+    // g(m') and a certain lower bound of it.
+    let (g1, g2) = (am * m1, (s(2.0) * b) * m1);
+    let g = lower(g1 + g2 + c, g1.abs() + g2.abs() + c.abs());
+    // b < 0.
+    let y_ok = (c - mb).ge(upper(zero, c.abs() + mb.abs()));
+    let cg = c * g;
+    let r = (m1 * m1) * e;
+    let first_neg = bb.ge(upper(am, am.abs()));
+    let second_neg = y_ok & (m1.le(zero) | lower(cg, cg.abs()).ge(upper(r, r)));
+    // b > 0.
+    let z_ok = (-am - bb).ge(upper(zero, am.abs() + bb));
+    let ag = a * g;
+    let first_pos = z_ok & lower(ag, ag.abs()).ge(upper(e, e));
+    let second_pos = (-c - mb).ge(upper(zero, c.abs() + mb.abs()));
+    let decided = (neg & first_neg & second_neg) | (b.gt(zero) & first_pos & second_pos);
+    !lin & (none | (m.abs().lt(s(f64::INFINITY)) & decided))
+}
+
+/// Whether `kernel::slab(z0, dz, zlo, zhi)` certainly starts at or above
+/// `m`, or is certainly empty. For dz = 0 the slab is everything or nothing,
+/// decided by the same comparisons; otherwise its lower end is the rounded
+/// quotient (zlo − z0)/dz (dz > 0) or −(z0 − zhi)/dz (dz < 0), at least m
+/// when the exact quotient is (m is a float): zlo − z0 ≥ m·dz, or
+/// z0 − zhi ≥ −m·dz, the product bounded with [`upper`].
+#[inline(always)]
+fn slab_lo_at_least(z0: F, dz: f64, zlo: f64, zhi: f64, m: F) -> M {
+    let zero = s(0.0);
+    let (a0, a1) = (s(zlo) - z0, z0 - s(zhi));
+    if dz == 0.0 {
+        return !(a0.le(zero) & a1.le(zero));
+    }
+    let md = m * s(dz);
+    let finite = m.abs().lt(s(f64::INFINITY));
+    if dz > 0.0 {
+        finite & a0.ge(upper(md, md.abs()))
+    } else if dz < 0.0 {
+        finite & a1.ge(upper(-md, md.abs()))
+    } else {
+        M::splat(false)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Coefficients: the same expressions as `Local::along`, `capsule_span` and
+// `Local::new`, lane by lane.
+
+/// `Local::along` for the rays through `pu` (axis `U`), `pv` (axis `V`)
 /// along `K`: (z0, b, c); dz = axis[K] and a = 1 − dz² are constants.
 #[inline(always)]
 fn along<const K: usize, const U: usize, const V: usize>(
-    pu: f64,
+    pu: F,
     pv: f64,
     origin: &[f64; 3],
     axis: &[f64; 3],
-) -> (f64, f64, f64) {
-    let mut p = [0.0; 3];
-    p[U] = pu - origin[U];
-    p[V] = pv - origin[V];
-    p[K] = -origin[K];
-    let z0 = p[0] * axis[0] + p[1] * axis[1] + p[2] * axis[2];
+) -> (F, F, F) {
+    let mut p = [s(0.0); 3];
+    p[U] = pu - s(origin[U]);
+    p[V] = s(pv - origin[V]);
+    p[K] = s(-origin[K]);
+    let z0 = p[0] * s(axis[0]) + p[1] * s(axis[1]) + p[2] * s(axis[2]);
     let pp = [
-        p[0] - z0 * axis[0],
-        p[1] - z0 * axis[1],
-        p[2] - z0 * axis[2],
+        p[0] - z0 * s(axis[0]),
+        p[1] - z0 * s(axis[1]),
+        p[2] - z0 * s(axis[2]),
     ];
     (z0, pp[K], pp[0] * pp[0] + pp[1] * pp[1] + pp[2] * pp[2])
 }
 
-/// The ray's origin o (o[K] = 0) as `stock` builds it.
+/// The rays' origins o (o[K] = 0) as `stock` builds them.
 #[inline(always)]
-fn ray_origin<const K: usize, const U: usize, const V: usize>(pu: f64, pv: f64) -> [f64; 3] {
-    let mut o = [0.0; 3];
+fn ray_origin<const K: usize, const U: usize, const V: usize>(pu: F, pv: f64) -> [F; 3] {
+    let mut o = [s(0.0); 3];
     o[U] = pu;
-    o[V] = pv;
+    o[V] = s(pv);
     o
 }
 
-/// `a + b + c` as nalgebra's 3-vector dot product sums it.
+/// x·y summed as nalgebra's 3-vector dot product: (x₀y₀ + x₁y₁) + x₂y₂.
 #[inline(always)]
-fn dot(x: &[f64; 3], y: &[f64; 3]) -> f64 {
+fn dot(x: &[F; 3], y: &[F; 3]) -> F {
     x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
 }
 
-/// The sphere of `capsule_span`: the quadratic's (b, c).
 #[inline(always)]
-fn capsule_sphere(o: &[f64; 3], c: &[f64; 3], d: &[f64; 3], r: f64) -> (f64, f64) {
-    let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
-    (dot(&oc, d), dot(&oc, &oc) - r * r)
+fn splat3(v: &[f64; 3]) -> [F; 3] {
+    [s(v[0]), s(v[1]), s(v[2])]
 }
 
-/// The cylinder part of `capsule_span`: `Local::new(o, d, c0, w)` → (z0, b, c).
+/// A sphere of `capsule_span`: its quadratic's (b, c) (a = 1).
 #[inline(always)]
-fn capsule_line(o: &[f64; 3], k: &Capsule) -> (f64, f64, f64) {
-    let p = [o[0] - k.c0[0], o[1] - k.c0[1], o[2] - k.c0[2]];
-    let z0 = dot(&p, &k.w);
-    let pp = [p[0] - z0 * k.w[0], p[1] - z0 * k.w[1], p[2] - z0 * k.w[2]];
-    (z0, dot(&pp, &k.dp), dot(&pp, &pp))
+fn capsule_sphere(o: &[F; 3], c: &[f64; 3], d: &[F; 3], r: f64) -> (F, F) {
+    let oc = [o[0] - s(c[0]), o[1] - s(c[1]), o[2] - s(c[2])];
+    (dot(&oc, d), dot(&oc, &oc) - s(r * r))
 }
+
+/// The cylinder of `capsule_span`: `Local::new(o, d, c0, w)`'s (z0, b, c).
+#[inline(always)]
+fn capsule_line(o: &[F; 3], k: &Capsule) -> (F, F, F) {
+    let p = [o[0] - s(k.c0[0]), o[1] - s(k.c0[1]), o[2] - s(k.c0[2])];
+    let w = splat3(&k.w);
+    let z0 = dot(&p, &w);
+    let pp = [p[0] - z0 * w[0], p[1] - z0 * w[1], p[2] - z0 * w[2]];
+    (z0, dot(&pp, &splat3(&k.dp)), dot(&pp, &pp))
+}
+
+// ---------------------------------------------------------------------------
+// Four rays of one solid: which need their span, and the spans.
+
+const NONE: Opt = Opt {
+    lo: F([0.0; W]),
+    hi: F([0.0; W]),
+    some: M([0; W]),
+};
+
+/// The rays (lanes of `gate`) whose span is not certainly at or above `m`,
+/// and their spans (meaningful on those lanes).
+#[inline(always)]
+fn chunk<const K: usize, const U: usize, const V: usize>(
+    solid: &RowSolid,
+    pu: F,
+    pv: f64,
+    m: F,
+    gate: M,
+) -> (M, Opt) {
+    match *solid {
+        RowSolid::Cylinder {
+            origin,
+            axis,
+            z0,
+            z1,
+            r,
+        } => {
+            let (lz, b, c) = along::<K, U, V>(pu, pv, &origin, &axis);
+            let dz = axis[K];
+            let (a, c) = (s(1.0 - dz * dz), c - s(r * r));
+            // The span is the slab met with the radial span: it starts no
+            // lower than either.
+            let skip = slab_lo_at_least(lz, dz, z0, z1, m) | quadratic_lo_at_least(a, b, c, m);
+            let need = gate & !skip;
+            if !need.any() {
+                return (need, NONE);
+            }
+            (need, meet(slab(lz, dz, z0, z1), quadratic_le0(a, b, c)))
+        }
+        RowSolid::Sphere {
+            origin,
+            axis,
+            zc,
+            r,
+        } => {
+            let (lz, b, c) = along::<K, U, V>(pu, pv, &origin, &axis);
+            let dz = axis[K];
+            let zr = lz - s(zc);
+            let (a, b, c) = (
+                s(1.0 - dz * dz + dz * dz),
+                b + zr * s(dz),
+                c + zr * zr - s(r * r),
+            );
+            let need = gate & !quadratic_lo_at_least(a, b, c, m);
+            if !need.any() {
+                return (need, NONE);
+            }
+            (need, quadratic_le0(a, b, c))
+        }
+        RowSolid::Capsule(ref k) => {
+            let o = ray_origin::<K, U, V>(pu, pv);
+            let d = splat3(&k.d);
+            let (b0, c0) = capsule_sphere(&o, &k.c0, &d, k.r);
+            let (b1, c1) = capsule_sphere(&o, &k.c1, &d, k.r);
+            let (lz, b, c) = capsule_line(&o, k);
+            let (a, c) = (s(k.a), c - s(k.r * k.r));
+            let one = s(1.0);
+            // The hull starts at the lowest of its parts.
+            let spheres = quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
+            let line = if k.len > 0.0 {
+                slab_lo_at_least(lz, k.dz, 0.0, k.len, m) | quadratic_lo_at_least(a, b, c, m)
+            } else {
+                M::splat(true)
+            };
+            let need = gate & !(spheres & line);
+            if !need.any() {
+                return (need, NONE);
+            }
+            let mut span = hull(quadratic_le0(one, b0, c0), quadratic_le0(one, b1, c1));
+            if k.len > 0.0 {
+                span = hull(span, meet(slab(lz, k.dz, 0.0, k.len), quadratic_le0(a, b, c)));
+            }
+            (need, span)
+        }
+        RowSolid::Other => (M::splat(false), NONE),
+    }
+}
+
+// ---------------------------------------------------------------------------
+// A row.
 
 /// Scratch buffers of a row, kept by each thread from row to row.
 #[derive(Default)]
@@ -243,11 +459,8 @@ pub(crate) struct Scratch {
     first: Vec<f64>,
     last: Vec<f64>,
     m: Vec<f64>,
-    q: Coefficients,
-    flags: Vec<bool>,
-    need: Vec<u32>,
-    out: Vec<Opt>,
-    found: Vec<(u32, Span)>,
+    /// Rays with a span that meets the material but ends below its top.
+    split: Vec<bool>,
     spans: Vec<Span>,
 }
 
@@ -261,19 +474,19 @@ pub(crate) struct Active {
 }
 
 /// What [`cut_row`] needs of the solids: the prepared kernels, each
-/// solid's extent along the rays, and the scalar span of the others.
+/// solid's extent along the rays, and the scalar span of every solid.
 pub(crate) struct RowSolids<'a> {
     pub prepared: &'a [RowSolid],
     /// Each solid's bounds along the rays (lo, hi).
     pub along: &'a [(f64, f64)],
-    /// The span of solid `i` on the ray at (`pu`, `pv`), for
-    /// [`RowSolid::Other`].
-    pub other: &'a (dyn Fn(usize, f64, f64) -> Option<Span> + Sync),
+    /// The span of solid `i` on the ray at (`pu`, `pv`): `kernel`'s scalar
+    /// function, for [`RowSolid::Other`] and for split rays.
+    pub span: &'a (dyn Fn(usize, f64, f64) -> Option<Span> + Sync),
 }
 
-/// Cuts one row: the rays `row[a..=b]` of every active solid (visited in
-/// the order given), then subtracts from each ray the union of the spans it
-/// kept, as the reference removal does.
+/// Cuts one row: every active solid (visited in the order given) on the
+/// rays `row[a..=b]` of its range, then each ray as the reference removal
+/// would (module doc).
 pub(crate) fn cut_row(
     frame: &RowFrame,
     row: &mut [Ray],
@@ -294,9 +507,8 @@ pub(crate) fn cut_row(
     cut_row_any(frame, row, active, solids, id, scratch);
 }
 
-/// [`cut_row`] compiled for AVX2: the same operations, four lanes wide.
-/// Rust never fuses a product and a sum, so the lanes round as the scalar
-/// code does and the stock's bits do not depend on the processor.
+/// [`cut_row`] compiled for AVX2: the same operations, four lanes in one
+/// instruction.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn cut_row_avx2(
@@ -326,179 +538,6 @@ fn cut_row_any(
     }
 }
 
-/// The coefficients of one solid on the rays of its range.
-#[inline(always)]
-fn coefficients<const K: usize, const U: usize, const V: usize>(
-    s: &RowSolid,
-    pu: &[f64],
-    pv: f64,
-    q: &mut Coefficients,
-) {
-    let n = pu.len();
-    q.resize(n);
-    match *s {
-        RowSolid::Cylinder {
-            origin, axis, r, ..
-        } => {
-            for j in 0..n {
-                let (lz, b, c) = along::<K, U, V>(pu[j], pv, &origin, &axis);
-                (q.z[j], q.b[j], q.c[j]) = (lz, b, c - r * r);
-            }
-        }
-        RowSolid::Sphere {
-            origin,
-            axis,
-            zc,
-            r,
-        } => {
-            let dz = axis[K];
-            for j in 0..n {
-                let (lz, b, c) = along::<K, U, V>(pu[j], pv, &origin, &axis);
-                let zr = lz - zc;
-                (q.b[j], q.c[j]) = (b + zr * dz, c + zr * zr - r * r);
-            }
-        }
-        RowSolid::Capsule(ref k) => {
-            for j in 0..n {
-                let o = ray_origin::<K, U, V>(pu[j], pv);
-                (q.b0[j], q.c0[j]) = capsule_sphere(&o, &k.c0, &k.d, k.r);
-                (q.b1[j], q.c1[j]) = capsule_sphere(&o, &k.c1, &k.d, k.r);
-                let (lz, b, c) = capsule_line(&o, k);
-                (q.z[j], q.b[j], q.c[j]) = (lz, b, c - k.r * k.r);
-            }
-        }
-        RowSolid::Other => {}
-    }
-}
-
-/// Per-ray coefficients of a solid: for a piece, `Local`'s z0 (cylinder),
-/// b and c of its quadratic (c already less r²); for a capsule, the two
-/// spheres' (b, c) and the segment cylinder's (z0, b, c − r²).
-#[derive(Default)]
-struct Coefficients {
-    z: Vec<f64>,
-    b: Vec<f64>,
-    c: Vec<f64>,
-    b0: Vec<f64>,
-    c0: Vec<f64>,
-    b1: Vec<f64>,
-    c1: Vec<f64>,
-}
-
-impl Coefficients {
-    fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.z,
-            &mut self.b,
-            &mut self.c,
-            &mut self.b0,
-            &mut self.c0,
-            &mut self.b1,
-            &mut self.c1,
-        ] {
-            v.clear();
-            v.resize(n, 0.0);
-        }
-    }
-}
-
-/// Whether each ray of the range needs the solid's span: within the
-/// solid's extent along the ray (the reference's test) and not certainly
-/// starting at or above the ray's m.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn flag<const K: usize>(
-    s: &RowSolid,
-    q: &Coefficients,
-    (lo_k, hi_k): (f64, f64),
-    first: &[f64],
-    last: &[f64],
-    m: &[f64],
-    flags: &mut [bool],
-) {
-    let n = flags.len();
-    let gate = |j: usize| !(hi_k <= first[j] || lo_k >= last[j]);
-    match *s {
-        RowSolid::Cylinder {
-            axis, z0, z1, ..
-        } => {
-            let dz = axis[K];
-            let a = 1.0 - dz * dz;
-            for j in 0..n {
-                let skip = slab_lo_at_least(q.z[j], dz, z0, z1, m[j])
-                    | quadratic_lo_at_least(a, q.b[j], q.c[j], m[j]);
-                flags[j] = gate(j) & !skip;
-            }
-        }
-        RowSolid::Sphere { axis, .. } => {
-            let dz = axis[K];
-            let a = 1.0 - dz * dz + dz * dz;
-            for j in 0..n {
-                flags[j] = gate(j) & !quadratic_lo_at_least(a, q.b[j], q.c[j], m[j]);
-            }
-        }
-        RowSolid::Capsule(ref k) => {
-            for j in 0..n {
-                // The hull starts at the lowest of its parts.
-                let spheres = quadratic_lo_at_least(1.0, q.b0[j], q.c0[j], m[j])
-                    & quadratic_lo_at_least(1.0, q.b1[j], q.c1[j], m[j]);
-                let line = !(k.len > 0.0)
-                    | slab_lo_at_least(q.z[j], k.dz, 0.0, k.len, m[j])
-                    | quadratic_lo_at_least(k.a, q.b[j], q.c[j], m[j]);
-                flags[j] = gate(j) & !(spheres & line);
-            }
-        }
-        RowSolid::Other => {
-            for j in 0..n {
-                flags[j] = gate(j);
-            }
-        }
-    }
-}
-
-/// The exact spans of the rays `need` (indices into the coefficients).
-#[inline(always)]
-fn exact<const K: usize>(s: &RowSolid, q: &Coefficients, need: &[u32], out: &mut [Opt]) {
-    match *s {
-        RowSolid::Cylinder {
-            axis, z0, z1, ..
-        } => {
-            let dz = axis[K];
-            let a = 1.0 - dz * dz;
-            for (o, &j) in out.iter_mut().zip(need) {
-                let j = j as usize;
-                let axial = slab(q.z[j], dz, z0, z1);
-                let radial = quadratic_le0(a, q.b[j], q.c[j]);
-                *o = meet(axial, radial);
-            }
-        }
-        RowSolid::Sphere { axis, .. } => {
-            let dz = axis[K];
-            let a = 1.0 - dz * dz + dz * dz;
-            for (o, &j) in out.iter_mut().zip(need) {
-                let j = j as usize;
-                *o = quadratic_le0(a, q.b[j], q.c[j]);
-            }
-        }
-        RowSolid::Capsule(ref k) => {
-            for (o, &j) in out.iter_mut().zip(need) {
-                let j = j as usize;
-                let mut span = hull(
-                    quadratic_le0(1.0, q.b0[j], q.c0[j]),
-                    quadratic_le0(1.0, q.b1[j], q.c1[j]),
-                );
-                if k.len > 0.0 {
-                    let axial = slab(q.z[j], k.dz, 0.0, k.len);
-                    let radial = quadratic_le0(k.a, q.b[j], q.c[j]);
-                    span = hull(span, meet(axial, radial));
-                }
-                *o = span;
-            }
-        }
-        RowSolid::Other => {}
-    }
-}
-
 #[inline(always)]
 fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     frame: &RowFrame,
@@ -506,99 +545,105 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     active: &[Active],
     solids: &RowSolids,
     id: u32,
-    scratch: &mut Scratch,
+    sc: &mut Scratch,
 ) {
     let Some(a_min) = active.iter().map(|s| s.a).min() else {
         return;
     };
     let b_max = active.iter().map(|s| s.b).max().unwrap_or(a_min);
-    let sc = scratch;
-    sc.first.clear();
-    sc.last.clear();
-    sc.pu.clear();
-    for (iu, ray) in row[a_min..=b_max].iter().enumerate() {
-        // An empty ray: no solid passes the test against its ends.
-        let (f, l) = match (ray.first(), ray.last()) {
-            (Some(f), Some(l)) => (f.lo, l.hi),
+    let n = b_max + 1 - a_min;
+    let padded = n.div_ceil(W) * W;
+    let pv = frame.pv;
+    for v in [&mut sc.pu, &mut sc.first, &mut sc.last] {
+        v.clear();
+    }
+    for j in 0..padded {
+        sc.pu
+            .push(frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h);
+        // Padding and empty rays: no solid passes the gate against their
+        // ends.
+        let (f, l) = match row.get(a_min + j).filter(|_| j < n) {
+            Some(ray) if !ray.is_empty() => (ray[0].lo, ray[ray.len() - 1].hi),
             _ => (f64::INFINITY, f64::NEG_INFINITY),
         };
         sc.first.push(f);
         sc.last.push(l);
-        sc.pu
-            .push(frame.origin_u + ((a_min + iu) as f64 + 0.5) * frame.h);
     }
     sc.m.clear();
     sc.m.extend_from_slice(&sc.last);
-    sc.found.clear();
-    let pv = frame.pv;
+    sc.split.clear();
+    sc.split.resize(padded, false);
+    let mut any_split = false;
+    let lane = F(std::array::from_fn(|i| i as f64));
     for act in active {
         let (j0, j1) = (act.a - a_min, act.b - a_min);
-        let s = &solids.prepared[act.solid];
-        coefficients::<K, U, V>(s, &sc.pu[j0..=j1], pv, &mut sc.q);
-        sc.flags.clear();
-        sc.flags.resize(j1 + 1 - j0, false);
-        flag::<K>(
-            s,
-            &sc.q,
-            solids.along[act.solid],
-            &sc.first[j0..=j1],
-            &sc.last[j0..=j1],
-            &sc.m[j0..=j1],
-            &mut sc.flags,
-        );
-        sc.need.clear();
-        for (j, &f) in sc.flags.iter().enumerate() {
-            if f {
-                sc.need.push(j as u32);
-            }
-        }
-        if sc.need.is_empty() {
-            continue;
-        }
-        sc.out.clear();
-        sc.out.resize(
-            sc.need.len(),
-            Opt {
-                lo: 0.0,
-                hi: 0.0,
-                some: false,
-            },
-        );
-        if let RowSolid::Other = s {
-            for (o, &j) in sc.out.iter_mut().zip(&sc.need) {
-                if let Some(sp) = (solids.other)(act.solid, sc.pu[j0 + j as usize], pv) {
-                    *o = Opt {
-                        lo: sp.lo,
-                        hi: sp.hi,
-                        some: true,
-                    };
+        let (lo_k, hi_k) = solids.along[act.solid];
+        let solid = &solids.prepared[act.solid];
+        let mut base = j0 / W * W;
+        while base <= j1 {
+            let idx = s(base as f64) + lane;
+            let (first, last) = (F::load(&sc.first, base), F::load(&sc.last, base));
+            // The reference's gate: the ray's index within the solid's
+            // bounds and its material within the solid's extent.
+            let gate = idx.ge(s(j0 as f64))
+                & idx.le(s(j1 as f64))
+                & !(s(hi_k).le(first) | s(lo_k).ge(last));
+            if gate.any() {
+                let m = F::load(&sc.m, base);
+                let (need, span) = if let RowSolid::Other = solid {
+                    scalar_spans(solids, act.solid, &sc.pu[base..base + W], pv, gate)
+                } else {
+                    chunk::<K, U, V>(solid, F::load(&sc.pu, base), pv, m, gate)
+                };
+                let keep = need & span.some;
+                let reach = keep & span.hi.ge(last);
+                (reach & span.lo.lt(m)).select(span.lo, m).store(&mut sc.m, base);
+                let split = keep & !span.hi.ge(last) & span.hi.gt(first);
+                if split.any() {
+                    for i in 0..W {
+                        sc.split[base + i] |= split.lane(i);
+                    }
+                    any_split = true;
                 }
             }
-        } else {
-            exact::<K>(s, &sc.q, &sc.need, &mut sc.out);
+            base += W;
         }
-        // Keep them; a span that reaches the ray's top lowers its m.
-        for (o, &j) in sc.out.iter().zip(&sc.need) {
-            if o.some {
-                let j = j0 + j as usize;
-                sc.found.push((j as u32, Span { lo: o.lo, hi: o.hi }));
-                if o.hi >= sc.last[j] && o.lo < sc.m[j] {
-                    sc.m[j] = o.lo;
+    }
+    for j in 0..n {
+        let ray = &mut row[a_min + j];
+        if sc.split[j] {
+            // The reference procedure for this ray: every span, united.
+            sc.spans.clear();
+            for act in active {
+                let (lo_k, hi_k) = solids.along[act.solid];
+                if (act.a..=act.b).contains(&(a_min + j))
+                    && !(hi_k <= sc.first[j] || lo_k >= sc.last[j])
+                    && let Some(sp) = (solids.span)(act.solid, sc.pu[j], pv)
+                {
+                    sc.spans.push(sp);
                 }
             }
+            remove_spans(ray, &mut sc.spans, id);
+        } else if sc.m[j] < sc.last[j] {
+            // Every span that met the material reached its top.
+            subtract(ray, sc.m[j], f64::INFINITY, id);
         }
     }
-    // Subtract each ray's spans (their order does not matter: the union
-    // is what is subtracted).
-    sc.found.sort_by_key(|&(j, _)| j);
-    let mut i = 0;
-    while i < sc.found.len() {
-        let j = sc.found[i].0;
-        sc.spans.clear();
-        while i < sc.found.len() && sc.found[i].0 == j {
-            sc.spans.push(sc.found[i].1);
-            i += 1;
+    let _ = any_split;
+}
+
+/// The scalar spans of a solid without a lane kernel, on the gated lanes.
+#[inline(always)]
+fn scalar_spans(solids: &RowSolids, i: usize, pu: &[f64], pv: f64, gate: M) -> (M, Opt) {
+    let mut out = NONE;
+    for l in 0..W {
+        if gate.lane(l)
+            && let Some(sp) = (solids.span)(i, pu[l], pv)
+        {
+            out.lo.0[l] = sp.lo;
+            out.hi.0[l] = sp.hi;
+            out.some.0[l] = u64::MAX;
         }
-        remove_spans(&mut row[a_min + j as usize], &mut sc.spans, id);
     }
+    (gate, out)
 }

@@ -723,7 +723,7 @@ impl Stock {
             let kuv = (k, u, v);
             let prepared: Vec<RowSolid> = solids.iter().map(|s| s.row_solid(&d)).collect();
             let along: Vec<(f64, f64)> = solids.iter().map(|s| (s.lo[k], s.hi[k])).collect();
-            let other = |i: usize, pu: f64, pv: f64| {
+            let span = |i: usize, pu: f64, pv: f64| {
                 let mut o = Vector3::zeros();
                 o[u] = pu;
                 o[v] = pv;
@@ -732,19 +732,16 @@ impl Stock {
             let row_solids = RowSolids {
                 prepared: &prepared,
                 along: &along,
-                other: &other,
+                span: &span,
             };
             f.rays[v0 * nu..(v1 + 1) * nu]
                 .par_chunks_mut(nu)
                 .with_min_len(8)
                 .enumerate()
-                .for_each_init(
-                    || (Vec::new(), Scratch::default()),
-                    |(active, scratch): &mut (Vec<Active>, Scratch), (jv, row)| {
+                .for_each(|(jv, row)| {
+                    SCRATCH.with_borrow_mut(|(active, scratch)| {
                         let frame = RowFrame {
                             k,
-                            u,
-                            v,
                             origin_u: origin[u],
                             h,
                             pv: origin[v] + ((v0 + jv) as f64 + 0.5) * h,
@@ -763,10 +760,15 @@ impl Stock {
                             }
                         }
                         cut_row(&frame, row, active, &row_solids, id, scratch);
-                    },
-                );
+                    })
+                });
         }
     }
+}
+
+thread_local! {
+    /// Each thread's buffers for the rows it cuts, kept from move to move.
+    static SCRATCH: std::cell::RefCell<(Vec<Active>, Scratch)> = Default::default();
 }
 
 /// The union of the solids' bounds.
