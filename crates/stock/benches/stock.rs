@@ -22,8 +22,8 @@ use kinpost_stock::{Design, Mesh, Stock, Tool, ToolPose, compare};
 use nalgebra::Point3;
 
 mod programs;
-use programs as program;
 use program::stock;
+use programs as program;
 
 const CHUNK: usize = 500;
 

@@ -114,7 +114,6 @@ pub(crate) struct RowFrame {
     pub pv: f64,
 }
 
-
 /// A span on four rays: its ends and whether it exists.
 #[derive(Clone, Copy)]
 struct Opt {
@@ -166,7 +165,10 @@ fn hull(a: Opt, b: Opt) -> Opt {
 /// `kernel::slab`: t with lo ≤ z0 + dz·t ≤ hi.
 #[inline(always)]
 fn slab(z0: F, dz: f64, lo: f64, hi: f64) -> Opt {
-    meet(linear_le0(s(lo) - z0, s(-dz)), linear_le0(z0 - s(hi), s(dz)))
+    meet(
+        linear_le0(s(lo) - z0, s(-dz)),
+        linear_le0(z0 - s(hi), s(dz)),
+    )
 }
 
 /// `kernel::quadratic_le0`: t with a·t² + 2b·t + c ≤ 0.
@@ -429,7 +431,8 @@ fn chunk<const K: usize, const U: usize, const V: usize>(
             let (a, c) = (s(k.a), c - s(k.r * k.r));
             let one = s(1.0);
             // The hull starts at the lowest of its parts.
-            let spheres = quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
+            let spheres =
+                quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
             let line = if k.len > 0.0 {
                 slab_lo_at_least(lz, k.dz, 0.0, k.len, m) | quadratic_lo_at_least(a, b, c, m)
             } else {
@@ -441,7 +444,10 @@ fn chunk<const K: usize, const U: usize, const V: usize>(
             }
             let mut span = hull(quadratic_le0(one, b0, c0), quadratic_le0(one, b1, c1));
             if k.len > 0.0 {
-                span = hull(span, meet(slab(lz, k.dz, 0.0, k.len), quadratic_le0(a, b, c)));
+                span = hull(
+                    span,
+                    meet(slab(lz, k.dz, 0.0, k.len), quadratic_le0(a, b, c)),
+                );
             }
             (need, span)
         }
@@ -597,7 +603,9 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                 };
                 let keep = need & span.some;
                 let reach = keep & span.hi.ge(last);
-                (reach & span.lo.lt(m)).select(span.lo, m).store(&mut sc.m, base);
+                (reach & span.lo.lt(m))
+                    .select(span.lo, m)
+                    .store(&mut sc.m, base);
                 let split = keep & !span.hi.ge(last) & span.hi.gt(first);
                 if split.any() {
                     for i in 0..W {
@@ -646,4 +654,155 @@ fn scalar_spans(solids: &RowSolids, i: usize, pu: &[f64], pv: f64, gate: M) -> (
         }
     }
     (gate, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel;
+    use proptest::prelude::*;
+
+    fn lanes(x: f64) -> F {
+        F::splat(x)
+    }
+
+    /// Coefficients of every kind: ordinary, a negligible (the linear
+    /// case), b = 0 and b of either sign, an empty span.
+    fn coefficient() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            4 => -1e4f64..1e4,
+            1 => -1.0f64..1.0,
+            1 => Just(0.0),
+            1 => Just(-0.0),
+            1 => -1e-12f64..1e-12,
+        ]
+    }
+
+    /// The levels to test against a computed start: the start itself, one
+    /// ulp either side, and values near it.
+    fn levels(lo: f64) -> [f64; 6] {
+        [
+            lo,
+            lo.next_up(),
+            lo.next_down(),
+            lo + 1e-9,
+            lo - 1e-9,
+            lo * (1.0 + 1e-13),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20000))]
+
+        #[test]
+        fn the_lane_quadratic_is_the_scalar_one_bit_for_bit(
+            a in prop_oneof![0.0f64..2.0, Just(0.0), 0.0f64..1e-13],
+            b in coefficient(),
+            c in coefficient(),
+        ) {
+            let lane = quadratic_le0(lanes(a), lanes(b), lanes(c));
+            let scalar = kernel::quadratic_le0(a, b, c);
+            match scalar {
+                Some(sp) => {
+                    prop_assert!(lane.some.lane(0));
+                    prop_assert_eq!(lane.lo.0[0].to_bits(), sp.lo.to_bits());
+                    prop_assert_eq!(lane.hi.0[0].to_bits(), sp.hi.to_bits());
+                }
+                None => prop_assert!(!lane.some.lane(0)),
+            }
+        }
+
+        #[test]
+        fn the_lane_slab_is_the_scalar_one_bit_for_bit(
+            z0 in coefficient(), dz in prop_oneof![-1.0f64..1.0, Just(0.0)],
+            lo in -10.0f64..0.0, len in 0.0f64..10.0,
+        ) {
+            let lane = slab(lanes(z0), dz, lo, lo + len);
+            match kernel::slab(z0, dz, lo, lo + len) {
+                Some(sp) => {
+                    prop_assert!(lane.some.lane(0));
+                    prop_assert_eq!(lane.lo.0[0].to_bits(), sp.lo.to_bits());
+                    prop_assert_eq!(lane.hi.0[0].to_bits(), sp.hi.to_bits());
+                }
+                None => prop_assert!(!lane.some.lane(0)),
+            }
+        }
+
+        /// Never "certainly at or above m" when the computed start is below
+        /// m, even by an ulp.
+        #[test]
+        fn the_quadratic_skip_test_is_sound(
+            a in prop_oneof![0.0f64..2.0, 0.999f64..1.0, Just(1.0)],
+            b in coefficient(),
+            c in coefficient(),
+            m in -1e4f64..1e4,
+        ) {
+            let span = kernel::quadratic_le0(a, b, c);
+            let mut ms = vec![m];
+            if let Some(sp) = span {
+                ms.extend(levels(sp.lo));
+            }
+            for m in ms {
+                let claim = quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(m)).lane(0);
+                if claim {
+                    prop_assert!(span.is_none_or(|sp| sp.lo >= m), "{span:?} claimed ≥ {m}");
+                }
+            }
+        }
+
+        /// Near tangency (d ≈ 0) the computed start moves most with the
+        /// discriminant's rounding.
+        #[test]
+        fn the_quadratic_skip_test_is_sound_near_tangency(
+            a in 0.5f64..1.5,
+            b in prop_oneof![-100.0f64..-1.0, 1.0f64..100.0],
+            delta in prop_oneof![-1e-12f64..1e-12, -1e-15f64..1e-15, -1e-9f64..1e-9],
+        ) {
+            let c = b * b / a * (1.0 + delta);
+            let span = kernel::quadratic_le0(a, b, c);
+            if let Some(sp) = span {
+                for m in levels(sp.lo).into_iter().chain([sp.lo - 1e-6, sp.lo - 1e-7]) {
+                    if quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(m)).lane(0) {
+                        prop_assert!(sp.lo >= m, "{sp:?} claimed ≥ {m}");
+                    }
+                }
+            }
+        }
+
+        #[test]
+        fn the_slab_skip_test_is_sound(
+            z0 in coefficient(), dz in prop_oneof![-1.0f64..1.0, Just(0.0), -1e-9f64..1e-9],
+            lo in -10.0f64..0.0, len in 0.0f64..10.0, m in -1e4f64..1e4,
+        ) {
+            let span = kernel::slab(z0, dz, lo, lo + len);
+            let mut ms = vec![m];
+            if let Some(sp) = span {
+                ms.extend(levels(sp.lo));
+            }
+            for m in ms {
+                if slab_lo_at_least(lanes(z0), dz, lo, lo + len, lanes(m)).lane(0) {
+                    prop_assert!(span.is_none_or(|sp| sp.lo >= m), "{span:?} claimed ≥ {m}");
+                }
+            }
+        }
+    }
+
+    /// The skip test decides most of the cases it is meant for: a wheel's
+    /// rim well above the level (a test that never skips would be sound
+    /// and useless).
+    #[test]
+    fn the_quadratic_skip_test_skips_what_is_clearly_above() {
+        // |p⊥ + t·d⊥|² ≤ 50² for a wheel centred 90 mm up: the span starts
+        // at 40; a level of 39.9 is below it, 40.1 above.
+        let (a, b, c) = (1.0, -90.0, 90.0 * 90.0 - 50.0 * 50.0);
+        let lo = kernel::quadratic_le0(a, b, c).unwrap().lo;
+        assert!((lo - 40.0).abs() < 1e-9);
+        assert!(quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(39.9)).lane(0));
+        assert!(!quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(40.1)).lane(0));
+        // Below the origin (b > 0): the span starts at −140.
+        let lo = kernel::quadratic_le0(a, 90.0, c).unwrap().lo;
+        assert!((lo + 140.0).abs() < 1e-9);
+        assert!(quadratic_lo_at_least(lanes(a), lanes(90.0), lanes(c), lanes(-140.1)).lane(0));
+        assert!(!quadratic_lo_at_least(lanes(a), lanes(90.0), lanes(c), lanes(-139.9)).lane(0));
+    }
 }

@@ -826,7 +826,6 @@ fn index_range(o: f64, h: f64, n: usize, lo: f64, hi: f64) -> Option<(usize, usi
     (a <= b).then_some((a as usize, b as usize))
 }
 
-
 fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
     let n = (distance / step).ceil().max(1.0);
     if !(n <= 1.0e7) {
