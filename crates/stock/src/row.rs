@@ -34,6 +34,7 @@ use nalgebra::Vector3;
 use crate::dexel::{Ray, remove_spans, subtract};
 use crate::kernel::Span;
 use crate::lanes::{F, M, W};
+use crate::tolerance::SLIVER_MM;
 
 /// A solid prepared for the rays along axis `K` of one family: the
 /// constants of its span, taken from the same expressions as
@@ -243,6 +244,45 @@ fn upper(x: F, scale: F) -> F {
 /// linear case of `quadratic_le0` (a negligible) and b = 0 are not decided.
 #[inline(always)]
 fn quadratic_lo_at_least(a: F, b: F, c: F, m: F) -> M {
+    // The common case on all four lanes: the tool on the far side of the
+    // rays' origin (b < 0) and a positive level.
+    let common = b.lt(s(0.0)) & m.gt(s(1e-200)) & m.lt(s(f64::INFINITY));
+    if (!common).any() {
+        quadratic_lo_at_least_any(a, b, c, m)
+    } else {
+        quadratic_lo_at_least_common(a, b, c, m)
+    }
+}
+
+/// [`quadratic_lo_at_least`] for b < 0 and 0 < m < ∞ on every lane: the
+/// same conditions (X₁: |b| ≥ a·m'; X₂: c − m'|b| ≥ 0 and c·g(m') ≥
+/// m'²·|e|) with the signs known, so that each margin is one product:
+/// for x ≥ 0, fl(x·(1 + 32u)) is above x and fl(x·(1 − 32u)) below it by
+/// more than the rounding of the few operations that made x. m' = fl(m·(1 +
+/// 64u)) ≥ m + 32u·m.
+#[inline(always)]
+fn quadratic_lo_at_least_common(a: F, b: F, c: F, m: F) -> M {
+    let (up, down, tiny) = (s(1.0 + SLACK), s(1.0 - SLACK), s(TINY));
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(s(0.0));
+    let (bb2, ac) = (b * b, a * c);
+    let none = (bb2 - ac).lt(s(0.0));
+    let e = s(4.0 * U) * (bb2 + ac.abs());
+    let m1 = m * s(1.0 + 2.0 * SLACK);
+    let bb = -b;
+    let am = a * m1;
+    let first = bb.ge(am * up + tiny);
+    let mb = m1 * bb;
+    let y_ok = (c * down).ge(mb * up + tiny);
+    // g(m') = a·m'² + 2b·m' + c, with g1 ≥ 0 ≥ g2.
+    let (g1, g2) = (am * m1, (s(2.0) * b) * m1);
+    let g = (g1 + g2 + c) - s(SLACK) * (g1 - g2 + c.abs()) - tiny;
+    let second = y_ok & ((c * g) * down).ge(((m1 * m1) * e) * up + tiny);
+    !lin & (none | (first & second))
+}
+
+/// [`quadratic_lo_at_least`] for any signs.
+#[inline(always)]
+fn quadratic_lo_at_least_any(a: F, b: F, c: F, m: F) -> M {
     let zero = s(0.0);
     // The same branch as `quadratic_le0`, from the same floats.
     let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(zero);
@@ -634,10 +674,28 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
             remove_spans(ray, &mut sc.spans, id);
         } else if sc.m[j] < sc.last[j] {
             // Every span that met the material reached its top.
-            subtract(ray, sc.m[j], f64::INFINITY, id);
+            cut_top(ray, sc.m[j], id);
         }
     }
     let _ = any_split;
+}
+
+/// `subtract(ray, m, +∞, id)` for m below the ray's top, with the one
+/// interval case inline: the interval keeps [lo, m] when it is at least
+/// `SLIVER_MM` long, else goes.
+#[inline(always)]
+fn cut_top(ray: &mut Ray, m: f64, id: u32) {
+    if ray.len() == 1 {
+        let seg = &mut ray[0];
+        if seg.lo < m && m - seg.lo >= SLIVER_MM {
+            seg.hi = m;
+            seg.hi_move = id;
+        } else {
+            ray.clear();
+        }
+    } else {
+        subtract(ray, m, f64::INFINITY, id);
+    }
 }
 
 /// The scalar spans of a solid without a lane kernel, on the gated lanes.
