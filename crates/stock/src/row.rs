@@ -344,37 +344,6 @@ fn slab_lo_at_least(z0: F, dz: f64, zlo: f64, zhi: f64, m: F) -> M {
 // Coefficients: the same expressions as `Local::along`, `capsule_span` and
 // `Local::new`, lane by lane.
 
-/// `Local::along` for the rays through `pu` (axis `U`), `pv` (axis `V`)
-/// along `K`: (z0, b, c); dz = axis[K] and a = 1 − dz² are constants.
-#[inline(always)]
-fn along<const K: usize, const U: usize, const V: usize>(
-    pu: F,
-    pv: f64,
-    origin: &[f64; 3],
-    axis: &[f64; 3],
-) -> (F, F, F) {
-    let mut p = [s(0.0); 3];
-    p[U] = pu - s(origin[U]);
-    p[V] = s(pv - origin[V]);
-    p[K] = s(-origin[K]);
-    let z0 = p[0] * s(axis[0]) + p[1] * s(axis[1]) + p[2] * s(axis[2]);
-    let pp = [
-        p[0] - z0 * s(axis[0]),
-        p[1] - z0 * s(axis[1]),
-        p[2] - z0 * s(axis[2]),
-    ];
-    (z0, pp[K], pp[0] * pp[0] + pp[1] * pp[1] + pp[2] * pp[2])
-}
-
-/// The rays' origins o (o[K] = 0) as `stock` builds them.
-#[inline(always)]
-fn ray_origin<const K: usize, const U: usize, const V: usize>(pu: F, pv: f64) -> [F; 3] {
-    let mut o = [s(0.0); 3];
-    o[U] = pu;
-    o[V] = s(pv);
-    o
-}
-
 /// x·y summed as nalgebra's 3-vector dot product: (x₀y₀ + x₁y₁) + x₂y₂.
 #[inline(always)]
 fn dot(x: &[F; 3], y: &[F; 3]) -> F {
@@ -386,23 +355,6 @@ fn splat3(v: &[f64; 3]) -> [F; 3] {
     [s(v[0]), s(v[1]), s(v[2])]
 }
 
-/// A sphere of `capsule_span`: its quadratic's (b, c) (a = 1).
-#[inline(always)]
-fn capsule_sphere(o: &[F; 3], c: &[f64; 3], d: &[F; 3], r: f64) -> (F, F) {
-    let oc = [o[0] - s(c[0]), o[1] - s(c[1]), o[2] - s(c[2])];
-    (dot(&oc, d), dot(&oc, &oc) - s(r * r))
-}
-
-/// The cylinder of `capsule_span`: `Local::new(o, d, c0, w)`'s (z0, b, c).
-#[inline(always)]
-fn capsule_line(o: &[F; 3], k: &Capsule) -> (F, F, F) {
-    let p = [o[0] - s(k.c0[0]), o[1] - s(k.c0[1]), o[2] - s(k.c0[2])];
-    let w = splat3(&k.w);
-    let z0 = dot(&p, &w);
-    let pp = [p[0] - z0 * w[0], p[1] - z0 * w[1], p[2] - z0 * w[2]];
-    (z0, dot(&pp, &splat3(&k.dp)), dot(&pp, &pp))
-}
-
 // ---------------------------------------------------------------------------
 // Four rays of one solid: which need their span, and the spans.
 
@@ -412,86 +364,188 @@ const NONE: Opt = Opt {
     some: M([0; W]),
 };
 
-/// The rays (lanes of `gate`) whose span is not certainly at or above `m`,
-/// and their spans (meaningful on those lanes).
-#[inline(always)]
-fn chunk<const K: usize, const U: usize, const V: usize>(
-    solid: &RowSolid,
-    pu: F,
-    pv: f64,
-    m: F,
-    gate: M,
-) -> (M, Opt) {
-    match *solid {
-        RowSolid::Cylinder {
-            origin,
-            axis,
+/// A solid's kernel on the rays of one row, its constants made once.
+trait Kernel {
+    /// The rays (lanes of `gate`) at `pu` whose span is not certainly at or
+    /// above `m`, and their spans (meaningful on those lanes).
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt);
+}
+
+/// A cylinder piece: `Local::along` and `kernel::cylinder`.
+struct CylinderKernel<const K: usize, const U: usize, const V: usize> {
+    origin_u: F,
+    /// p[V]·w[V] and p[K]·w[K] are constant along the row, but are summed in
+    /// `Local::along`'s order with the varying term, so only the vectors
+    /// are kept.
+    p: [F; 3],
+    w: [F; 3],
+    dz: f64,
+    a: F,
+    rr: F,
+    z0: f64,
+    z1: f64,
+}
+
+impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
+    #[inline(always)]
+    fn new(origin: &[f64; 3], axis: &[f64; 3], z0: f64, z1: f64, r: f64, pv: f64) -> Self {
+        let mut p = [s(0.0); 3];
+        p[V] = s(pv - origin[V]);
+        p[K] = s(-origin[K]);
+        let dz = axis[K];
+        CylinderKernel {
+            origin_u: s(origin[U]),
+            p,
+            w: splat3(axis),
+            dz,
+            a: s(1.0 - dz * dz),
+            rr: s(r * r),
             z0,
             z1,
-            r,
-        } => {
-            let (lz, b, c) = along::<K, U, V>(pu, pv, &origin, &axis);
-            let dz = axis[K];
-            let (a, c) = (s(1.0 - dz * dz), c - s(r * r));
-            // The span is the slab met with the radial span: it starts no
-            // lower than either.
-            let skip = slab_lo_at_least(lz, dz, z0, z1, m) | quadratic_lo_at_least(a, b, c, m);
-            let need = gate & !skip;
-            if !need.any() {
-                return (need, NONE);
-            }
-            (need, meet(slab(lz, dz, z0, z1), quadratic_le0(a, b, c)))
         }
-        RowSolid::Sphere {
-            origin,
-            axis,
-            zc,
-            r,
-        } => {
-            let (lz, b, c) = along::<K, U, V>(pu, pv, &origin, &axis);
-            let dz = axis[K];
-            let zr = lz - s(zc);
-            let (a, b, c) = (
-                s(1.0 - dz * dz + dz * dz),
-                b + zr * s(dz),
-                c + zr * zr - s(r * r),
+    }
+
+    /// `Local::along`: (z0, b, c).
+    #[inline(always)]
+    fn line(&self, pu: F) -> (F, F, F) {
+        let mut p = self.p;
+        p[U] = pu - self.origin_u;
+        let w = &self.w;
+        let z0 = p[0] * w[0] + p[1] * w[1] + p[2] * w[2];
+        let pp = [p[0] - z0 * w[0], p[1] - z0 * w[1], p[2] - z0 * w[2]];
+        (z0, pp[K], pp[0] * pp[0] + pp[1] * pp[1] + pp[2] * pp[2])
+    }
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K, U, V> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let (lz, b, c) = self.line(pu);
+        let c = c - self.rr;
+        // The span is the slab met with the radial span: it starts no lower
+        // than either.
+        let skip = quadratic_lo_at_least(self.a, b, c, m)
+            | slab_lo_at_least(lz, self.dz, self.z0, self.z1, m);
+        let need = gate & !skip;
+        if !need.any() {
+            return (need, NONE);
+        }
+        (
+            need,
+            meet(
+                slab(lz, self.dz, self.z0, self.z1),
+                quadratic_le0(self.a, b, c),
+            ),
+        )
+    }
+}
+
+/// A sphere piece: `Local::along` and the sphere of `piece_span`.
+struct SphereKernel<const K: usize, const U: usize, const V: usize> {
+    line: CylinderKernel<K, U, V>,
+    zc: F,
+    dz: F,
+    a: F,
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for SphereKernel<K, U, V> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let (lz, b, c) = self.line.line(pu);
+        let zr = lz - self.zc;
+        let (b, c) = (b + zr * self.dz, c + zr * zr - self.line.rr);
+        let need = gate & !quadratic_lo_at_least(self.a, b, c, m);
+        if !need.any() {
+            return (need, NONE);
+        }
+        (need, quadratic_le0(self.a, b, c))
+    }
+}
+
+/// A capsule: `capsule_span`.
+struct CapsuleKernel<'a, const K: usize, const U: usize, const V: usize> {
+    k: &'a Capsule,
+    pv: F,
+    d: [F; 3],
+    c0: [F; 3],
+    c1: [F; 3],
+    w: [F; 3],
+    dp: [F; 3],
+    rr: F,
+    a: F,
+}
+
+impl<const K: usize, const U: usize, const V: usize> CapsuleKernel<'_, K, U, V> {
+    /// A sphere's (b, c) (a = 1).
+    #[inline(always)]
+    fn sphere(&self, o: &[F; 3], c: &[F; 3]) -> (F, F) {
+        let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+        (dot(&oc, &self.d), dot(&oc, &oc) - self.rr)
+    }
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for CapsuleKernel<'_, K, U, V> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let mut o = [s(0.0); 3];
+        o[U] = pu;
+        o[V] = self.pv;
+        let (b0, c0) = self.sphere(&o, &self.c0);
+        let (b1, c1) = self.sphere(&o, &self.c1);
+        // `Local::new(o, d, c0, w)`.
+        let p = [o[0] - self.c0[0], o[1] - self.c0[1], o[2] - self.c0[2]];
+        let lz = dot(&p, &self.w);
+        let pp = [
+            p[0] - lz * self.w[0],
+            p[1] - lz * self.w[1],
+            p[2] - lz * self.w[2],
+        ];
+        let (b, c) = (dot(&pp, &self.dp), dot(&pp, &pp) - self.rr);
+        let one = s(1.0);
+        let (len, dz) = (self.k.len, self.k.dz);
+        // The hull starts at the lowest of its parts.
+        let spheres = quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
+        let line = if len > 0.0 {
+            quadratic_lo_at_least(self.a, b, c, m) | slab_lo_at_least(lz, dz, 0.0, len, m)
+        } else {
+            M::splat(true)
+        };
+        let need = gate & !(spheres & line);
+        if !need.any() {
+            return (need, NONE);
+        }
+        let mut span = hull(quadratic_le0(one, b0, c0), quadratic_le0(one, b1, c1));
+        if len > 0.0 {
+            span = hull(
+                span,
+                meet(slab(lz, dz, 0.0, len), quadratic_le0(self.a, b, c)),
             );
-            let need = gate & !quadratic_lo_at_least(a, b, c, m);
-            if !need.any() {
-                return (need, NONE);
-            }
-            (need, quadratic_le0(a, b, c))
         }
-        RowSolid::Capsule(ref k) => {
-            let o = ray_origin::<K, U, V>(pu, pv);
-            let d = splat3(&k.d);
-            let (b0, c0) = capsule_sphere(&o, &k.c0, &d, k.r);
-            let (b1, c1) = capsule_sphere(&o, &k.c1, &d, k.r);
-            let (lz, b, c) = capsule_line(&o, k);
-            let (a, c) = (s(k.a), c - s(k.r * k.r));
-            let one = s(1.0);
-            // The hull starts at the lowest of its parts.
-            let spheres =
-                quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
-            let line = if k.len > 0.0 {
-                slab_lo_at_least(lz, k.dz, 0.0, k.len, m) | quadratic_lo_at_least(a, b, c, m)
-            } else {
-                M::splat(true)
-            };
-            let need = gate & !(spheres & line);
-            if !need.any() {
-                return (need, NONE);
+        (need, span)
+    }
+}
+
+/// A solid without a lane kernel: the scalar span of every gated ray.
+struct ScalarKernel<'a> {
+    solids: &'a RowSolids<'a>,
+    solid: usize,
+    pv: f64,
+}
+
+impl Kernel for ScalarKernel<'_> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, _m: F, gate: M) -> (M, Opt) {
+        let mut out = NONE;
+        for l in 0..W {
+            if gate.lane(l)
+                && let Some(sp) = (self.solids.span)(self.solid, pu.0[l], self.pv)
+            {
+                out.lo.0[l] = sp.lo;
+                out.hi.0[l] = sp.hi;
+                out.some.0[l] = u64::MAX;
             }
-            let mut span = hull(quadratic_le0(one, b0, c0), quadratic_le0(one, b1, c1));
-            if k.len > 0.0 {
-                span = hull(
-                    span,
-                    meet(slab(lz, k.dz, 0.0, k.len), quadratic_le0(a, b, c)),
-                );
-            }
-            (need, span)
         }
-        RowSolid::Other => (M::splat(false), NONE),
+        (gate, out)
     }
 }
 
@@ -507,6 +561,8 @@ pub(crate) struct Scratch {
     m: Vec<f64>,
     /// Rays with a span that meets the material but ends below its top.
     split: Vec<bool>,
+    /// The spans computed, by ray: what split rays subtract.
+    found: Vec<(u32, Span)>,
     spans: Vec<Span>,
 }
 
@@ -526,7 +582,7 @@ pub(crate) struct RowSolids<'a> {
     /// Each solid's bounds along the rays (lo, hi).
     pub along: &'a [(f64, f64)],
     /// The span of solid `i` on the ray at (`pu`, `pv`): `kernel`'s scalar
-    /// function, for [`RowSolid::Other`] and for split rays.
+    /// function, for [`RowSolid::Other`].
     pub span: &'a (dyn Fn(usize, f64, f64) -> Option<Span> + Sync),
 }
 
@@ -584,6 +640,56 @@ fn cut_row_any(
     }
 }
 
+/// The solid's rays `j0..=j1` of the row: skip test, exact spans, and the
+/// levels m lowered by the spans that reach the top. Returns whether a span
+/// ends inside a ray's material.
+#[inline(always)]
+fn sweep<Kn: Kernel>(
+    kern: &Kn,
+    (j0, j1): (usize, usize),
+    (lo_k, hi_k): (f64, f64),
+    sc: &mut Scratch,
+) -> bool {
+    let lane = F(std::array::from_fn(|i| i as f64));
+    let (j0f, j1f, lo_k, hi_k) = (s(j0 as f64), s(j1 as f64), s(lo_k), s(hi_k));
+    let mut any_split = false;
+    let mut base = j0 / W * W;
+    while base <= j1 {
+        let idx = s(base as f64) + lane;
+        let (first, last) = (F::load(&sc.first, base), F::load(&sc.last, base));
+        // The reference's gate: the ray's index within the solid's bounds
+        // and its material within the solid's extent.
+        let gate = idx.ge(j0f) & idx.le(j1f) & !(hi_k.le(first) | lo_k.ge(last));
+        if gate.any() {
+            let m = F::load(&sc.m, base);
+            let (need, span) = kern.chunk(F::load(&sc.pu, base), m, gate);
+            let keep = need & span.some;
+            if keep.any() {
+                let reach = keep & span.hi.ge(last);
+                (reach & span.lo.lt(m))
+                    .select(span.lo, m)
+                    .store(&mut sc.m, base);
+                let split = keep & !span.hi.ge(last) & span.hi.gt(first);
+                any_split |= split.any();
+                for i in 0..W {
+                    if keep.lane(i) {
+                        sc.found.push((
+                            (base + i) as u32,
+                            Span {
+                                lo: span.lo.0[i],
+                                hi: span.hi.0[i],
+                            },
+                        ));
+                        sc.split[base + i] |= split.lane(i);
+                    }
+                }
+            }
+        }
+        base += W;
+    }
+    any_split
+}
+
 #[inline(always)]
 fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     frame: &RowFrame,
@@ -600,84 +706,108 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     let n = b_max + 1 - a_min;
     let padded = n.div_ceil(W) * W;
     let pv = frame.pv;
-    for v in [&mut sc.pu, &mut sc.first, &mut sc.last] {
-        v.clear();
-    }
-    for j in 0..padded {
-        sc.pu
-            .push(frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h);
-        // Padding and empty rays: no solid passes the gate against their
-        // ends.
-        let (f, l) = match row.get(a_min + j).filter(|_| j < n) {
-            Some(ray) if !ray.is_empty() => (ray[0].lo, ray[ray.len() - 1].hi),
+    sc.pu.clear();
+    sc.first.clear();
+    sc.last.clear();
+    sc.pu
+        .extend((0..padded).map(|j| frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h));
+    for ray in &row[a_min..=b_max] {
+        // Empty rays (and the padding): no solid passes the gate against
+        // their ends.
+        let (f, l) = match (ray.first(), ray.last()) {
+            (Some(f), Some(l)) => (f.lo, l.hi),
             _ => (f64::INFINITY, f64::NEG_INFINITY),
         };
         sc.first.push(f);
         sc.last.push(l);
     }
+    sc.first.resize(padded, f64::INFINITY);
+    sc.last.resize(padded, f64::NEG_INFINITY);
     sc.m.clear();
     sc.m.extend_from_slice(&sc.last);
     sc.split.clear();
     sc.split.resize(padded, false);
+    sc.found.clear();
     let mut any_split = false;
-    let lane = F(std::array::from_fn(|i| i as f64));
     for act in active {
-        let (j0, j1) = (act.a - a_min, act.b - a_min);
-        let (lo_k, hi_k) = solids.along[act.solid];
-        let solid = &solids.prepared[act.solid];
-        let mut base = j0 / W * W;
-        while base <= j1 {
-            let idx = s(base as f64) + lane;
-            let (first, last) = (F::load(&sc.first, base), F::load(&sc.last, base));
-            // The reference's gate: the ray's index within the solid's
-            // bounds and its material within the solid's extent.
-            let gate = idx.ge(s(j0 as f64))
-                & idx.le(s(j1 as f64))
-                & !(s(hi_k).le(first) | s(lo_k).ge(last));
-            if gate.any() {
-                let m = F::load(&sc.m, base);
-                let (need, span) = if let RowSolid::Other = solid {
-                    scalar_spans(solids, act.solid, &sc.pu[base..base + W], pv, gate)
-                } else {
-                    chunk::<K, U, V>(solid, F::load(&sc.pu, base), pv, m, gate)
+        let range = (act.a - a_min, act.b - a_min);
+        let along = solids.along[act.solid];
+        any_split |= match solids.prepared[act.solid] {
+            RowSolid::Cylinder {
+                ref origin,
+                ref axis,
+                z0,
+                z1,
+                r,
+            } => sweep(
+                &CylinderKernel::<K, U, V>::new(origin, axis, z0, z1, r, pv),
+                range,
+                along,
+                sc,
+            ),
+            RowSolid::Sphere {
+                ref origin,
+                ref axis,
+                zc,
+                r,
+            } => {
+                let dz = axis[K];
+                let kern = SphereKernel {
+                    line: CylinderKernel::<K, U, V>::new(origin, axis, 0.0, 0.0, r, pv),
+                    zc: s(zc),
+                    dz: s(dz),
+                    a: s(1.0 - dz * dz + dz * dz),
                 };
-                let keep = need & span.some;
-                let reach = keep & span.hi.ge(last);
-                (reach & span.lo.lt(m))
-                    .select(span.lo, m)
-                    .store(&mut sc.m, base);
-                let split = keep & !span.hi.ge(last) & span.hi.gt(first);
-                if split.any() {
-                    for i in 0..W {
-                        sc.split[base + i] |= split.lane(i);
-                    }
-                    any_split = true;
-                }
+                sweep(&kern, range, along, sc)
             }
-            base += W;
-        }
+            RowSolid::Capsule(ref k) => {
+                let kern = CapsuleKernel::<K, U, V> {
+                    k,
+                    pv: s(pv),
+                    d: splat3(&k.d),
+                    c0: splat3(&k.c0),
+                    c1: splat3(&k.c1),
+                    w: splat3(&k.w),
+                    dp: splat3(&k.dp),
+                    rr: s(k.r * k.r),
+                    a: s(k.a),
+                };
+                sweep(&kern, range, along, sc)
+            }
+            RowSolid::Other => {
+                let kern = ScalarKernel {
+                    solids,
+                    solid: act.solid,
+                    pv,
+                };
+                sweep(&kern, range, along, sc)
+            }
+        };
     }
     for j in 0..n {
-        let ray = &mut row[a_min + j];
-        if sc.split[j] {
-            // The reference procedure for this ray: every span, united.
-            sc.spans.clear();
-            for act in active {
-                let (lo_k, hi_k) = solids.along[act.solid];
-                if (act.a..=act.b).contains(&(a_min + j))
-                    && !(hi_k <= sc.first[j] || lo_k >= sc.last[j])
-                    && let Some(sp) = (solids.span)(act.solid, sc.pu[j], pv)
-                {
-                    sc.spans.push(sp);
-                }
-            }
-            remove_spans(ray, &mut sc.spans, id);
-        } else if sc.m[j] < sc.last[j] {
+        if !sc.split[j] && sc.m[j] < sc.last[j] {
             // Every span that met the material reached its top.
-            cut_top(ray, sc.m[j], id);
+            cut_top(&mut row[a_min + j], sc.m[j], id);
         }
     }
-    let _ = any_split;
+    if !any_split {
+        return;
+    }
+    // Rays with a span that ends inside the material: the union of their
+    // spans (those skipped add nothing within the material), as the
+    // reference subtracts it.
+    sc.found.retain(|&(j, _)| sc.split[j as usize]);
+    sc.found.sort_by_key(|&(j, _)| j);
+    let mut i = 0;
+    while i < sc.found.len() {
+        let j = sc.found[i].0;
+        sc.spans.clear();
+        while i < sc.found.len() && sc.found[i].0 == j {
+            sc.spans.push(sc.found[i].1);
+            i += 1;
+        }
+        remove_spans(&mut row[a_min + j as usize], &mut sc.spans, id);
+    }
 }
 
 /// `subtract(ray, m, +∞, id)` for m below the ray's top, with the one
@@ -696,22 +826,6 @@ fn cut_top(ray: &mut Ray, m: f64, id: u32) {
     } else {
         subtract(ray, m, f64::INFINITY, id);
     }
-}
-
-/// The scalar spans of a solid without a lane kernel, on the gated lanes.
-#[inline(always)]
-fn scalar_spans(solids: &RowSolids, i: usize, pu: &[f64], pv: f64, gate: M) -> (M, Opt) {
-    let mut out = NONE;
-    for l in 0..W {
-        if gate.lane(l)
-            && let Some(sp) = (solids.span)(i, pu[l], pv)
-        {
-            out.lo.0[l] = sp.lo;
-            out.hi.0[l] = sp.hi;
-            out.some.0[l] = u64::MAX;
-        }
-    }
-    (gate, out)
 }
 
 #[cfg(test)]
