@@ -369,10 +369,139 @@ trait Kernel {
     /// The rays (lanes of `gate`) at `pu` whose span is not certainly at or
     /// above `m`, and their spans (meaningful on those lanes).
     fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt);
+
+    /// Whether the span of every ray of the row at a coordinate in [pa, pb]
+    /// (rays `pa` to `pb`) certainly starts at or above `m` (or is empty);
+    /// `false` when not certain.
+    #[inline(always)]
+    fn segment_skips(&self, _pa: f64, _pb: f64, _m: f64) -> bool {
+        false
+    }
+}
+
+/// A closed interval enclosing the *computed* values of an expression over
+/// the rays of a row segment. Rounding to nearest is monotone, so a
+/// rounded sum, difference or product of values within intervals lies
+/// within the same operation on their ends (by sign for products), and the
+/// ends are themselves rounded as the rays' values are.
+#[derive(Clone, Copy, Debug)]
+struct Iv {
+    lo: f64,
+    hi: f64,
+}
+
+impl Iv {
+    #[inline(always)]
+    fn point(x: f64) -> Iv {
+        Iv { lo: x, hi: x }
+    }
+    #[inline(always)]
+    fn add(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
+        }
+    }
+    #[inline(always)]
+    fn sub(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo - o.hi,
+            hi: self.hi - o.lo,
+        }
+    }
+    /// Times a float (its sign decides the order of the ends).
+    #[inline(always)]
+    fn times(self, c: f64) -> Iv {
+        let (a, b) = (self.lo * c, self.hi * c);
+        if c >= 0.0 {
+            Iv { lo: a, hi: b }
+        } else {
+            Iv { lo: b, hi: a }
+        }
+    }
+    #[inline(always)]
+    fn square(self) -> Iv {
+        let (a, b) = (self.lo * self.lo, self.hi * self.hi);
+        if self.lo >= 0.0 {
+            Iv { lo: a, hi: b }
+        } else if self.hi <= 0.0 {
+            Iv { lo: b, hi: a }
+        } else {
+            Iv {
+                lo: 0.0,
+                hi: a.max(b),
+            }
+        }
+    }
+    #[inline(always)]
+    fn abs_max(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+}
+
+/// [`quadratic_lo_at_least_common`] for every (a, b, c) with b, c within
+/// intervals, and every level up to `m`: its conditions at their worst
+/// corner. With m' = fl(m·(1 + 64u)) ≥ each ray's m' (b < 0 < m'): |b| ≥
+/// a·m' is hardest at the smallest |b|; c − m'|b| ≥ 0 at the smallest c and
+/// largest |b|; g(m') = a·m'² + 2b·m' + c grows with b and c, so its least
+/// value is at the least b and c; |e| is largest at the largest b² and |a·c|.
+/// Every ray's span is also empty when the largest discriminant is negative.
+#[inline(always)]
+fn quadratic_segment_skips(a: f64, b: Iv, c: Iv, m: f64) -> bool {
+    if !(b.hi < 0.0 && m > 1e-200 && m < f64::INFINITY) {
+        return false;
+    }
+    let (up, down) = (1.0 + SLACK, 1.0 - SLACK);
+    let (b_abs_lo, b_abs_hi) = (-b.hi, -b.lo);
+    let c_abs = c.abs_max();
+    // `quadratic_le0`'s linear branch on no ray.
+    if a <= 1e-15 * (b_abs_hi + c_abs).max(1e-300) || a == 0.0 {
+        return false;
+    }
+    let bb2_hi = b_abs_hi * b_abs_hi;
+    if bb2_hi - a * c.lo < 0.0 {
+        // Every discriminant below zero: no span.
+        return true;
+    }
+    let m1 = m * (1.0 + 2.0 * SLACK);
+    let am = a * m1;
+    let first = b_abs_lo >= am * up + TINY;
+    let y_ok = c.lo * down >= (m1 * b_abs_hi) * up + TINY;
+    let (g1, g2) = (am * m1, (2.0 * b.lo) * m1);
+    let g = (g1 + g2 + c.lo) - SLACK * (g1 - g2 + c_abs) - TINY;
+    let e = 4.0 * U * (bb2_hi + (a * c_abs).abs());
+    first && y_ok && (c.lo * g) * down >= ((m1 * m1) * e) * up + TINY
+}
+
+/// [`slab_lo_at_least`] for every z0 within an interval and every level up
+/// to `m` (the bound on the quotient grows with m).
+#[inline(always)]
+fn slab_segment_skips(z0: Iv, dz: f64, zlo: f64, zhi: f64, m: f64) -> bool {
+    let (a0_lo, a1_lo) = (zlo - z0.hi, z0.lo - zhi);
+    if dz == 0.0 {
+        return a0_lo > 0.0 || a1_lo > 0.0;
+    }
+    if !(m.abs() < f64::INFINITY) {
+        return false;
+    }
+    let md = m * dz;
+    let bound = md.abs() * SLACK + TINY;
+    if dz > 0.0 {
+        a0_lo >= md + bound
+    } else if dz < 0.0 {
+        a1_lo >= -md + bound
+    } else {
+        false
+    }
 }
 
 /// A cylinder piece: `Local::along` and `kernel::cylinder`.
 struct CylinderKernel<const K: usize, const U: usize, const V: usize> {
+    /// The same constants as scalars, for [`Kernel::segment_skips`].
+    origin_f: [f64; 3],
+    axis_f: [f64; 3],
+    pv: f64,
+    r: f64,
     origin_u: F,
     /// p[V]·w[V] and p[K]·w[K] are constant along the row, but are summed in
     /// `Local::along`'s order with the varying term, so only the vectors
@@ -394,6 +523,10 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
         p[K] = s(-origin[K]);
         let dz = axis[K];
         CylinderKernel {
+            origin_f: *origin,
+            axis_f: *axis,
+            pv,
+            r,
             origin_u: s(origin[U]),
             p,
             w: splat3(axis),
@@ -417,7 +550,39 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
     }
 }
 
+impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
+    /// `Local::along` on the rays with pu in [pa, pb]: enclosures of the
+    /// computed (z0, b, c) (the same operations, [`Iv`]).
+    #[inline(always)]
+    fn line_segment(&self, pa: f64, pb: f64) -> (Iv, Iv, Iv) {
+        let (o, w) = (&self.origin_f, &self.axis_f);
+        let mut p = [Iv::point(0.0); 3];
+        p[U] = Iv {
+            lo: pa - o[U],
+            hi: pb - o[U],
+        };
+        p[V] = Iv::point(self.pv - o[V]);
+        p[K] = Iv::point(-o[K]);
+        let z0 = p[0].times(w[0]).add(p[1].times(w[1])).add(p[2].times(w[2]));
+        let pp = [
+            p[0].sub(z0.times(w[0])),
+            p[1].sub(z0.times(w[1])),
+            p[2].sub(z0.times(w[2])),
+        ];
+        let c = pp[0].square().add(pp[1].square()).add(pp[2].square());
+        (z0, pp[K], c)
+    }
+}
+
 impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K, U, V> {
+    #[inline(always)]
+    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
+        let (z0, b, c) = self.line_segment(pa, pb);
+        let dz = self.axis_f[K];
+        slab_segment_skips(z0, dz, self.z0, self.z1, m)
+            || quadratic_segment_skips(1.0 - dz * dz, b, c.sub(Iv::point(self.r * self.r)), m)
+    }
+
     #[inline(always)]
     fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
         let (lz, b, c) = self.line(pu);
@@ -651,8 +816,39 @@ fn sweep<Kn: Kernel>(
     sc: &mut Scratch,
 ) -> bool {
     let lane = F(std::array::from_fn(|i| i as f64));
-    let (j0f, j1f, lo_k, hi_k) = (s(j0 as f64), s(j1 as f64), s(lo_k), s(hi_k));
+    let (lo_k, hi_k) = (s(lo_k), s(hi_k));
     let mut any_split = false;
+    // Whole segments first, from either end, in doubling steps while they
+    // are certainly above their levels; then the rest four rays at a time.
+    // [j0, end) is what is left.
+    let (mut j0, mut end) = (j0, j1 + 1);
+    let seg_max = |sc: &Scratch, a: usize, b: usize| {
+        sc.m[a..b].iter().fold(f64::NEG_INFINITY, |x, &y| x.max(y))
+    };
+    let mut step = 2 * W;
+    while j0 + step <= end
+        && kern.segment_skips(sc.pu[j0], sc.pu[j0 + step - 1], seg_max(sc, j0, j0 + step))
+    {
+        j0 += step;
+        step *= 2;
+    }
+    step = 2 * W;
+    while end >= j0 + step
+        && kern.segment_skips(
+            sc.pu[end - step],
+            sc.pu[end - 1],
+            seg_max(sc, end - step, end),
+        )
+    {
+        end -= step;
+        step *= 2;
+    }
+    if end <= j0 {
+        return false;
+    }
+    let j1 = end - 1;
+    let j0f = s(j0 as f64);
+    let j1f = s(j1 as f64);
     let mut base = j0 / W * W;
     while base <= j1 {
         let idx = s(base as f64) + lane;
