@@ -726,7 +726,7 @@ pub(crate) struct Scratch {
     m: Vec<f64>,
     /// Rays with a span that meets the material but ends below its top.
     split: Vec<bool>,
-    /// The spans computed, by ray: what split rays subtract.
+    /// The spans that end inside their ray's material.
     found: Vec<(u32, Span)>,
     spans: Vec<Span>,
 }
@@ -865,18 +865,22 @@ fn sweep<Kn: Kernel>(
                 (reach & span.lo.lt(m))
                     .select(span.lo, m)
                     .store(&mut sc.m, base);
+                // Spans that end inside the material are kept for their
+                // ray; the others are all summed up by m.
                 let split = keep & !span.hi.ge(last) & span.hi.gt(first);
-                any_split |= split.any();
-                for i in 0..W {
-                    if keep.lane(i) {
-                        sc.found.push((
-                            (base + i) as u32,
-                            Span {
-                                lo: span.lo.0[i],
-                                hi: span.hi.0[i],
-                            },
-                        ));
-                        sc.split[base + i] |= split.lane(i);
+                if split.any() {
+                    any_split = true;
+                    for i in 0..W {
+                        if split.lane(i) {
+                            sc.found.push((
+                                (base + i) as u32,
+                                Span {
+                                    lo: span.lo.0[i],
+                                    hi: span.hi.0[i],
+                                },
+                            ));
+                            sc.split[base + i] = true;
+                        }
                     }
                 }
             }
@@ -989,20 +993,26 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     if !any_split {
         return;
     }
-    // Rays with a span that ends inside the material: the union of their
-    // spans (those skipped add nothing within the material), as the
+    // Rays with a span that ends inside the material: the union of those
+    // spans and of [m, +∞), which within the material is the union of the
+    // spans that reach the top (those skipped add nothing there), as the
     // reference subtracts it.
-    sc.found.retain(|&(j, _)| sc.split[j as usize]);
     sc.found.sort_by_key(|&(j, _)| j);
     let mut i = 0;
     while i < sc.found.len() {
-        let j = sc.found[i].0;
+        let j = sc.found[i].0 as usize;
         sc.spans.clear();
-        while i < sc.found.len() && sc.found[i].0 == j {
+        while i < sc.found.len() && sc.found[i].0 as usize == j {
             sc.spans.push(sc.found[i].1);
             i += 1;
         }
-        remove_spans(&mut row[a_min + j as usize], &mut sc.spans, id);
+        if sc.m[j] < sc.last[j] {
+            sc.spans.push(Span {
+                lo: sc.m[j],
+                hi: f64::INFINITY,
+            });
+        }
+        remove_spans(&mut row[a_min + j], &mut sc.spans, id);
     }
 }
 
