@@ -650,6 +650,47 @@ impl<const K: usize, const U: usize, const V: usize> CapsuleKernel<'_, K, U, V> 
 }
 
 impl<const K: usize, const U: usize, const V: usize> Kernel for CapsuleKernel<'_, K, U, V> {
+    /// Every part certainly above m on every ray of the segment ([`Iv`]
+    /// enclosures of the same operations as [`Kernel::chunk`]).
+    #[inline(always)]
+    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
+        let k = self.k;
+        let mut o = [Iv::point(0.0); 3];
+        o[U] = Iv { lo: pa, hi: pb };
+        o[V] = Iv::point(self.pv.0[0]);
+        let dot = |x: &[Iv; 3], y: &[f64; 3]| {
+            x[0].times(y[0]).add(x[1].times(y[1])).add(x[2].times(y[2]))
+        };
+        let norm2 = |x: &[Iv; 3]| x[0].square().add(x[1].square()).add(x[2].square());
+        let minus = |x: &[Iv; 3], c: &[f64; 3]| {
+            [
+                x[0].sub(Iv::point(c[0])),
+                x[1].sub(Iv::point(c[1])),
+                x[2].sub(Iv::point(c[2])),
+            ]
+        };
+        let rr = Iv::point(k.r * k.r);
+        let sphere = |c: &[f64; 3]| {
+            let oc = minus(&o, c);
+            quadratic_segment_skips(1.0, dot(&oc, &k.d), norm2(&oc).sub(rr), m)
+        };
+        if !(sphere(&k.c0) && sphere(&k.c1)) {
+            return false;
+        }
+        if !(k.len > 0.0) {
+            return true;
+        }
+        let p = minus(&o, &k.c0);
+        let lz = dot(&p, &k.w);
+        let pp = [
+            p[0].sub(lz.times(k.w[0])),
+            p[1].sub(lz.times(k.w[1])),
+            p[2].sub(lz.times(k.w[2])),
+        ];
+        slab_segment_skips(lz, k.dz, 0.0, k.len, m)
+            || quadratic_segment_skips(k.a, dot(&pp, &k.dp), norm2(&pp).sub(rr), m)
+    }
+
     #[inline(always)]
     fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
         let mut o = [s(0.0); 3];
@@ -668,14 +709,18 @@ impl<const K: usize, const U: usize, const V: usize> Kernel for CapsuleKernel<'_
         let (b, c) = (dot(&pp, &self.dp), dot(&pp, &pp) - self.rr);
         let one = s(1.0);
         let (len, dz) = (self.k.len, self.k.dz);
-        // The hull starts at the lowest of its parts.
-        let spheres = quadratic_lo_at_least(one, b0, c0, m) & quadratic_lo_at_least(one, b1, c1, m);
-        let line = if len > 0.0 {
-            quadratic_lo_at_least(self.a, b, c, m) | slab_lo_at_least(lz, dz, 0.0, len, m)
-        } else {
-            M::splat(true)
-        };
-        let need = gate & !(spheres & line);
+        // The hull starts at the lowest of its parts: a ray needs its span
+        // unless every part is certainly above m. The parts are tested one
+        // after the other while some gated ray may still be skipped.
+        let mut need = gate & !quadratic_lo_at_least(one, b0, c0, m);
+        if need != gate {
+            need = need | (gate & !quadratic_lo_at_least(one, b1, c1, m));
+        }
+        if need != gate && len > 0.0 {
+            let line =
+                quadratic_lo_at_least(self.a, b, c, m) | slab_lo_at_least(lz, dz, 0.0, len, m);
+            need = need | (gate & !line);
+        }
         if !need.any() {
             return (need, NONE);
         }
