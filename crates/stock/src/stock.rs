@@ -707,16 +707,17 @@ impl Stock {
             return;
         };
         let (origin, h, counts) = (self.origin, self.resolution, self.counts);
-        for f in &mut self.families {
+        // The three families at once (their rays are apart), each by rows.
+        self.families.par_iter_mut().for_each(|f| {
             let (k, u, v, nu) = (f.axis, f.u, f.v, f.nu);
             let (Some((u0, u1)), Some((v0, v1))) = (
                 index_range(origin[u], h, counts[u], lo[u], hi[u]),
                 index_range(origin[v], h, counts[v], lo[v], hi[v]),
             ) else {
-                continue;
+                return;
             };
             if hi[k] < origin[k] || lo[k] > origin[k] + counts[k] as f64 * h {
-                continue;
+                return;
             }
             let mut d = Vector3::zeros();
             d[k] = 1.0;
@@ -734,9 +735,13 @@ impl Stock {
                 along: &along,
                 span: &span,
             };
+            // A few tasks a thread: a move's work is a fraction of a
+            // millisecond, so finer tasks cost more than they balance.
+            let rows = v1 + 1 - v0;
+            let per_task = rows.div_ceil(4 * rayon::current_num_threads()).max(4);
             f.rays[v0 * nu..(v1 + 1) * nu]
                 .par_chunks_mut(nu)
-                .with_min_len(8)
+                .with_min_len(per_task)
                 .enumerate()
                 .for_each(|(jv, row)| {
                     SCRATCH.with_borrow_mut(|(active, scratch)| {
@@ -762,7 +767,7 @@ impl Stock {
                         cut_row(&frame, row, active, &row_solids, id, scratch);
                     })
                 });
-        }
+        });
     }
 }
 
