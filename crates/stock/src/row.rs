@@ -589,9 +589,10 @@ impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K
         let c = c - self.rr;
         // The span is the slab met with the radial span: it starts no lower
         // than either.
-        let skip = quadratic_lo_at_least(self.a, b, c, m)
-            | slab_lo_at_least(lz, self.dz, self.z0, self.z1, m);
-        let need = gate & !skip;
+        let mut need = gate & !quadratic_lo_at_least(self.a, b, c, m);
+        if need.any() {
+            need = need & !slab_lo_at_least(lz, self.dz, self.z0, self.z1, m);
+        }
         if !need.any() {
             return (need, NONE);
         }
