@@ -810,7 +810,7 @@ pub(crate) fn cut_row(
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::is_x86_feature_detected!("avx2") {
+        if !portable_forced() && std::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2 (checked just above), the one
             // requirement of `cut_row_avx2`.
             unsafe { cut_row_avx2(frame, row, active, solids, id, scratch) };
@@ -818,6 +818,22 @@ pub(crate) fn cut_row(
         }
     }
     cut_row_any(frame, row, active, solids, id, scratch);
+}
+
+/// Tests can force the portable path, to check it on processors with AVX2.
+#[cfg(test)]
+pub(crate) static FORCE_PORTABLE: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+#[cfg(test)]
+fn portable_forced() -> bool {
+    FORCE_PORTABLE.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn portable_forced() -> bool {
+    false
 }
 
 /// [`cut_row`] compiled for AVX2: the same operations, four lanes in one

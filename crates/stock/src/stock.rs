@@ -863,3 +863,86 @@ fn interpolate(a: &ToolPose, b: &ToolPose, s: f64) -> Option<ToolPose> {
         reference,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bytes(s: &Stock) -> Vec<u8> {
+        let mut out = Vec::new();
+        for f in &s.families {
+            for ray in &f.rays {
+                out.extend((ray.len() as u32).to_le_bytes());
+                for seg in ray {
+                    out.extend(seg.lo.to_bits().to_le_bytes());
+                    out.extend(seg.hi.to_bits().to_le_bytes());
+                    out.extend(seg.lo_move.to_le_bytes());
+                    out.extend(seg.hi_move.to_le_bytes());
+                }
+            }
+        }
+        out
+    }
+
+    /// Wheel (sampled, cylinders), ball (capsules), bull nose and drill
+    /// (no lane kernel) on a stock across the origin.
+    fn cut_all(removal: Removal) -> Vec<u8> {
+        let mut s = Stock::from_box(
+            Point3::new(-6.0, -4.0, -3.0),
+            Point3::new(6.0, 4.0, 1.0),
+            0.1,
+        )
+        .unwrap();
+        s.set_removal(removal);
+        let tools = [
+            Tool::ContactWheel {
+                radius: 15.0,
+                width: 5.0,
+                edge_radius: 0.0,
+            },
+            Tool::BallEnd {
+                diameter: 2.0,
+                flute_length: 6.0,
+                shank: None,
+            },
+            Tool::BullNose {
+                diameter: 3.0,
+                corner_radius: 0.5,
+                flute_length: 6.0,
+                shank: None,
+            },
+            Tool::Drill {
+                diameter: 1.5,
+                point_angle_deg: 118.0,
+                flute_length: 5.0,
+            },
+        ];
+        let mut id = 0;
+        for (t, tool) in tools.iter().enumerate() {
+            let y = -3.0 + 2.0 * t as f64;
+            for i in 0..40 {
+                let x = -5.0 + 0.25 * i as f64;
+                let tilt = 0.05 * (i as f64).sin();
+                let pose = |x: f64, tilt: f64| {
+                    ToolPose::new(Point3::new(x, y, 0.7), Vector3::new(0.0, -tilt, 1.0))
+                        .with_reference(Vector3::x())
+                };
+                s.cut_move(tool, &pose(x, tilt), &pose(x + 0.25, -tilt), id)
+                    .unwrap();
+                id += 1;
+            }
+        }
+        bytes(&s)
+    }
+
+    #[test]
+    fn the_portable_and_the_avx2_paths_give_the_reference_stock() {
+        let reference = cut_all(Removal::Reference);
+        crate::row::FORCE_PORTABLE.store(true, std::sync::atomic::Ordering::Relaxed);
+        let portable = cut_all(Removal::Fast);
+        crate::row::FORCE_PORTABLE.store(false, std::sync::atomic::Ordering::Relaxed);
+        let dispatched = cut_all(Removal::Fast);
+        assert!(portable == reference, "the portable path differs");
+        assert!(dispatched == reference, "the dispatched path differs");
+    }
+}
