@@ -5,7 +5,9 @@
 //!   passes along X, 1.5 mm apart, 0.05 mm deep, in moves of 0.1 mm (100,000
 //!   moves), the tool axis on the flat's normal tilting ±0.2° across the
 //!   feed (period 37 mm; the belt's edges dip 0.04 mm), so every move turns
-//!   the wheel's axis: five-axis moves, sampled (2 poses a move).
+//!   the wheel's axis: five-axis moves, sampled (3 new poses a move: 0.1 mm
+//!   of travel and the turn move a point of the wheel by just over two ray
+//!   spacings).
 //! * `ball_3axis`: a 6 mm ball end mill, 0.5 mm deep, the same zig-zag in
 //!   0.1 mm moves (pure translations, swept exactly).
 //! * `compare`: a 250 × 80 × 40 stock at 0.0576 mm (10 million rays)

@@ -118,10 +118,11 @@ pub struct MoveCut {
 /// How a cut visits the rays. Both give the same stock, bit for bit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Removal {
-    /// Skips, ray by ray, a solid whose span certainly changes nothing: it
-    /// starts at or above the top of the ray's material, or above the start
-    /// of a span already found that reaches the top (a test with products
-    /// and sums only, see `kernel::quadratic_lo_at_least`).
+    /// Skips a solid where its span certainly changes nothing: it starts at
+    /// or above the top of the ray's material, or above the start of a span
+    /// already found that reaches the top (a test with products and sums
+    /// only, every rounding bounded; ray by ray, or a whole row segment at
+    /// once), and computes the other spans four rays at a time.
     #[default]
     Fast,
     /// Computes the span of every solid on every ray within its bounds: the
@@ -693,15 +694,15 @@ impl Stock {
     }
 
     /// The fast removal: the same stock as [`Stock::remove_reference`], bit
-    /// for bit, computing fewer spans. On each ray the solids are visited
-    /// last first (the most advanced sample of a move is the deepest on most
-    /// rays it meets) and a solid is skipped when its span certainly starts
-    /// at or above m: the top of the ray's material, lowered to the start of
-    /// every span found that reaches the top. Such a span adds nothing to
-    /// the union of the spans within the material, and the subtraction
-    /// depends on nothing else: a union's pieces that miss the material
-    /// (first, last) are no-ops in [`subtract`], and a piece that reaches
-    /// beyond an end of the material acts as if it ended there.
+    /// for bit, computing far fewer spans. Each family's rows go to
+    /// [`crate::row::cut_row`] (the three families at once, rows in
+    /// parallel): on each ray the solids are visited last first (the most
+    /// advanced sample of a move is the deepest on most rays it meets), and
+    /// a solid is skipped where its span certainly starts at or above the
+    /// ray's level m (the top of its material, lowered to the start of every
+    /// span found that reaches the top), ray by ray or a whole row segment
+    /// at once. The reasons, and why this changes no bit, are in the
+    /// `row` module's doc.
     fn remove_fast(&mut self, solids: &[Bounded], id: u32) {
         let Some((lo, hi)) = solids_bounds(solids) else {
             return;
