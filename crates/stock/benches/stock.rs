@@ -5,7 +5,9 @@
 //!   passes along X, 1.5 mm apart, 0.05 mm deep, in moves of 0.1 mm (100,000
 //!   moves), the tool axis on the flat's normal tilting ±0.2° across the
 //!   feed (period 37 mm; the belt's edges dip 0.04 mm), so every move turns
-//!   the wheel's axis: five-axis moves, sampled (2 poses a move).
+//!   the wheel's axis: five-axis moves, sampled (3 new poses a move: 0.1 mm
+//!   of travel and the turn move a point of the wheel by just over two ray
+//!   spacings).
 //! * `ball_3axis`: a 6 mm ball end mill, 0.5 mm deep, the same zig-zag in
 //!   0.1 mm moves (pure translations, swept exactly).
 //! * `compare`: a 250 × 80 × 40 stock at 0.0576 mm (10 million rays)
@@ -19,40 +21,13 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use kinpost_stock::{Design, Mesh, Stock, Tool, ToolPose, compare};
-use nalgebra::{Point3, Vector3};
+use nalgebra::Point3;
+
+mod programs;
+use program::stock;
+use programs as program;
 
 const CHUNK: usize = 500;
-
-fn stock(h: f64) -> Stock {
-    Stock::from_box(
-        Point3::new(0.0, 0.0, 0.0),
-        Point3::new(250.0, 80.0, 40.0),
-        h,
-    )
-    .unwrap()
-}
-
-/// 100,000 poses: 40 passes of 2,500 steps of 0.1 mm.
-fn program(z: f64, lean_deg: f64, tilt_deg: f64) -> Vec<ToolPose> {
-    let mut poses = Vec::with_capacity(100_000);
-    for pass in 0..40 {
-        let y = 10.0 + 1.5 * pass as f64;
-        let forward = pass % 2 == 0;
-        for i in 0..2500 {
-            let s = i as f64 * 0.1;
-            let x = if forward { s } else { 250.0 - s };
-            let lean = lean_deg.to_radians() * (2.0 * std::f64::consts::PI * x / 50.0).sin();
-            let tilt = tilt_deg.to_radians() * (2.0 * std::f64::consts::PI * x / 37.0).cos();
-            let axis = Vector3::new(
-                lean.sin(),
-                -tilt.sin() * lean.cos(),
-                tilt.cos() * lean.cos(),
-            );
-            poses.push(ToolPose::new(Point3::new(x, y, z), axis).with_reference(Vector3::x()));
-        }
-    }
-    poses
-}
 
 fn run(c: &mut Criterion, name: &str, tool: Tool, poses: &[ToolPose], threads: usize) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -91,24 +66,14 @@ fn run(c: &mut Criterion, name: &str, tool: Tool, poses: &[ToolPose], threads: u
 }
 
 fn wheel(c: &mut Criterion) {
-    let tool = Tool::ContactWheel {
-        radius: 50.0,
-        width: 25.0,
-        edge_radius: 0.0,
-    };
-    let poses = program(39.95, 0.0, 0.2);
+    let (tool, poses) = program::wheel_5axis();
     for threads in [1, 2] {
         run(c, "wheel_5axis", tool, &poses, threads);
     }
 }
 
 fn ball(c: &mut Criterion) {
-    let tool = Tool::BallEnd {
-        diameter: 6.0,
-        flute_length: 20.0,
-        shank: None,
-    };
-    let poses = program(39.5, 0.0, 0.0);
+    let (tool, poses) = program::ball_3axis();
     for threads in [1, 2] {
         run(c, "ball_3axis", tool, &poses, threads);
     }

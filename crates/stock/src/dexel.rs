@@ -111,3 +111,24 @@ pub fn add(ray: &mut Ray, a: f64, b: f64) {
     ray.drain(first..last);
     ray.insert(first, seg);
 }
+
+/// Subtracts the union of the spans from the ray.
+pub fn remove_spans(ray: &mut Ray, spans: &mut [crate::kernel::Span], id: u32) {
+    match spans.len() {
+        0 => {}
+        1 => subtract(ray, spans[0].lo, spans[0].hi, id),
+        _ => {
+            spans.sort_by(|a, b| a.lo.total_cmp(&b.lo));
+            let mut cur = spans[0];
+            for s in &spans[1..] {
+                if s.lo <= cur.hi {
+                    cur.hi = cur.hi.max(s.hi);
+                } else {
+                    subtract(ray, cur.lo, cur.hi, id);
+                    cur = *s;
+                }
+            }
+            subtract(ray, cur.lo, cur.hi, id);
+        }
+    }
+}

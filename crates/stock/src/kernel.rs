@@ -89,7 +89,7 @@ fn linear_le0(a0: f64, a1: f64) -> Option<Span> {
 }
 
 /// `t` with `lo ≤ z0 + dz·t ≤ hi`.
-fn slab(z0: f64, dz: f64, lo: f64, hi: f64) -> Option<Span> {
+pub(crate) fn slab(z0: f64, dz: f64, lo: f64, hi: f64) -> Option<Span> {
     meet(linear_le0(lo - z0, -dz), linear_le0(z0 - hi, dz))
 }
 

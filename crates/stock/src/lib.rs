@@ -40,6 +40,17 @@
 //! ([`clip`]); rows of rays run in parallel, each ray alone, so the result
 //! is the same bytes for any thread count.
 //!
+//! **Speed.** Most of a move's spans change nothing: a wheel's or a ball's
+//! surface behind its contact, or a sample of a move above the deeper one
+//! after it. The default [`Removal::Fast`] skips them where a test with
+//! products and sums only (no root, no quotient, every rounding bounded)
+//! proves that the span the kernel would compute starts at or above the
+//! ray's material, ray by ray or a whole row segment at once, and computes
+//! the others four rays at a time ([`Stock::set_removal`]; AVX2 chosen at
+//! run time). It gives the stock of [`Removal::Reference`], the
+//! straightforward evaluation of every span, bit for bit, on every
+//! processor and for any thread count.
+//!
 //! **Grinding process.** [`ProcessModel`]: the pressure axis's force table,
 //! a Winkler contact and Preston's removal law, read from a TOML process
 //! file; [`Stock::grind_move`] grinds with it; [`calibrate`] fits Preston's
@@ -81,10 +92,12 @@ pub mod contour;
 pub mod design;
 pub mod dexel;
 pub mod kernel;
+mod lanes;
 pub mod mesh;
 pub mod output;
 pub mod process;
 pub mod report;
+mod row;
 pub mod stock;
 pub mod tolerance;
 pub mod tool;
@@ -98,5 +111,5 @@ pub use process::{
     belt_speed_mm_s, calibrate,
 };
 pub use report::{BlockRef, GrindBlock, GrindingSummary, Report, ReportRegion};
-pub use stock::{CutError, Family, MoveCut, Stock, StockError, default_resolution};
+pub use stock::{CutError, Family, MoveCut, Removal, Stock, StockError, default_resolution};
 pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};

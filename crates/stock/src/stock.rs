@@ -4,8 +4,9 @@ use nalgebra::{Point3, Unit, Vector3};
 use rayon::prelude::*;
 
 use crate::clip::{Aabb, piece_in_box, swept_in_box};
-use crate::dexel::{Ray, Segment, UNCUT, subtract};
+use crate::dexel::{Ray, Segment, UNCUT, remove_spans};
 use crate::kernel::{Local, Span, capsule_span, cylinder_sweep_span, piece_span};
+use crate::row::{Active, Capsule, RowFrame, RowSolid, RowSolids, Scratch, cut_row};
 use crate::tolerance::{
     DEFAULT_RAY_BUDGET, MAX_RAYS, NICE_RESOLUTIONS_MM, SAME_AXIS, SAMPLE_STEP_FRACTION,
 };
@@ -102,6 +103,7 @@ pub struct Stock {
     families: [Family; 3],
     initial_volume: f64,
     last: Option<(Tool, ToolPose)>,
+    removal: Removal,
 }
 
 /// How a move was cut.
@@ -111,6 +113,21 @@ pub struct MoveCut {
     pub samples: u64,
     /// Whether the move was swept analytically (a pure translation).
     pub analytic: bool,
+}
+
+/// How a cut visits the rays. Both give the same stock, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Removal {
+    /// Skips a solid where its span certainly changes nothing: it starts at
+    /// or above the top of the ray's material, or above the start of a span
+    /// already found that reaches the top (a test with products and sums
+    /// only, every rounding bounded; ray by ray, or a whole row segment at
+    /// once), and computes the other spans four rays at a time.
+    #[default]
+    Fast,
+    /// Computes the span of every solid on every ray within its bounds: the
+    /// straightforward path, the reference the fast one is tested against.
+    Reference,
 }
 
 /// A solid the cut removes, with its bounds.
@@ -164,6 +181,35 @@ impl Bounded {
                 r,
                 v,
             } => cylinder_sweep_span(o, d, origin, axis, *z0, *z1, *r, v),
+        }
+    }
+
+    /// The solid's batch kernel for rays along `d` (a unit axis).
+    fn row_solid(&self, d: &Vector3<f64>) -> RowSolid {
+        match self.solid {
+            Solid::Piece {
+                piece: Piece::Cylinder { z0, z1, r },
+                origin,
+                axis,
+            } => RowSolid::Cylinder {
+                origin: origin.into(),
+                axis: axis.into(),
+                z0,
+                z1,
+                r,
+            },
+            Solid::Piece {
+                piece: Piece::Sphere { zc, r },
+                origin,
+                axis,
+            } => RowSolid::Sphere {
+                origin: origin.into(),
+                axis: axis.into(),
+                zc,
+                r,
+            },
+            Solid::Capsule { c0, v, r } => RowSolid::Capsule(Capsule::new(&c0, &v, r, d)),
+            _ => RowSolid::Other,
         }
     }
 }
@@ -250,6 +296,7 @@ impl Stock {
             families: [family(0), family(1), family(2)],
             initial_volume: 0.0,
             last: None,
+            removal: Removal::Fast,
         })
     }
 
@@ -297,6 +344,16 @@ impl Stock {
             self.origin,
             std::array::from_fn(|i| self.origin[i] + self.counts[i] as f64 * self.resolution),
         )
+    }
+
+    /// How cuts visit the rays ([`Removal::Fast`] unless set).
+    pub fn removal(&self) -> Removal {
+        self.removal
+    }
+
+    /// Chooses how cuts visit the rays; both give the same stock.
+    pub fn set_removal(&mut self, removal: Removal) {
+        self.removal = removal;
     }
 
     /// The ray spacing, mm.
@@ -555,9 +612,19 @@ impl Stock {
     }
 
     /// Subtracts the union of the solids from every ray that crosses their
-    /// bounds. Rows of rays run in parallel; every ray is handled alone, so
-    /// the result does not depend on the thread count.
+    /// bounds, by the chosen [`Removal`].
     fn remove(&mut self, solids: &[Bounded], id: u32) {
+        match self.removal {
+            Removal::Fast => self.remove_fast(solids, id),
+            Removal::Reference => self.remove_reference(solids, id),
+        }
+    }
+
+    /// The straightforward removal: every solid's span on every ray within
+    /// the solid's bounds, united and subtracted. Rows of rays run in
+    /// parallel; every ray is handled alone, so the result does not depend
+    /// on the thread count.
+    fn remove_reference(&mut self, solids: &[Bounded], id: u32) {
         if solids.is_empty() {
             return;
         }
@@ -625,27 +692,144 @@ impl Stock {
                 });
         }
     }
+
+    /// The fast removal: the same stock as [`Stock::remove_reference`], bit
+    /// for bit, computing far fewer spans. Each family's rows go to
+    /// [`crate::row::cut_row`] (the three families at once, rows in
+    /// parallel): on each ray the solids are visited last first (the most
+    /// advanced sample of a move is the deepest on most rays it meets), and
+    /// a solid is skipped where its span certainly starts at or above the
+    /// ray's level m (the top of its material, lowered to the start of every
+    /// span found that reaches the top), ray by ray or a whole row segment
+    /// at once. The reasons, and why this changes no bit, are in the
+    /// `row` module's doc.
+    fn remove_fast(&mut self, solids: &[Bounded], id: u32) {
+        let Some((lo, hi)) = solids_bounds(solids) else {
+            return;
+        };
+        let (origin, h, counts) = (self.origin, self.resolution, self.counts);
+        // The three families at once (their rays are apart), each by rows.
+        self.families.par_iter_mut().for_each(|f| {
+            let (k, u, v, nu) = (f.axis, f.u, f.v, f.nu);
+            let (Some((u0, u1)), Some((v0, v1))) = (
+                index_range(origin[u], h, counts[u], lo[u], hi[u]),
+                index_range(origin[v], h, counts[v], lo[v], hi[v]),
+            ) else {
+                return;
+            };
+            if hi[k] < origin[k] || lo[k] > origin[k] + counts[k] as f64 * h {
+                return;
+            }
+            let mut d = Vector3::zeros();
+            d[k] = 1.0;
+            let kuv = (k, u, v);
+            let prepared: Vec<RowSolid> = solids.iter().map(|s| s.row_solid(&d)).collect();
+            let along: Vec<(f64, f64)> = solids.iter().map(|s| (s.lo[k], s.hi[k])).collect();
+            let span = |i: usize, pu: f64, pv: f64| {
+                let mut o = Vector3::zeros();
+                o[u] = pu;
+                o[v] = pv;
+                solids[i].span(&o, &d, kuv)
+            };
+            let row_solids = RowSolids {
+                prepared: &prepared,
+                along: &along,
+                span: &span,
+            };
+            // A few tasks a thread: a move's work is a fraction of a
+            // millisecond, so finer tasks cost more than they balance.
+            let rows = v1 + 1 - v0;
+            let per_task = rows.div_ceil(4 * rayon::current_num_threads()).max(4);
+            f.rays[v0 * nu..(v1 + 1) * nu]
+                .par_chunks_mut(nu)
+                .with_min_len(per_task)
+                .enumerate()
+                .for_each(|(jv, row)| {
+                    SCRATCH.with_borrow_mut(|(active, scratch)| {
+                        let frame = RowFrame {
+                            k,
+                            origin_u: origin[u],
+                            h,
+                            pv: origin[v] + ((v0 + jv) as f64 + 0.5) * h,
+                        };
+                        let pu_at = |iu: usize| origin[u] + (iu as f64 + 0.5) * h;
+                        // The solids that meet this row, last first, with
+                        // the rays within their bounds (the reference's test
+                        // lo ≤ pu ≤ hi; pu grows with the index).
+                        active.clear();
+                        for (si, s) in solids.iter().enumerate().rev() {
+                            if frame.pv < s.lo[v] || frame.pv > s.hi[v] {
+                                continue;
+                            }
+                            if let Some((a, b)) = rays_within(&pu_at, u0, u1, s.lo[u], s.hi[u]) {
+                                active.push(Active { solid: si, a, b });
+                            }
+                        }
+                        cut_row(&frame, row, active, &row_solids, id, scratch);
+                    })
+                });
+        });
+    }
 }
 
-/// Subtracts the union of the spans from the ray.
-fn remove_spans(ray: &mut Ray, spans: &mut [Span], id: u32) {
-    match spans.len() {
-        0 => {}
-        1 => subtract(ray, spans[0].lo, spans[0].hi, id),
-        _ => {
-            spans.sort_by(|a, b| a.lo.total_cmp(&b.lo));
-            let mut cur = spans[0];
-            for s in &spans[1..] {
-                if s.lo <= cur.hi {
-                    cur.hi = cur.hi.max(s.hi);
-                } else {
-                    subtract(ray, cur.lo, cur.hi, id);
-                    cur = *s;
-                }
-            }
-            subtract(ray, cur.lo, cur.hi, id);
+thread_local! {
+    /// Each thread's buffers for the rows it cuts, kept from move to move.
+    static SCRATCH: std::cell::RefCell<(Vec<Active>, Scratch)> = Default::default();
+}
+
+/// The union of the solids' bounds.
+fn solids_bounds(solids: &[Bounded]) -> Option<([f64; 3], [f64; 3])> {
+    if solids.is_empty() {
+        return None;
+    }
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for s in solids {
+        for i in 0..3 {
+            lo[i] = lo[i].min(s.lo[i]);
+            hi[i] = hi[i].max(s.hi[i]);
         }
     }
+    Some((lo, hi))
+}
+
+/// The first and last index in [a, b] whose coordinate `at(i)` (growing
+/// with i) is within [lo, hi]: a guess from the spacing, then corrected by
+/// the comparisons themselves.
+fn rays_within(
+    at: &impl Fn(usize) -> f64,
+    a: usize,
+    b: usize,
+    lo: f64,
+    hi: f64,
+) -> Option<(usize, usize)> {
+    // Binary searches for the first index with at(i) ≥ lo and the last with
+    // at(i) ≤ hi.
+    let first = {
+        let (mut l, mut r) = (a, b + 1);
+        while l < r {
+            let mid = l + (r - l) / 2;
+            if at(mid) >= lo { r = mid } else { l = mid + 1 }
+        }
+        l
+    };
+    let last = {
+        let (mut l, mut r) = (a, b + 1);
+        while l < r {
+            let mid = l + (r - l) / 2;
+            if at(mid) <= hi { l = mid + 1 } else { r = mid }
+        }
+        l.checked_sub(1)?
+    };
+    (first <= b && last >= first && last >= a).then_some((first, last))
+}
+
+/// Index range of the rays of a lattice axis (origin `o`, spacing `h`,
+/// `n` rays) whose coordinate is in [lo, hi].
+fn index_range(o: f64, h: f64, n: usize, lo: f64, hi: f64) -> Option<(usize, usize)> {
+    let a = ((lo - o) / h - 0.5).ceil().max(0.0);
+    let b = ((hi - o) / h - 0.5).floor().min(n as f64 - 1.0);
+    (a <= b).then_some((a as usize, b as usize))
 }
 
 fn sample_count(distance: f64, step: f64) -> Result<u64, CutError> {
@@ -679,4 +863,87 @@ fn interpolate(a: &ToolPose, b: &ToolPose, s: f64) -> Option<ToolPose> {
         axis,
         reference,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bytes(s: &Stock) -> Vec<u8> {
+        let mut out = Vec::new();
+        for f in &s.families {
+            for ray in &f.rays {
+                out.extend((ray.len() as u32).to_le_bytes());
+                for seg in ray {
+                    out.extend(seg.lo.to_bits().to_le_bytes());
+                    out.extend(seg.hi.to_bits().to_le_bytes());
+                    out.extend(seg.lo_move.to_le_bytes());
+                    out.extend(seg.hi_move.to_le_bytes());
+                }
+            }
+        }
+        out
+    }
+
+    /// Wheel (sampled, cylinders), ball (capsules), bull nose and drill
+    /// (no lane kernel) on a stock across the origin.
+    fn cut_all(removal: Removal) -> Vec<u8> {
+        let mut s = Stock::from_box(
+            Point3::new(-6.0, -4.0, -3.0),
+            Point3::new(6.0, 4.0, 1.0),
+            0.1,
+        )
+        .unwrap();
+        s.set_removal(removal);
+        let tools = [
+            Tool::ContactWheel {
+                radius: 15.0,
+                width: 5.0,
+                edge_radius: 0.0,
+            },
+            Tool::BallEnd {
+                diameter: 2.0,
+                flute_length: 6.0,
+                shank: None,
+            },
+            Tool::BullNose {
+                diameter: 3.0,
+                corner_radius: 0.5,
+                flute_length: 6.0,
+                shank: None,
+            },
+            Tool::Drill {
+                diameter: 1.5,
+                point_angle_deg: 118.0,
+                flute_length: 5.0,
+            },
+        ];
+        let mut id = 0;
+        for (t, tool) in tools.iter().enumerate() {
+            let y = -3.0 + 2.0 * t as f64;
+            for i in 0..40 {
+                let x = -5.0 + 0.25 * i as f64;
+                let tilt = 0.05 * (i as f64).sin();
+                let pose = |x: f64, tilt: f64| {
+                    ToolPose::new(Point3::new(x, y, 0.7), Vector3::new(0.0, -tilt, 1.0))
+                        .with_reference(Vector3::x())
+                };
+                s.cut_move(tool, &pose(x, tilt), &pose(x + 0.25, -tilt), id)
+                    .unwrap();
+                id += 1;
+            }
+        }
+        bytes(&s)
+    }
+
+    #[test]
+    fn the_portable_and_the_avx2_paths_give_the_reference_stock() {
+        let reference = cut_all(Removal::Reference);
+        crate::row::FORCE_PORTABLE.store(true, std::sync::atomic::Ordering::Relaxed);
+        let portable = cut_all(Removal::Fast);
+        crate::row::FORCE_PORTABLE.store(false, std::sync::atomic::Ordering::Relaxed);
+        let dispatched = cut_all(Removal::Fast);
+        assert!(portable == reference, "the portable path differs");
+        assert!(dispatched == reference, "the dispatched path differs");
+    }
 }

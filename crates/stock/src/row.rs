@@ -1,0 +1,1248 @@
+//! The fast removal along one row of rays.
+//!
+//! [`crate::stock`]'s fast removal hands each row of rays (one family, one
+//! index across the row) to [`cut_row`]. Each ray keeps a level m, at first
+//! the top of its material (`last`). The solids are visited one after the
+//! other (last sample first: on most rays it meets, the most advanced
+//! sample of a move is the deepest); for each, the rays within its bounds
+//! are taken four at a time ([`crate::lanes`]): a *skip test* asks whether
+//! the span the solid would compute there certainly starts at or above m,
+//! without a root or a quotient ([`quadratic_lo_at_least`]), and the rays
+//! that fail it get their exact span, with the operations, in the order, of
+//! [`crate::kernel`]'s scalar functions. A span that reaches the ray's top
+//! lowers m to its start. At the end, a ray whose spans all reached the top
+//! loses (m, top); a ray with a span that ends inside its material (rare for
+//! the family along the tool: a wheel's hole through a side ray) is cut by
+//! the reference procedure, every span computed.
+//!
+//! Why this is the reference's stock, bit for bit: the subtraction of a
+//! union of spans from a ray ([`remove_spans`]) depends only on the union
+//! within the ray's material (first, last): pieces that miss it are no-ops
+//! in [`subtract`], and a piece that reaches past an end acts as if it ended
+//! there (no piece is kept beyond it). A span that starts at or above m adds
+//! nothing within the material: m is the top, or the start of a span that
+//! reaches the top. If all spans that meet the material reach its top, their
+//! union within it is [m, top), so `subtract(m, +∞)` is the reference's cut.
+//!
+//! [`cut_row`] runs compiled for AVX2 when the processor has it, else for
+//! the x86-64 baseline (or any other target): the same operations on the
+//! same lanes, so the same bits on every processor and for any thread count
+//! (each ray is cut alone).
+
+use nalgebra::Vector3;
+
+use crate::dexel::{Ray, remove_spans, subtract};
+use crate::kernel::Span;
+use crate::lanes::{F, M, W};
+use crate::tolerance::SLIVER_MM;
+
+/// A solid prepared for the rays along axis `K` of one family: the
+/// constants of its span, taken from the same expressions as
+/// [`crate::kernel`]'s functions.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum RowSolid {
+    /// A cylinder piece (`Local::along` and `cylinder`).
+    Cylinder {
+        /// Frame origin and unit axis.
+        origin: [f64; 3],
+        axis: [f64; 3],
+        z0: f64,
+        z1: f64,
+        r: f64,
+    },
+    /// A sphere piece (`Local::along` and the sphere of `piece_span`).
+    Sphere {
+        origin: [f64; 3],
+        axis: [f64; 3],
+        zc: f64,
+        r: f64,
+    },
+    /// A sphere swept along a segment (`capsule_span`).
+    Capsule(Capsule),
+    /// No batch kernel: the scalar span, no skip test.
+    Other,
+}
+
+/// The constants of `capsule_span` for rays along one axis.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Capsule {
+    c0: [f64; 3],
+    c1: [f64; 3],
+    r: f64,
+    /// The segment's length, its unit direction w, and for the ray
+    /// direction d: d·w, d − (d·w)·w and |d − (d·w)·w|².
+    len: f64,
+    w: [f64; 3],
+    dz: f64,
+    dp: [f64; 3],
+    a: f64,
+    d: [f64; 3],
+}
+
+impl Capsule {
+    /// The capsule of a sphere of radius `r` from `c0` to `c0 + v`, for rays
+    /// along the unit vector `d` (the same expressions as `capsule_span`).
+    pub(crate) fn new(c0: &Vector3<f64>, v: &Vector3<f64>, r: f64, d: &Vector3<f64>) -> Capsule {
+        let c1 = c0 + v;
+        let len = v.norm();
+        // Only used when len > 0, as in `capsule_span`.
+        let w = v / len;
+        let dz = d.dot(&w);
+        let dp = d - dz * w;
+        Capsule {
+            c0: (*c0).into(),
+            c1: c1.into(),
+            r,
+            len,
+            w: w.into(),
+            dz,
+            dp: dp.into(),
+            a: dp.norm_squared(),
+            d: (*d).into(),
+        }
+    }
+}
+
+/// What a row needs beyond its solids: where its rays are.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RowFrame {
+    /// The rays' axis (the row runs along the first other axis).
+    pub k: usize,
+    /// Lattice origin along the row, spacing, and the row's coordinate on
+    /// the second other axis.
+    pub origin_u: f64,
+    pub h: f64,
+    pub pv: f64,
+}
+
+/// A span on four rays: its ends and whether it exists.
+#[derive(Clone, Copy)]
+struct Opt {
+    lo: F,
+    hi: F,
+    some: M,
+}
+
+#[inline(always)]
+fn s(x: f64) -> F {
+    F::splat(x)
+}
+
+/// `kernel::linear_le0`: t with a0 + a1·t ≤ 0.
+#[inline(always)]
+fn linear_le0(a0: F, a1: F) -> Opt {
+    let q = (-a0) / a1;
+    let (pos, neg) = (a1.gt(s(0.0)), a1.lt(s(0.0)));
+    Opt {
+        lo: neg.select(q, s(f64::NEG_INFINITY)),
+        hi: pos.select(q, s(f64::INFINITY)),
+        some: pos | neg | a0.le(s(0.0)),
+    }
+}
+
+/// `Span::meet` of two optional spans (`kernel::meet`).
+#[inline(always)]
+fn meet(a: Opt, b: Opt) -> Opt {
+    let lo = a.lo.max(b.lo);
+    let hi = a.hi.min(b.hi);
+    Opt {
+        lo,
+        hi,
+        some: a.some & b.some & lo.le(hi),
+    }
+}
+
+/// `kernel::hull`.
+#[inline(always)]
+fn hull(a: Opt, b: Opt) -> Opt {
+    let both = a.some & b.some;
+    Opt {
+        lo: both.select(a.lo.min(b.lo), a.some.select(a.lo, b.lo)),
+        hi: both.select(a.hi.max(b.hi), a.some.select(a.hi, b.hi)),
+        some: a.some | b.some,
+    }
+}
+
+/// `kernel::slab`: t with lo ≤ z0 + dz·t ≤ hi.
+#[inline(always)]
+fn slab(z0: F, dz: f64, lo: f64, hi: f64) -> Opt {
+    meet(
+        linear_le0(s(lo) - z0, s(-dz)),
+        linear_le0(z0 - s(hi), s(dz)),
+    )
+}
+
+/// `kernel::quadratic_le0`: t with a·t² + 2b·t + c ≤ 0.
+#[inline(always)]
+fn quadratic_le0(a: F, b: F, c: F) -> Opt {
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(s(0.0));
+    let l = linear_le0(c, s(2.0) * b);
+    let disc = b * b - a * c;
+    let sq = disc.sqrt();
+    let q = -(b + sq.copysign(b));
+    let qz = q.eq(s(0.0));
+    let (r1, r2) = (q / a, c / q);
+    Opt {
+        lo: lin.select(l.lo, qz.select(s(0.0), r1.min(r2))),
+        hi: lin.select(l.hi, qz.select(s(0.0), r1.max(r2))),
+        some: (lin & l.some) | (!lin & !disc.lt(s(0.0))),
+    }
+}
+
+// ---------------------------------------------------------------------------
+// The skip tests: certain bounds without roots or quotients.
+//
+// They decide whether a span, *as computed* (bits and all), starts at or
+// above m, from the very coefficients the exact kernels use; sums and
+// products only, each compared with a margin that bounds its rounding.
+
+/// Unit roundoff of f64 (half an ulp of 1).
+const U: f64 = f64::EPSILON / 2.0;
+/// A margin of 32 u: every rounded product or sum below is within (1 + u)
+/// of its exact value, and at most a handful are chained before a margin
+/// is applied.
+const SLACK: f64 = 32.0 * U;
+/// An absolute floor under every margin: errors of results in the
+/// subnormal range (far below any length in mm).
+const TINY: f64 = 1e-290;
+
+/// A certain lower bound of the exact value of the rounded `x`, where `x`
+/// is the result of one or two rounded operations on exact operands whose
+/// magnitudes sum to at most `scale`.
+#[inline(always)]
+fn lower(x: F, scale: F) -> F {
+    x - s(SLACK) * scale - s(TINY)
+}
+
+/// A certain upper bound, likewise.
+#[inline(always)]
+fn upper(x: F, scale: F) -> F {
+    x + s(SLACK) * scale + s(TINY)
+}
+
+/// Whether the lower end of the span [`quadratic_le0`]`(a, b, c)` computes
+/// is certainly ≥ `m`, or that span certainly empty (lanes set); a clear
+/// lane is "not certain".
+///
+/// Let d be the computed discriminant (the float `quadratic_le0` computes,
+/// d = b² − a·c + e with |e| ≤ 2.01u(b² + |a·c|)), Q = |b| + √d and σ =
+/// −sign b. The computed s = fl(√d) and |q| = fl(|b| + s) are within (1 ±
+/// u) and (1 ± 2.01u) of √d and Q, so the computed roots q/a and c/q are
+/// within a relative 3.1u of X₁ = σ·Q/a and X₂ = σ·c/Q, and their minimum
+/// (the span's start) is ≥ m when both X are ≥ m' = m + 32u·|m| (x − 3.1u·|x|
+/// grows with x; the float m' is rounded up). With g(t) = a·t² + 2b·t + c:
+/// * b < 0: X₁ ≥ m' ⇐ |b| ≥ a·m'; X₂ ≥ m' ⇔ Y = c − m'|b| ≥ m'·√d, that is
+///   Y ≥ 0 and (m' ≤ 0, or Y² − m'²d = c·g(m') − m'²e ≥ 0: with c ≥ m'|b| >
+///   0, c·g(m') ≥ m'²·|e| suffices);
+/// * b > 0: X₁ ≥ m' ⇔ Z = −a·m' − |b| ≥ √d, that is Z ≥ 0 and Z² − d =
+///   a·g(m') − e ≥ 0; X₂ ≥ m' ⇔ −c − m'|b| ≥ m'·√d, implied by −c − m'|b|
+///   ≥ 0 (m' < 0 here, as Z ≥ 0 needs).
+///
+/// No root, no quotient: every product and sum is rounded, and every
+/// comparison is made between a certain lower and a certain upper bound
+/// ([`lower`], [`upper`], margins of 32u of the magnitudes involved). The
+/// linear case of `quadratic_le0` (a negligible) and b = 0 are not decided.
+#[inline(always)]
+fn quadratic_lo_at_least(a: F, b: F, c: F, m: F) -> M {
+    // The common case on all four lanes: the tool on the far side of the
+    // rays' origin (b < 0) and a positive level.
+    let common = b.lt(s(0.0)) & m.gt(s(1e-200)) & m.lt(s(f64::INFINITY));
+    if (!common).any() {
+        quadratic_lo_at_least_any(a, b, c, m)
+    } else {
+        quadratic_lo_at_least_common(a, b, c, m)
+    }
+}
+
+/// [`quadratic_lo_at_least`] for b < 0 and 0 < m < ∞ on every lane: the
+/// same conditions (X₁: |b| ≥ a·m'; X₂: c − m'|b| ≥ 0 and c·g(m') ≥
+/// m'²·|e|) with the signs known, so that each margin is one product:
+/// for x ≥ 0, fl(x·(1 + 32u)) is above x and fl(x·(1 − 32u)) below it by
+/// more than the rounding of the few operations that made x. m' = fl(m·(1 +
+/// 64u)) ≥ m + 32u·m.
+#[inline(always)]
+fn quadratic_lo_at_least_common(a: F, b: F, c: F, m: F) -> M {
+    let (up, down, tiny) = (s(1.0 + SLACK), s(1.0 - SLACK), s(TINY));
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(s(0.0));
+    let (bb2, ac) = (b * b, a * c);
+    let none = (bb2 - ac).lt(s(0.0));
+    let e = s(4.0 * U) * (bb2 + ac.abs());
+    let m1 = m * s(1.0 + 2.0 * SLACK);
+    let bb = -b;
+    let am = a * m1;
+    let first = bb.ge(am * up + tiny);
+    let mb = m1 * bb;
+    let y_ok = (c * down).ge(mb * up + tiny);
+    // g(m') = a·m'² + 2b·m' + c, with g1 ≥ 0 ≥ g2.
+    let (g1, g2) = (am * m1, (s(2.0) * b) * m1);
+    let g = (g1 + g2 + c) - s(SLACK) * (g1 - g2 + c.abs()) - tiny;
+    let second = y_ok & ((c * g) * down).ge(((m1 * m1) * e) * up + tiny);
+    !lin & (none | (first & second))
+}
+
+/// [`quadratic_lo_at_least`] for any signs.
+#[inline(always)]
+fn quadratic_lo_at_least_any(a: F, b: F, c: F, m: F) -> M {
+    let zero = s(0.0);
+    // The same branch as `quadratic_le0`, from the same floats.
+    let lin = a.le(s(1e-15) * (b.abs() + c.abs()).max(s(1e-300))) | a.eq(zero);
+    let (bb2, ac) = (b * b, a * c);
+    let d = bb2 - ac;
+    // `quadratic_le0` returns None: nothing to cut.
+    let none = d.lt(zero);
+    // A bound of |e|: 2.01u(b² + |a·c|) from the rounded b² and a·c, with
+    // room for their own rounding.
+    let e = s(4.0 * U) * (bb2 + ac.abs());
+    let m1 = upper(m + s(SLACK) * m.abs(), m.abs());
+    let bb = b.abs();
+    let neg = b.lt(zero);
+    let am = a * m1;
+    let mb = m1 * bb;
+    // g(m') and a certain lower bound of it.
+    let (g1, g2) = (am * m1, (s(2.0) * b) * m1);
+    let g = lower(g1 + g2 + c, g1.abs() + g2.abs() + c.abs());
+    // b < 0.
+    let y_ok = (c - mb).ge(upper(zero, c.abs() + mb.abs()));
+    let cg = c * g;
+    let r = (m1 * m1) * e;
+    let first_neg = bb.ge(upper(am, am.abs()));
+    let second_neg = y_ok & (m1.le(zero) | lower(cg, cg.abs()).ge(upper(r, r)));
+    // b > 0.
+    let z_ok = (-am - bb).ge(upper(zero, am.abs() + bb));
+    let ag = a * g;
+    let first_pos = z_ok & lower(ag, ag.abs()).ge(upper(e, e));
+    let second_pos = (-c - mb).ge(upper(zero, c.abs() + mb.abs()));
+    let decided = (neg & first_neg & second_neg) | (b.gt(zero) & first_pos & second_pos);
+    !lin & (none | (m.abs().lt(s(f64::INFINITY)) & decided))
+}
+
+/// Whether `kernel::slab(z0, dz, zlo, zhi)` certainly starts at or above
+/// `m`, or is certainly empty. For dz = 0 the slab is everything or nothing,
+/// decided by the same comparisons; otherwise its lower end is the rounded
+/// quotient (zlo − z0)/dz (dz > 0) or −(z0 − zhi)/dz (dz < 0), at least m
+/// when the exact quotient is (m is a float): zlo − z0 ≥ m·dz, or
+/// z0 − zhi ≥ −m·dz, the product bounded with [`upper`].
+#[inline(always)]
+fn slab_lo_at_least(z0: F, dz: f64, zlo: f64, zhi: f64, m: F) -> M {
+    let zero = s(0.0);
+    let (a0, a1) = (s(zlo) - z0, z0 - s(zhi));
+    if dz == 0.0 {
+        return !(a0.le(zero) & a1.le(zero));
+    }
+    let md = m * s(dz);
+    let finite = m.abs().lt(s(f64::INFINITY));
+    if dz > 0.0 {
+        finite & a0.ge(upper(md, md.abs()))
+    } else if dz < 0.0 {
+        finite & a1.ge(upper(-md, md.abs()))
+    } else {
+        M::splat(false)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Coefficients: the same expressions as `Local::along`, `capsule_span` and
+// `Local::new`, lane by lane.
+
+/// x·y summed as nalgebra's 3-vector dot product: (x₀y₀ + x₁y₁) + x₂y₂.
+#[inline(always)]
+fn dot(x: &[F; 3], y: &[F; 3]) -> F {
+    x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+}
+
+#[inline(always)]
+fn splat3(v: &[f64; 3]) -> [F; 3] {
+    [s(v[0]), s(v[1]), s(v[2])]
+}
+
+// ---------------------------------------------------------------------------
+// Four rays of one solid: which need their span, and the spans.
+
+const NONE: Opt = Opt {
+    lo: F([0.0; W]),
+    hi: F([0.0; W]),
+    some: M([0; W]),
+};
+
+/// A solid's kernel on the rays of one row, its constants made once.
+trait Kernel {
+    /// The rays (lanes of `gate`) at `pu` whose span is not certainly at or
+    /// above `m`, and their spans (meaningful on those lanes).
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt);
+
+    /// Whether the span of every ray of the row at a coordinate in [pa, pb]
+    /// (rays `pa` to `pb`) certainly starts at or above `m` (or is empty);
+    /// `false` when not certain.
+    #[inline(always)]
+    fn segment_skips(&self, _pa: f64, _pb: f64, _m: f64) -> bool {
+        false
+    }
+}
+
+/// A closed interval enclosing the *computed* values of an expression over
+/// the rays of a row segment. Rounding to nearest is monotone, so a
+/// rounded sum, difference or product of values within intervals lies
+/// within the same operation on their ends (by sign for products), and the
+/// ends are themselves rounded as the rays' values are.
+#[derive(Clone, Copy, Debug)]
+struct Iv {
+    lo: f64,
+    hi: f64,
+}
+
+impl Iv {
+    #[inline(always)]
+    fn point(x: f64) -> Iv {
+        Iv { lo: x, hi: x }
+    }
+    #[inline(always)]
+    fn add(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
+        }
+    }
+    #[inline(always)]
+    fn sub(self, o: Iv) -> Iv {
+        Iv {
+            lo: self.lo - o.hi,
+            hi: self.hi - o.lo,
+        }
+    }
+    /// Times a float (its sign decides the order of the ends).
+    #[inline(always)]
+    fn times(self, c: f64) -> Iv {
+        let (a, b) = (self.lo * c, self.hi * c);
+        if c >= 0.0 {
+            Iv { lo: a, hi: b }
+        } else {
+            Iv { lo: b, hi: a }
+        }
+    }
+    #[inline(always)]
+    fn square(self) -> Iv {
+        let (a, b) = (self.lo * self.lo, self.hi * self.hi);
+        if self.lo >= 0.0 {
+            Iv { lo: a, hi: b }
+        } else if self.hi <= 0.0 {
+            Iv { lo: b, hi: a }
+        } else {
+            Iv {
+                lo: 0.0,
+                hi: a.max(b),
+            }
+        }
+    }
+    #[inline(always)]
+    fn abs_max(self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+}
+
+/// [`quadratic_lo_at_least_common`] for every (a, b, c) with b, c within
+/// intervals, and every level up to `m`: its conditions at their worst
+/// corner. With m' = fl(m·(1 + 64u)) ≥ each ray's m' (b < 0 < m'): |b| ≥
+/// a·m' is hardest at the smallest |b|; c − m'|b| ≥ 0 at the smallest c and
+/// largest |b|; g(m') = a·m'² + 2b·m' + c grows with b and c, so its least
+/// value is at the least b and c; |e| is largest at the largest b² and |a·c|.
+/// Every ray's span is also empty when the largest discriminant is negative.
+#[inline(always)]
+fn quadratic_segment_skips(a: f64, b: Iv, c: Iv, m: f64) -> bool {
+    if !(b.hi < 0.0 && m > 1e-200 && m < f64::INFINITY) {
+        return false;
+    }
+    let (up, down) = (1.0 + SLACK, 1.0 - SLACK);
+    let (b_abs_lo, b_abs_hi) = (-b.hi, -b.lo);
+    let c_abs = c.abs_max();
+    // `quadratic_le0`'s linear branch on no ray.
+    if a <= 1e-15 * (b_abs_hi + c_abs).max(1e-300) || a == 0.0 {
+        return false;
+    }
+    let bb2_hi = b_abs_hi * b_abs_hi;
+    if bb2_hi - a * c.lo < 0.0 {
+        // Every discriminant below zero: no span.
+        return true;
+    }
+    let m1 = m * (1.0 + 2.0 * SLACK);
+    let am = a * m1;
+    let first = b_abs_lo >= am * up + TINY;
+    let y_ok = c.lo * down >= (m1 * b_abs_hi) * up + TINY;
+    let (g1, g2) = (am * m1, (2.0 * b.lo) * m1);
+    let g = (g1 + g2 + c.lo) - SLACK * (g1 - g2 + c_abs) - TINY;
+    let e = 4.0 * U * (bb2_hi + (a * c_abs).abs());
+    first && y_ok && (c.lo * g) * down >= ((m1 * m1) * e) * up + TINY
+}
+
+/// [`slab_lo_at_least`] for every z0 within an interval and every level up
+/// to `m` (the bound on the quotient grows with m).
+#[inline(always)]
+fn slab_segment_skips(z0: Iv, dz: f64, zlo: f64, zhi: f64, m: f64) -> bool {
+    let (a0_lo, a1_lo) = (zlo - z0.hi, z0.lo - zhi);
+    if dz == 0.0 {
+        return a0_lo > 0.0 || a1_lo > 0.0;
+    }
+    if !(m.abs() < f64::INFINITY) {
+        return false;
+    }
+    let md = m * dz;
+    let bound = md.abs() * SLACK + TINY;
+    if dz > 0.0 {
+        a0_lo >= md + bound
+    } else if dz < 0.0 {
+        a1_lo >= -md + bound
+    } else {
+        false
+    }
+}
+
+/// A cylinder piece: `Local::along` and `kernel::cylinder`.
+struct CylinderKernel<const K: usize, const U: usize, const V: usize> {
+    /// The same constants as scalars, for [`Kernel::segment_skips`].
+    origin_f: [f64; 3],
+    axis_f: [f64; 3],
+    pv: f64,
+    r: f64,
+    origin_u: F,
+    /// p[V]·w[V] and p[K]·w[K] are constant along the row, but are summed in
+    /// `Local::along`'s order with the varying term, so only the vectors
+    /// are kept.
+    p: [F; 3],
+    w: [F; 3],
+    dz: f64,
+    a: F,
+    rr: F,
+    z0: f64,
+    z1: f64,
+}
+
+impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
+    #[inline(always)]
+    fn new(origin: &[f64; 3], axis: &[f64; 3], z0: f64, z1: f64, r: f64, pv: f64) -> Self {
+        let mut p = [s(0.0); 3];
+        p[V] = s(pv - origin[V]);
+        p[K] = s(-origin[K]);
+        let dz = axis[K];
+        CylinderKernel {
+            origin_f: *origin,
+            axis_f: *axis,
+            pv,
+            r,
+            origin_u: s(origin[U]),
+            p,
+            w: splat3(axis),
+            dz,
+            a: s(1.0 - dz * dz),
+            rr: s(r * r),
+            z0,
+            z1,
+        }
+    }
+
+    /// `Local::along`: (z0, b, c).
+    #[inline(always)]
+    fn line(&self, pu: F) -> (F, F, F) {
+        let mut p = self.p;
+        p[U] = pu - self.origin_u;
+        let w = &self.w;
+        let z0 = p[0] * w[0] + p[1] * w[1] + p[2] * w[2];
+        let pp = [p[0] - z0 * w[0], p[1] - z0 * w[1], p[2] - z0 * w[2]];
+        (z0, pp[K], pp[0] * pp[0] + pp[1] * pp[1] + pp[2] * pp[2])
+    }
+}
+
+impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
+    /// `Local::along` on the rays with pu in [pa, pb]: enclosures of the
+    /// computed (z0, b, c) (the same operations, [`Iv`]).
+    #[inline(always)]
+    fn line_segment(&self, pa: f64, pb: f64) -> (Iv, Iv, Iv) {
+        let (o, w) = (&self.origin_f, &self.axis_f);
+        let mut p = [Iv::point(0.0); 3];
+        p[U] = Iv {
+            lo: pa - o[U],
+            hi: pb - o[U],
+        };
+        p[V] = Iv::point(self.pv - o[V]);
+        p[K] = Iv::point(-o[K]);
+        let z0 = p[0].times(w[0]).add(p[1].times(w[1])).add(p[2].times(w[2]));
+        let pp = [
+            p[0].sub(z0.times(w[0])),
+            p[1].sub(z0.times(w[1])),
+            p[2].sub(z0.times(w[2])),
+        ];
+        let c = pp[0].square().add(pp[1].square()).add(pp[2].square());
+        (z0, pp[K], c)
+    }
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K, U, V> {
+    #[inline(always)]
+    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
+        let (z0, b, c) = self.line_segment(pa, pb);
+        let dz = self.axis_f[K];
+        slab_segment_skips(z0, dz, self.z0, self.z1, m)
+            || quadratic_segment_skips(1.0 - dz * dz, b, c.sub(Iv::point(self.r * self.r)), m)
+    }
+
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let (lz, b, c) = self.line(pu);
+        let c = c - self.rr;
+        // The span is the slab met with the radial span: it starts no lower
+        // than either.
+        let mut need = gate & !quadratic_lo_at_least(self.a, b, c, m);
+        if need.any() {
+            need = need & !slab_lo_at_least(lz, self.dz, self.z0, self.z1, m);
+        }
+        if !need.any() {
+            return (need, NONE);
+        }
+        (
+            need,
+            meet(
+                slab(lz, self.dz, self.z0, self.z1),
+                quadratic_le0(self.a, b, c),
+            ),
+        )
+    }
+}
+
+/// A sphere piece: `Local::along` and the sphere of `piece_span`.
+struct SphereKernel<const K: usize, const U: usize, const V: usize> {
+    line: CylinderKernel<K, U, V>,
+    zc: F,
+    dz: F,
+    a: F,
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for SphereKernel<K, U, V> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let (lz, b, c) = self.line.line(pu);
+        let zr = lz - self.zc;
+        let (b, c) = (b + zr * self.dz, c + zr * zr - self.line.rr);
+        let need = gate & !quadratic_lo_at_least(self.a, b, c, m);
+        if !need.any() {
+            return (need, NONE);
+        }
+        (need, quadratic_le0(self.a, b, c))
+    }
+}
+
+/// A capsule: `capsule_span`.
+struct CapsuleKernel<'a, const K: usize, const U: usize, const V: usize> {
+    k: &'a Capsule,
+    pv: F,
+    d: [F; 3],
+    c0: [F; 3],
+    c1: [F; 3],
+    w: [F; 3],
+    dp: [F; 3],
+    rr: F,
+    a: F,
+}
+
+impl<const K: usize, const U: usize, const V: usize> CapsuleKernel<'_, K, U, V> {
+    /// A sphere's (b, c) (a = 1).
+    #[inline(always)]
+    fn sphere(&self, o: &[F; 3], c: &[F; 3]) -> (F, F) {
+        let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
+        (dot(&oc, &self.d), dot(&oc, &oc) - self.rr)
+    }
+}
+
+impl<const K: usize, const U: usize, const V: usize> Kernel for CapsuleKernel<'_, K, U, V> {
+    /// Every part certainly above m on every ray of the segment ([`Iv`]
+    /// enclosures of the same operations as [`Kernel::chunk`]).
+    #[inline(always)]
+    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
+        let k = self.k;
+        let mut o = [Iv::point(0.0); 3];
+        o[U] = Iv { lo: pa, hi: pb };
+        o[V] = Iv::point(self.pv.0[0]);
+        let dot = |x: &[Iv; 3], y: &[f64; 3]| {
+            x[0].times(y[0]).add(x[1].times(y[1])).add(x[2].times(y[2]))
+        };
+        let norm2 = |x: &[Iv; 3]| x[0].square().add(x[1].square()).add(x[2].square());
+        let minus = |x: &[Iv; 3], c: &[f64; 3]| {
+            [
+                x[0].sub(Iv::point(c[0])),
+                x[1].sub(Iv::point(c[1])),
+                x[2].sub(Iv::point(c[2])),
+            ]
+        };
+        let rr = Iv::point(k.r * k.r);
+        let sphere = |c: &[f64; 3]| {
+            let oc = minus(&o, c);
+            quadratic_segment_skips(1.0, dot(&oc, &k.d), norm2(&oc).sub(rr), m)
+        };
+        if !(sphere(&k.c0) && sphere(&k.c1)) {
+            return false;
+        }
+        if !(k.len > 0.0) {
+            return true;
+        }
+        let p = minus(&o, &k.c0);
+        let lz = dot(&p, &k.w);
+        let pp = [
+            p[0].sub(lz.times(k.w[0])),
+            p[1].sub(lz.times(k.w[1])),
+            p[2].sub(lz.times(k.w[2])),
+        ];
+        slab_segment_skips(lz, k.dz, 0.0, k.len, m)
+            || quadratic_segment_skips(k.a, dot(&pp, &k.dp), norm2(&pp).sub(rr), m)
+    }
+
+    #[inline(always)]
+    fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt) {
+        let mut o = [s(0.0); 3];
+        o[U] = pu;
+        o[V] = self.pv;
+        let (b0, c0) = self.sphere(&o, &self.c0);
+        let (b1, c1) = self.sphere(&o, &self.c1);
+        // `Local::new(o, d, c0, w)`.
+        let p = [o[0] - self.c0[0], o[1] - self.c0[1], o[2] - self.c0[2]];
+        let lz = dot(&p, &self.w);
+        let pp = [
+            p[0] - lz * self.w[0],
+            p[1] - lz * self.w[1],
+            p[2] - lz * self.w[2],
+        ];
+        let (b, c) = (dot(&pp, &self.dp), dot(&pp, &pp) - self.rr);
+        let one = s(1.0);
+        let (len, dz) = (self.k.len, self.k.dz);
+        // The hull starts at the lowest of its parts: a ray needs its span
+        // unless every part is certainly above m. The parts are tested one
+        // after the other while some gated ray may still be skipped.
+        let mut need = gate & !quadratic_lo_at_least(one, b0, c0, m);
+        if need != gate {
+            need = need | (gate & !quadratic_lo_at_least(one, b1, c1, m));
+        }
+        if need != gate && len > 0.0 {
+            let line =
+                quadratic_lo_at_least(self.a, b, c, m) | slab_lo_at_least(lz, dz, 0.0, len, m);
+            need = need | (gate & !line);
+        }
+        if !need.any() {
+            return (need, NONE);
+        }
+        let mut span = hull(quadratic_le0(one, b0, c0), quadratic_le0(one, b1, c1));
+        if len > 0.0 {
+            span = hull(
+                span,
+                meet(slab(lz, dz, 0.0, len), quadratic_le0(self.a, b, c)),
+            );
+        }
+        (need, span)
+    }
+}
+
+/// A solid without a lane kernel: the scalar span of every gated ray.
+struct ScalarKernel<'a> {
+    solids: &'a RowSolids<'a>,
+    solid: usize,
+    pv: f64,
+}
+
+impl Kernel for ScalarKernel<'_> {
+    #[inline(always)]
+    fn chunk(&self, pu: F, _m: F, gate: M) -> (M, Opt) {
+        let mut out = NONE;
+        for l in 0..W {
+            if gate.lane(l)
+                && let Some(sp) = (self.solids.span)(self.solid, pu.0[l], self.pv)
+            {
+                out.lo.0[l] = sp.lo;
+                out.hi.0[l] = sp.hi;
+                out.some.0[l] = u64::MAX;
+            }
+        }
+        (gate, out)
+    }
+}
+
+// ---------------------------------------------------------------------------
+// A row.
+
+/// Scratch buffers of a row, kept by each thread from row to row.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    pu: Vec<f64>,
+    first: Vec<f64>,
+    last: Vec<f64>,
+    m: Vec<f64>,
+    /// Rays with a span that meets the material but ends below its top.
+    split: Vec<bool>,
+    /// The spans that end inside their ray's material.
+    found: Vec<(u32, Span)>,
+    spans: Vec<Span>,
+}
+
+/// A solid that meets a row: its index and its first and last ray (row
+/// indices, within the solid's bounds).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Active {
+    pub solid: usize,
+    pub a: usize,
+    pub b: usize,
+}
+
+/// What [`cut_row`] needs of the solids: the prepared kernels, each
+/// solid's extent along the rays, and the scalar span of every solid.
+pub(crate) struct RowSolids<'a> {
+    pub prepared: &'a [RowSolid],
+    /// Each solid's bounds along the rays (lo, hi).
+    pub along: &'a [(f64, f64)],
+    /// The span of solid `i` on the ray at (`pu`, `pv`): `kernel`'s scalar
+    /// function, for [`RowSolid::Other`].
+    pub span: &'a (dyn Fn(usize, f64, f64) -> Option<Span> + Sync),
+}
+
+/// Cuts one row: every active solid (visited in the order given) on the
+/// rays `row[a..=b]` of its range, then each ray as the reference removal
+/// would (module doc).
+pub(crate) fn cut_row(
+    frame: &RowFrame,
+    row: &mut [Ray],
+    active: &[Active],
+    solids: &RowSolids,
+    id: u32,
+    scratch: &mut Scratch,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if !portable_forced() && std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2 (checked just above), the one
+            // requirement of `cut_row_avx2`.
+            unsafe { cut_row_avx2(frame, row, active, solids, id, scratch) };
+            return;
+        }
+    }
+    cut_row_any(frame, row, active, solids, id, scratch);
+}
+
+/// Tests can force the portable path, to check it on processors with AVX2.
+#[cfg(test)]
+pub(crate) static FORCE_PORTABLE: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+#[cfg(test)]
+fn portable_forced() -> bool {
+    FORCE_PORTABLE.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn portable_forced() -> bool {
+    false
+}
+
+/// [`cut_row`] compiled for AVX2: the same operations, four lanes in one
+/// instruction.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn cut_row_avx2(
+    frame: &RowFrame,
+    row: &mut [Ray],
+    active: &[Active],
+    solids: &RowSolids,
+    id: u32,
+    scratch: &mut Scratch,
+) {
+    cut_row_any(frame, row, active, solids, id, scratch);
+}
+
+#[inline(always)]
+fn cut_row_any(
+    frame: &RowFrame,
+    row: &mut [Ray],
+    active: &[Active],
+    solids: &RowSolids,
+    id: u32,
+    scratch: &mut Scratch,
+) {
+    match frame.k {
+        0 => cut_row_k::<0, 1, 2>(frame, row, active, solids, id, scratch),
+        1 => cut_row_k::<1, 0, 2>(frame, row, active, solids, id, scratch),
+        _ => cut_row_k::<2, 0, 1>(frame, row, active, solids, id, scratch),
+    }
+}
+
+/// The solid's rays `j0..=j1` of the row: skip test, exact spans, and the
+/// levels m lowered by the spans that reach the top. Returns whether a span
+/// ends inside a ray's material.
+#[inline(always)]
+fn sweep<Kn: Kernel>(
+    kern: &Kn,
+    (j0, j1): (usize, usize),
+    (lo_k, hi_k): (f64, f64),
+    sc: &mut Scratch,
+) -> bool {
+    let lane = F(std::array::from_fn(|i| i as f64));
+    let (lo_k, hi_k) = (s(lo_k), s(hi_k));
+    let mut any_split = false;
+    // Whole segments first, from either end, in doubling steps while they
+    // are certainly above their levels; then the rest four rays at a time.
+    // [j0, end) is what is left.
+    let (mut j0, mut end) = (j0, j1 + 1);
+    let seg_max = |sc: &Scratch, a: usize, b: usize| {
+        sc.m[a..b].iter().fold(f64::NEG_INFINITY, |x, &y| x.max(y))
+    };
+    let mut step = 2 * W;
+    while j0 + step <= end
+        && kern.segment_skips(sc.pu[j0], sc.pu[j0 + step - 1], seg_max(sc, j0, j0 + step))
+    {
+        j0 += step;
+        step *= 2;
+    }
+    step = 2 * W;
+    while end >= j0 + step
+        && kern.segment_skips(
+            sc.pu[end - step],
+            sc.pu[end - 1],
+            seg_max(sc, end - step, end),
+        )
+    {
+        end -= step;
+        step *= 2;
+    }
+    if end <= j0 {
+        return false;
+    }
+    let j1 = end - 1;
+    let j0f = s(j0 as f64);
+    let j1f = s(j1 as f64);
+    let mut base = j0 / W * W;
+    while base <= j1 {
+        let idx = s(base as f64) + lane;
+        let (first, last) = (F::load(&sc.first, base), F::load(&sc.last, base));
+        // The reference's gate: the ray's index within the solid's bounds
+        // and its material within the solid's extent.
+        let gate = idx.ge(j0f) & idx.le(j1f) & !(hi_k.le(first) | lo_k.ge(last));
+        if gate.any() {
+            let m = F::load(&sc.m, base);
+            let (need, span) = kern.chunk(F::load(&sc.pu, base), m, gate);
+            let keep = need & span.some;
+            if keep.any() {
+                let reach = keep & span.hi.ge(last);
+                (reach & span.lo.lt(m))
+                    .select(span.lo, m)
+                    .store(&mut sc.m, base);
+                // Spans that end inside the material are kept for their
+                // ray; the others are all summed up by m.
+                let split = keep & !span.hi.ge(last) & span.hi.gt(first);
+                if split.any() {
+                    any_split = true;
+                    for i in 0..W {
+                        if split.lane(i) {
+                            sc.found.push((
+                                (base + i) as u32,
+                                Span {
+                                    lo: span.lo.0[i],
+                                    hi: span.hi.0[i],
+                                },
+                            ));
+                            sc.split[base + i] = true;
+                        }
+                    }
+                }
+            }
+        }
+        base += W;
+    }
+    any_split
+}
+
+#[inline(always)]
+fn cut_row_k<const K: usize, const U: usize, const V: usize>(
+    frame: &RowFrame,
+    row: &mut [Ray],
+    active: &[Active],
+    solids: &RowSolids,
+    id: u32,
+    sc: &mut Scratch,
+) {
+    let Some(a_min) = active.iter().map(|s| s.a).min() else {
+        return;
+    };
+    let b_max = active.iter().map(|s| s.b).max().unwrap_or(a_min);
+    let n = b_max + 1 - a_min;
+    let padded = n.div_ceil(W) * W;
+    let pv = frame.pv;
+    sc.pu.clear();
+    sc.first.clear();
+    sc.last.clear();
+    sc.pu
+        .extend((0..padded).map(|j| frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h));
+    for ray in &row[a_min..=b_max] {
+        // Empty rays (and the padding): no solid passes the gate against
+        // their ends.
+        let (f, l) = match (ray.first(), ray.last()) {
+            (Some(f), Some(l)) => (f.lo, l.hi),
+            _ => (f64::INFINITY, f64::NEG_INFINITY),
+        };
+        sc.first.push(f);
+        sc.last.push(l);
+    }
+    sc.first.resize(padded, f64::INFINITY);
+    sc.last.resize(padded, f64::NEG_INFINITY);
+    sc.m.clear();
+    sc.m.extend_from_slice(&sc.last);
+    sc.split.clear();
+    sc.split.resize(padded, false);
+    sc.found.clear();
+    let mut any_split = false;
+    for act in active {
+        let range = (act.a - a_min, act.b - a_min);
+        let along = solids.along[act.solid];
+        any_split |= match solids.prepared[act.solid] {
+            RowSolid::Cylinder {
+                ref origin,
+                ref axis,
+                z0,
+                z1,
+                r,
+            } => sweep(
+                &CylinderKernel::<K, U, V>::new(origin, axis, z0, z1, r, pv),
+                range,
+                along,
+                sc,
+            ),
+            RowSolid::Sphere {
+                ref origin,
+                ref axis,
+                zc,
+                r,
+            } => {
+                let dz = axis[K];
+                let kern = SphereKernel {
+                    line: CylinderKernel::<K, U, V>::new(origin, axis, 0.0, 0.0, r, pv),
+                    zc: s(zc),
+                    dz: s(dz),
+                    a: s(1.0 - dz * dz + dz * dz),
+                };
+                sweep(&kern, range, along, sc)
+            }
+            RowSolid::Capsule(ref k) => {
+                let kern = CapsuleKernel::<K, U, V> {
+                    k,
+                    pv: s(pv),
+                    d: splat3(&k.d),
+                    c0: splat3(&k.c0),
+                    c1: splat3(&k.c1),
+                    w: splat3(&k.w),
+                    dp: splat3(&k.dp),
+                    rr: s(k.r * k.r),
+                    a: s(k.a),
+                };
+                sweep(&kern, range, along, sc)
+            }
+            RowSolid::Other => {
+                let kern = ScalarKernel {
+                    solids,
+                    solid: act.solid,
+                    pv,
+                };
+                sweep(&kern, range, along, sc)
+            }
+        };
+    }
+    for j in 0..n {
+        if !sc.split[j] && sc.m[j] < sc.last[j] {
+            // Every span that met the material reached its top.
+            cut_top(&mut row[a_min + j], sc.m[j], id);
+        }
+    }
+    if !any_split {
+        return;
+    }
+    // Rays with a span that ends inside the material: the union of those
+    // spans and of [m, +∞), which within the material is the union of the
+    // spans that reach the top (those skipped add nothing there), as the
+    // reference subtracts it.
+    sc.found.sort_by_key(|&(j, _)| j);
+    let mut i = 0;
+    while i < sc.found.len() {
+        let j = sc.found[i].0 as usize;
+        sc.spans.clear();
+        while i < sc.found.len() && sc.found[i].0 as usize == j {
+            sc.spans.push(sc.found[i].1);
+            i += 1;
+        }
+        if sc.m[j] < sc.last[j] {
+            sc.spans.push(Span {
+                lo: sc.m[j],
+                hi: f64::INFINITY,
+            });
+        }
+        remove_spans(&mut row[a_min + j], &mut sc.spans, id);
+    }
+}
+
+/// `subtract(ray, m, +∞, id)` for m below the ray's top, with the one
+/// interval case inline: the interval keeps [lo, m] when it is at least
+/// `SLIVER_MM` long, else goes.
+#[inline(always)]
+fn cut_top(ray: &mut Ray, m: f64, id: u32) {
+    if ray.len() == 1 {
+        let seg = &mut ray[0];
+        if seg.lo < m && m - seg.lo >= SLIVER_MM {
+            seg.hi = m;
+            seg.hi_move = id;
+        } else {
+            ray.clear();
+        }
+    } else {
+        subtract(ray, m, f64::INFINITY, id);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel;
+    use proptest::prelude::*;
+
+    fn lanes(x: f64) -> F {
+        F::splat(x)
+    }
+
+    /// Coefficients of every kind: ordinary, a negligible (the linear
+    /// case), b = 0 and b of either sign, an empty span.
+    fn coefficient() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            4 => -1e4f64..1e4,
+            1 => -1.0f64..1.0,
+            1 => Just(0.0),
+            1 => Just(-0.0),
+            1 => -1e-12f64..1e-12,
+        ]
+    }
+
+    /// The levels to test against a computed start: the start itself, one
+    /// ulp either side, and values near it.
+    fn levels(lo: f64) -> [f64; 6] {
+        [
+            lo,
+            lo.next_up(),
+            lo.next_down(),
+            lo + 1e-9,
+            lo - 1e-9,
+            lo * (1.0 + 1e-13),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20000))]
+
+        #[test]
+        fn the_lane_quadratic_is_the_scalar_one_bit_for_bit(
+            a in prop_oneof![0.0f64..2.0, Just(0.0), 0.0f64..1e-13],
+            b in coefficient(),
+            c in coefficient(),
+        ) {
+            let lane = quadratic_le0(lanes(a), lanes(b), lanes(c));
+            let scalar = kernel::quadratic_le0(a, b, c);
+            match scalar {
+                Some(sp) => {
+                    prop_assert!(lane.some.lane(0));
+                    prop_assert_eq!(lane.lo.0[0].to_bits(), sp.lo.to_bits());
+                    prop_assert_eq!(lane.hi.0[0].to_bits(), sp.hi.to_bits());
+                }
+                None => prop_assert!(!lane.some.lane(0)),
+            }
+        }
+
+        #[test]
+        fn the_lane_slab_is_the_scalar_one_bit_for_bit(
+            z0 in coefficient(), dz in prop_oneof![-1.0f64..1.0, Just(0.0)],
+            lo in -10.0f64..0.0, len in 0.0f64..10.0,
+        ) {
+            let lane = slab(lanes(z0), dz, lo, lo + len);
+            match kernel::slab(z0, dz, lo, lo + len) {
+                Some(sp) => {
+                    prop_assert!(lane.some.lane(0));
+                    prop_assert_eq!(lane.lo.0[0].to_bits(), sp.lo.to_bits());
+                    prop_assert_eq!(lane.hi.0[0].to_bits(), sp.hi.to_bits());
+                }
+                None => prop_assert!(!lane.some.lane(0)),
+            }
+        }
+
+        /// Never "certainly at or above m" when the computed start is below
+        /// m, even by an ulp.
+        #[test]
+        fn the_quadratic_skip_test_is_sound(
+            a in prop_oneof![0.0f64..2.0, 0.999f64..1.0, Just(1.0)],
+            b in coefficient(),
+            c in coefficient(),
+            m in -1e4f64..1e4,
+        ) {
+            let span = kernel::quadratic_le0(a, b, c);
+            let mut ms = vec![m];
+            if let Some(sp) = span {
+                ms.extend(levels(sp.lo));
+            }
+            for m in ms {
+                let claim = quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(m)).lane(0);
+                if claim {
+                    prop_assert!(span.is_none_or(|sp| sp.lo >= m), "{span:?} claimed ≥ {m}");
+                }
+            }
+        }
+
+        /// Near tangency (d ≈ 0) the computed start moves most with the
+        /// discriminant's rounding.
+        #[test]
+        fn the_quadratic_skip_test_is_sound_near_tangency(
+            a in 0.5f64..1.5,
+            b in prop_oneof![-100.0f64..-1.0, 1.0f64..100.0],
+            delta in prop_oneof![-1e-12f64..1e-12, -1e-15f64..1e-15, -1e-9f64..1e-9],
+        ) {
+            let c = b * b / a * (1.0 + delta);
+            let span = kernel::quadratic_le0(a, b, c);
+            if let Some(sp) = span {
+                for m in levels(sp.lo).into_iter().chain([sp.lo - 1e-6, sp.lo - 1e-7]) {
+                    if quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(m)).lane(0) {
+                        prop_assert!(sp.lo >= m, "{sp:?} claimed ≥ {m}");
+                    }
+                }
+            }
+        }
+
+        #[test]
+        fn the_slab_skip_test_is_sound(
+            z0 in coefficient(), dz in prop_oneof![-1.0f64..1.0, Just(0.0), -1e-9f64..1e-9],
+            lo in -10.0f64..0.0, len in 0.0f64..10.0, m in -1e4f64..1e4,
+        ) {
+            let span = kernel::slab(z0, dz, lo, lo + len);
+            let mut ms = vec![m];
+            if let Some(sp) = span {
+                ms.extend(levels(sp.lo));
+            }
+            for m in ms {
+                if slab_lo_at_least(lanes(z0), dz, lo, lo + len, lanes(m)).lane(0) {
+                    prop_assert!(span.is_none_or(|sp| sp.lo >= m), "{span:?} claimed ≥ {m}");
+                }
+            }
+        }
+    }
+
+    /// The skip test decides most of the cases it is meant for: a wheel's
+    /// rim well above the level (a test that never skips would be sound
+    /// and useless).
+    #[test]
+    fn the_quadratic_skip_test_skips_what_is_clearly_above() {
+        // |p⊥ + t·d⊥|² ≤ 50² for a wheel centred 90 mm up: the span starts
+        // at 40; a level of 39.9 is below it, 40.1 above.
+        let (a, b, c) = (1.0, -90.0, 90.0 * 90.0 - 50.0 * 50.0);
+        let lo = kernel::quadratic_le0(a, b, c).unwrap().lo;
+        assert!((lo - 40.0).abs() < 1e-9);
+        assert!(quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(39.9)).lane(0));
+        assert!(!quadratic_lo_at_least(lanes(a), lanes(b), lanes(c), lanes(40.1)).lane(0));
+        // Below the origin (b > 0): the span starts at −140.
+        let lo = kernel::quadratic_le0(a, 90.0, c).unwrap().lo;
+        assert!((lo + 140.0).abs() < 1e-9);
+        assert!(quadratic_lo_at_least(lanes(a), lanes(90.0), lanes(c), lanes(-140.1)).lane(0));
+        assert!(!quadratic_lo_at_least(lanes(a), lanes(90.0), lanes(c), lanes(-139.9)).lane(0));
+    }
+}
