@@ -3,7 +3,7 @@
 //! Every operation is the scalar operation applied lane by lane
 //! (`std::array::from_fn`), which the compiler turns into one SIMD
 //! instruction (two SSE2 instructions on the x86-64 baseline, one AVX2
-//! instruction where [`crate::row`] is compiled for it). Each lane rounds
+//! instruction where the row kernels are compiled for it). Each lane rounds
 //! exactly as the scalar code does: Rust never fuses a product and a sum, and
 //! a select is a bitwise choice. Masks hold all ones (true) or zeros per lane.
 
