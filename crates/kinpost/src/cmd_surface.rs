@@ -1,6 +1,6 @@
 //! `kinpost surface fit|eval|plot` and `kinpost path`: measured points to a
 //! B-spline surface, and a belt-grinding path on it as an NX-style CL file
-//! (issue 6, seed 002, DESIGN.md §5).
+//! (Li (B-spline grinding), §2 and §5).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -43,7 +43,7 @@ pub struct FitArgs {
     /// End conditions of the interpolation.
     #[arg(long, value_enum, default_value = "natural")]
     ends: EndsArg,
-    /// Data parameters: uniform (DESIGN.md §5), chord-length or centripetal.
+    /// Data parameters: uniform (Li (B-spline grinding)), chord-length or centripetal.
     #[arg(long, value_enum, default_value = "uniform")]
     params: ParamsArg,
     /// Least-squares approximation with an NU×NV control net instead of

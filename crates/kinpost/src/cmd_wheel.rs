@@ -1,7 +1,7 @@
-//! `kinpost wheel`: what the pressure axis does to the wheel (DESIGN.md §2.2,
-//! seed 001 §2.7–2.13): the input-link angle α, the wheel offset in the
+//! `kinpost wheel`: what the pressure axis does to the wheel (Qi (thesis),
+//! §2.7–2.13): the input-link angle α, the wheel offset in the
 //! linkage plane and the axis correction the post applies, per pressure, and
-//! the wheel-centre trajectory as an SVG plot (seed 001 Figures 2.24, 2.35).
+//! the wheel-centre trajectory as an SVG plot (Qi (thesis) Figures 2.24, 2.35).
 
 use std::fmt::Write as _;
 
@@ -252,7 +252,7 @@ fn ticks(lo: f64, hi: f64) -> (Vec<f64>, usize) {
 /// the given rows (marked and labelled), as a self-contained SVG: offset
 /// along the first plane direction across, along the second up, each axis
 /// scaled to its own range (the Y excursion is tens of times smaller than
-/// the Z stroke, as in seed 001 Figure 2.24).
+/// the Z stroke, as in Qi (thesis) Figure 2.24).
 pub fn svg(machine: &Machine, rows: &[WheelRow]) -> Result<String, String> {
     let p = pressure_axis(machine)?;
     let [e1, e2] = p.plane.map(|i| machine.axes[i].name.as_str());

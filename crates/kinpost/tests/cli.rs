@@ -752,7 +752,7 @@ fn wheel_rows(out: &str) -> Vec<Vec<f64>> {
 }
 
 #[test]
-fn wheel_table_has_the_stroke_and_the_arc_of_seed_001() {
+fn wheel_table_has_the_stroke_and_the_arc_of_qi_thesis() {
     let o = run(&["wheel", "--machine", "mts1600", "--table", "3000:3600:100"]);
     assert_exit(&o, 0);
     let out = stdout(&o);
@@ -763,7 +763,7 @@ fn wheel_table_has_the_stroke_and_the_arc_of_seed_001() {
     assert_eq!(rows[0][0], 3000.0);
     assert_eq!(rows[6][0], 3600.0);
     assert_eq!((rows[0][1], rows[6][1]), (-6.73, 5.0));
-    // Seed 001 §2.7: 51.075 mm in Z between the stops.
+    // Qi (thesis) §2.7: 51.075 mm in Z between the stops.
     let stroke = (rows[6][3] - rows[0][3]).abs();
     assert!((stroke - 51.1).abs() <= 0.1, "{stroke}\n{out}");
     // The Y offset first grows, then shrinks (the arc of Figure 2.23).

@@ -1,4 +1,4 @@
-//! Reading and validating machine files (TOML, DESIGN.md §2).
+//! Reading and validating machine files (TOML; docs/machine-files.md).
 //!
 //! Every mistake is reported as a [`Diagnostic`] naming the file, line and
 //! column, and all mistakes of a file are reported at once.
@@ -113,7 +113,7 @@ struct RawAxis {
     fixed: Option<Spanned<f64>>,
     /// Locked (`fixed`) unless the CL gives reference directions.
     free_with_reference: Option<Spanned<bool>>,
-    /// Limits are machine coordinates: machine = NC + offset (DESIGN.md §2).
+    /// Limits are machine coordinates: machine = NC + offset (docs/conventions.md).
     machine_offset: Option<Spanned<f64>>,
     wrap: Option<Spanned<RawWrap>>,
     prefer: Option<Spanned<RawPrefer>>,
@@ -135,7 +135,7 @@ struct RawTool {
     reference: Option<Spanned<Nums<3>>>,
 }
 
-/// `[pressure]`: the grinding-pressure axis (DESIGN.md §2.2).
+/// `[pressure]`: the grinding-pressure axis (Qi (thesis), chapter 2).
 #[derive(Deserialize)]
 struct RawPressure {
     name: Spanned<String>,

@@ -1,5 +1,5 @@
 //! Forward and inverse kinematics of a [`Machine`] by the product of
-//! exponentials over the home configuration (DESIGN.md §2).
+//! exponentials over the home configuration (Lynch & Park 2017, §4.1).
 //!
 //! Conventions: `G_i(q)` is the rigid motion of axis `i` at NC value `q` in the
 //! home frame (translation `q·u` or rotation by `q` degrees about the line

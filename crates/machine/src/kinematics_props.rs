@@ -2,7 +2,7 @@
 //! chain orders, tilted part frames, rotary axes locked at a value, a locked
 //! linear axis, three free rotary axes with a tool reference), their forward
 //! kinematics checked against the product of exponentials written out with
-//! nalgebra isometries (DESIGN.md §2: `W(q)⁻¹·T(q)`), and the precomputed
+//! nalgebra isometries (`W(q)⁻¹·T(q)`, docs/conventions.md), and the precomputed
 //! linear solve against the general one.
 
 use nalgebra::{

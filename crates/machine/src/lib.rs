@@ -1,5 +1,5 @@
 //! The machine model of kinpost: machine files, forward and inverse
-//! kinematics (DESIGN.md §2), and the solids of the virtual machine with
+//! kinematics (product of exponentials, Lynch & Park 2017), and the solids of the virtual machine with
 //! the settings of its collision check ([`Solid`], [`CollisionSettings`],
 //! moved by [`Kinematics::body_poses`]; checked by `kinpost-collide`).
 //!

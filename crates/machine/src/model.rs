@@ -1,4 +1,4 @@
-//! The machine model of DESIGN.md §2: a serial chain of linear and rotary axes
+//! The machine model (docs/machine-files.md): a serial chain of linear and rotary axes
 //! described at home (every NC value zero), all vectors in one fixed machine
 //! frame, lengths in mm, angles in degrees.
 

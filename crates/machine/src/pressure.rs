@@ -1,12 +1,12 @@
-//! The grinding-pressure axis (DESIGN.md §2.2, seed 001 chapters 2–3): a
+//! The grinding-pressure axis (Qi (thesis), chapters 2–3): a
 //! process axis that moves the tool point.
 //!
 //! On the MTS1600 belt grinder the contact wheel hangs on the coupler BC of a
 //! parallelogram four-bar linkage (fixed link AD, input link AB, output link
 //! DC, |AB| = |DC|) that a pneumatic cylinder lowers as the pressure setting
-//! H1 drops. The coupler translates without turning (seed 001 §2.9), so every
+//! H1 drops. The coupler translates without turning (Qi (thesis) §2.9), so every
 //! point of the wheel moves exactly as the joint B does, whose path is the
-//! circle of seed 001 eq. (2.35):
+//! circle of Qi (thesis) eq. (2.35):
 //!
 //! ```text
 //! y_B = L_AB·cos α,   z_B = L_AB·sin α          α from the first plane axis
@@ -15,14 +15,14 @@
 //!
 //! with e₁, e₂ the home directions of the two linear axes spanning the
 //! linkage plane and α_ref = α(reference). The wheel offset Δ is a pure
-//! translation in the tool chain after its last axis (seed 001 eq. 3.7:
+//! translation in the tool chain after its last axis (Qi (thesis) eq. 3.7:
 //! T_ws'^ws = translation (0, d_y, d_z)), expressed at home, so the machine
 //! at pressure p is the same machine with its home tool point moved by Δ(p)
 //! ([`Machine::at_pressure`]); Δ(reference) = 0.
 //!
-//! H1 → α is a measured calibration curve (seed 001 §2.12, Table 2.5),
+//! H1 → α is a measured calibration curve (Qi (thesis) §2.12, Table 2.5),
 //! interpolated piecewise linearly and clamped at its ends, where the piston
-//! sits on its stops (seed 001 §2.4: H1 ≥ 3600 upper stop, H1 ≤ 3000 lower
+//! sits on its stops (Qi (thesis) §2.4: H1 ≥ 3600 upper stop, H1 ≤ 3000 lower
 //! stop). A machine may instead give the measured offsets per pressure.
 
 use nalgebra::Vector3;
@@ -169,7 +169,7 @@ pub fn interpolate<const N: usize>(rows: &[[f64; N]], x: f64) -> [f64; N] {
 
 impl Machine {
     /// The machine with its wheel held at `pressure`: the home tool point
-    /// moved by the wheel offset Δ(pressure) (seed 001 eq. 3.4–3.7; the
+    /// moved by the wheel offset Δ(pressure) (Qi (thesis) eq. 3.4–3.7; the
     /// offset is constant after the last tool-side axis, so it turns with the
     /// head), and no pressure axis. Forward and inverse kinematics at that
     /// pressure are those of `Kinematics::new(&machine.at_pressure(p))`. A
@@ -223,7 +223,7 @@ mod tests {
         let got = p.plane_offset(3000.0);
         assert!((got[0] - want[0]).abs() < 1e-12, "{got:?} {want:?}");
         assert!((got[1] - want[1]).abs() < 1e-12, "{got:?} {want:?}");
-        // The stroke of seed 001 §2.7: 51.075 mm measured.
+        // The stroke of Qi (thesis) §2.7: 51.075 mm measured.
         assert!((got[1].abs() - 51.075).abs() < 0.1);
         // Clamped: the piston sits on its stop.
         assert_eq!(p.plane_offset(1000.0), got);

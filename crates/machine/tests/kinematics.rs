@@ -1,6 +1,6 @@
 //! Properties of the kinematics over every built-in machine and the test
 //! machines in `tests/machines/`: `fk(ik(pose)) == pose` for every branch and
-//! `ik(fk(q))` contains `q`; plus the seed-000 numbers and the paper's
+//! `ik(fk(q))` contains `q`; plus the numbers of Qiao et al. 2022 and the paper's
 //! orientation law as independent checks.
 
 use kinpost_machine::{Kinematics, Machine, Pose, builtin, machine_from_toml};
@@ -195,10 +195,10 @@ fn an_axis_without_limits_takes_the_turns_within_210_degrees_of_the_hint() {
     assert_eq!(turns(-115.0), [(-20, -80), (20, -260)]);
 }
 
-/// Seed 000, Figure 28: the CL points and the NC values the authors' post
+/// Qiao et al. 2022, Figure 28: the CL points and the NC values the authors' post
 /// printed, to the printed decimals.
 #[test]
-fn seed000_figure28_points() {
+fn qiao_figure28_points() {
     let m = builtin::load("mts1600").unwrap().unwrap();
     let kin = Kinematics::new(&m);
     let cases = [
@@ -233,7 +233,7 @@ fn seed000_figure28_points() {
     }
 }
 
-/// Seed 000 eq. 3.18: the tool axis in the part frame is
+/// Qiao et al. 2022 eq. 3.18: the tool axis in the part frame is
 /// (sin B, −sin A·cos B, cos A·cos B), written here independently of the chain.
 #[test]
 fn mts1600_orientation_law_of_eq_3_18() {

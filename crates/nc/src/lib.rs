@@ -2,7 +2,7 @@
 //!
 //! A [`Dialect`] is data, loaded from a TOML file (the built-in ones are
 //! embedded, see [`Dialect::builtin_names`]; the format is documented in
-//! `DIALECTS.md`). [`NcWriter`] writes a program in a dialect: header and
+//! `docs/dialects.md`). [`NcWriter`] writes a program in a dialect: header and
 //! footer templates, tool changes, comments and — on the hot path — motion
 //! blocks, formatted without allocation. [`read_program`] reads such a program
 //! back into blocks of axis values, for closed-loop checks. [`interp`] is the

@@ -537,7 +537,7 @@ impl<W: Write> NcWriter<W> {
         match mode {
             None => self.command(TemplateKind::CoolantOff, Vec::new()),
             // Templates see the mode in lower case (`mist`, `flood`), as
-            // DIALECTS.md documents, whatever case the CL wrote.
+            // docs/dialects.md documents, whatever case the CL wrote.
             Some(m) => self.command(
                 TemplateKind::CoolantOn,
                 vec![(

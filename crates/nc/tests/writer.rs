@@ -17,11 +17,11 @@ fn mts_axes() -> Vec<AxisSpec> {
     ]
 }
 
-const SEED: &str = include_str!("../../../data/qiao2022/figure28b-verbatim.mpf");
+const FIGURE_28B: &str = include_str!("../../../data/qiao2022/figure28b-verbatim.mpf");
 
-/// The motion blocks of seed 000 Figure 28(b), as (X, Y, Z, B, A).
-fn seed_blocks() -> Vec<(String, [f64; 5])> {
-    SEED.lines()
+/// The motion blocks of Qiao et al. 2022 Figure 28(b), as (X, Y, Z, B, A).
+fn figure_blocks() -> Vec<(String, [f64; 5])> {
+    FIGURE_28B.lines()
         .filter(|l| l.starts_with("X="))
         .map(|l| {
             let v: Vec<f64> = l
@@ -45,13 +45,13 @@ fn text(w: NcWriter<Vec<u8>>) -> String {
 }
 
 #[test]
-fn golden_seed_000_feed_blocks() {
+fn golden_qiao_figure28_feed_blocks() {
     let dialect = Dialect::builtin("sinumerik").unwrap();
     let axes = mts_axes();
-    let seed = seed_blocks();
-    assert_eq!(seed.len(), 11);
+    let figure = figure_blocks();
+    assert_eq!(figure.len(), 11);
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
-    for (k, (_, [x, y, z, b, a])) in seed.iter().enumerate() {
+    for (k, (_, [x, y, z, b, a])) in figure.iter().enumerate() {
         // Perturb below the 4th decimal, with both signs (A slightly negative:
         // the DC word must still read 0.000, not 360.000 or -0.000).
         let e = if k % 2 == 0 { 3.7e-5 } else { -4.1e-5 };
@@ -67,9 +67,9 @@ fn golden_seed_000_feed_blocks() {
     assert_eq!(w.blocks_written(), 11);
     let out = text(w);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[0], format!("{} F250", seed[0].0));
+    assert_eq!(lines[0], format!("{} F250", figure[0].0));
     for (k, line) in lines.iter().enumerate().skip(1) {
-        assert_eq!(*line, seed[k].0);
+        assert_eq!(*line, figure[k].0);
     }
     assert_eq!(
         lines[0],
@@ -179,9 +179,9 @@ fn header_footer_templates_and_overrides() {
 }
 
 #[test]
-fn seed_header_as_machine_override() {
+fn figure_28b_header_as_machine_override() {
     // The header of Figure 28(b) as a machine file would give it.
-    let header: String = SEED
+    let header: String = FIGURE_28B
         .lines()
         .take_while(|l| !l.starts_with("X="))
         .collect::<Vec<_>>()
@@ -199,7 +199,7 @@ fn seed_header_as_machine_override() {
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
     w.header(&info, Some(&template)).unwrap();
     let mut f = true;
-    for (_, [x, y, z, b, a]) in seed_blocks() {
+    for (_, [x, y, z, b, a]) in figure_blocks() {
         w.block(&Block {
             cl_line: None,
             motion: Motion::Feed,
@@ -210,7 +210,7 @@ fn seed_header_as_machine_override() {
         f = false;
     }
     let out = text(w);
-    let want: String = SEED.lines().map(|l| format!("{l}\n")).collect();
+    let want: String = FIGURE_28B.lines().map(|l| format!("{l}\n")).collect();
     // Only the second block differs: it carries the F word.
     let diff: Vec<(&str, &str)> = out
         .lines()
@@ -226,7 +226,7 @@ fn seed_header_as_machine_override() {
     );
     // The reader reads our output back: the header's `N150 B0 C0` and
     // `N130 G01 B0 F5000` are motion too; 11 blocks from the body.
-    let blocks = read_program(&dialect, &axes, "seed.mpf", &out).unwrap();
+    let blocks = read_program(&dialect, &axes, "figure.mpf", &out).unwrap();
     let body: Vec<_> = blocks.iter().filter(|b| b.axes[0].is_some()).collect();
     assert_eq!(body.len(), 11);
     assert_eq!(
@@ -804,7 +804,7 @@ fn sinumerik_dc_only_for_endless_axes() {
     assert!(out.contains("X=1.000 A-30.000 C=DC(270.000) F100"), "{out}");
 }
 
-/// The `[pressure]` examples of DIALECTS.md, added to the built-ins that
+/// The `[pressure]` examples of docs/dialects.md, added to the built-ins that
 /// have none: written on their own line, read back by the same dialect.
 #[test]
 fn documented_pressure_tables() {

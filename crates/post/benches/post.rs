@@ -19,7 +19,7 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(points as u64));
     // Default: whole-path planning and linearization on. The point-by-point
-    // run without linearization is the foundation's pipeline (issue 4: the
+    // run without linearization is the foundation's pipeline (the
     // planned run stays within 2× of it).
     let point_by_point = PostOptions {
         planner: kinpost_post::PlannerMode::Nearest,

@@ -204,7 +204,7 @@ pub enum PressureError {
     /// The dialect has no `[pressure]` table.
     #[error(
         "dialect `{dialect}` cannot write the pressure word `{word}`: it has no [pressure] table \
-         (copy it and add one, see DIALECTS.md)"
+         (copy it and add one, see docs/dialects.md)"
     )]
     NoPressureWord {
         /// The dialect.

@@ -1,4 +1,4 @@
-//! Whole-path planning (issue 4): passing through and near the singular
+//! Whole-path planning: passing through and near the singular
 //! direction of a table/table machine, retract and reconfiguration where
 //! the travel forces a flip, and the linearization property over random
 //! machines.

@@ -1,4 +1,4 @@
-//! The grinding-pressure axis H1 (issue 5, DESIGN.md §2.2, seed 001):
+//! The grinding-pressure axis H1 (Qi (thesis), chapters 2–4):
 //!
 //! - machines made here, not in the repository (random chains, linkage
 //!   planes, link lengths and calibrations, or measured offsets), posting CL
@@ -8,7 +8,7 @@
 //! - at the reference pressure the output is that of the machine without a
 //!   pressure section, and with `--no-pressure-compensation` that of the
 //!   reference at every pressure (the pressure words aside);
-//! - the verification of seed 001 §4.3 (eq. 4.1–4.8).
+//! - the verification of Qi (thesis) §4.3 (eq. 4.1–4.8).
 
 mod common;
 mod rng;
@@ -50,7 +50,7 @@ fn lerp<const N: usize>(rows: &[[f64; N]], x: f64, col: usize) -> f64 {
 
 impl Model {
     /// The wheel offset along the plane directions at `p`, against
-    /// `reference`: seed 001 eq. 2.35, B = L·(cos α, sin α).
+    /// `reference`: Qi (thesis) eq. 2.35, B = L·(cos α, sin α).
     fn offset(&self, reference: f64, p: f64) -> [f64; 2] {
         match self {
             Model::Linkage { length, rows } => {
@@ -498,7 +498,7 @@ fn without_pressure_column(csv: &str) -> String {
 fn at_the_reference_the_output_is_that_of_the_machine_without_pressure() {
     let with = builtin::load("mts1600").unwrap().unwrap();
     let without = mts1600_without_pressure();
-    // A tilted job (B from −24° to +12°) and the flat part of seed 000.
+    // A tilted job (B from −24° to +12°) and the flat part of Qiao et al. 2022.
     let flat = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../examples/flat-part.cls"
@@ -700,7 +700,7 @@ fn a_pressure_change_between_two_points_keeps_the_contact_point_on_the_cl() {
     }
 }
 
-/// The verification experiment of seed 001 §4.3, numerically. As we read
+/// The verification experiment of Qi (thesis) §4.3, numerically. As we read
 /// the damaged text (subscripts and operators shuffled, Δ and ° lost):
 ///
 /// ```text
@@ -713,10 +713,10 @@ fn a_pressure_change_between_two_points_keeps_the_contact_point_on_the_cl() {
 /// (printed: "2 1Y =Y a cos(45 )+", "3 1Z =Z b sin(45 )−", "4 2Z =Z Z+",
 /// "5 3Y =Y + Y"). The first trace is ground with the wheel fully retracted
 /// (upper stop), the second with it fully dropped (lower stop) and the
-/// offset compensated (seed 001 §4.2, §4.3): the start and end points differ
+/// offset compensated (Qi (thesis) §4.2, §4.3): the start and end points differ
 /// by exactly the computed ΔY, ΔZ.
 #[test]
-fn seed001_section_4_3_two_traces_at_the_stops() {
+fn qi_section_4_3_two_traces_at_the_stops() {
     let mts = builtin::load("mts1600").unwrap().unwrap();
     // The same machine with the offsets the thesis measured between the
     // stops (§2.7, §4.3: 1.12 mm in Y, 51.075 mm in Z; the wheel drops, and
@@ -738,7 +738,7 @@ fn seed001_section_4_3_two_traces_at_the_stops() {
     let thesis = [1.12, 51.075];
     assert!((linkage[1] - 51.075).abs() < 0.1, "{linkage:?}");
     for (machine, [dy, dz]) in [(&mts, linkage), (&measured, thesis)] {
-        // The contact point: near Figure 28's first block of seed 000 (Z lower,
+        // The contact point: near Figure 28's first block of Qiao et al. 2022 (Z lower,
         // for the travel of Z with the wheel dropped), B = 0 as
         // in the experiment; a, b: distances to the edges of the part.
         let (x, y1, z1, a, b) = (459.0, 8.807, 300.0, 12.0, 17.5);

@@ -1,4 +1,4 @@
-//! Any machine written to DESIGN.md §2 and any CL path of `GOTO/x,y,z,i,j,k`
+//! Any machine written as docs/machine-files.md describes and any CL path of `GOTO/x,y,z,i,j,k`
 //! posts with `--dialect csv` to blocks whose forward kinematics reproduce
 //! the CL within the closed-loop tolerance. Machines, paths and the reading
 //! of the CSV are all made here, independently of the post.

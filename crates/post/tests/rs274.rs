@@ -372,8 +372,8 @@ fn mts1600_five_axis_example() {
 }
 
 #[test]
-fn mts1600_seed_000_flat_part() {
-    let Some(rs274) = interpreter("mts1600_seed_000_flat_part") else {
+fn mts1600_qiao_flat_part() {
+    let Some(rs274) = interpreter("mts1600_qiao_flat_part") else {
         return;
     };
     let n = compare(
@@ -664,7 +664,7 @@ fn inverse_time_block_times_are_the_cl_times() {
 }
 
 /// The grinding pressure through an analog output (the `[pressure]` example
-/// of DIALECTS.md for LinuxCNC, `M68 E0 Q…`): rs274 sets the output before
+/// of docs/dialects.md for LinuxCNC, `M68 E0 Q…`): rs274 sets the output before
 /// the moves that grind at that pressure, and the moves are the CSV rows of
 /// the compensated program.
 #[test]

@@ -1,5 +1,5 @@
 //! 6-axis output: on the mts1600, CL points with a reference direction free
-//! the C axis (locked at 0 for 5-axis CL, as in seed 000).
+//! the C axis (locked at 0 for 5-axis CL, as in Qiao et al. 2022).
 
 use kinpost_post::machine::{Kinematics, builtin};
 use kinpost_post::{PostOptions, post};

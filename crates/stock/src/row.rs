@@ -1,6 +1,6 @@
 //! The fast removal along one row of rays.
 //!
-//! [`crate::stock`]'s fast removal hands each row of rays (one family, one
+//! The stock's fast removal hands each row of rays (one family, one
 //! index across the row) to [`cut_row`]. Each ray keeps a level m, at first
 //! the top of its material (`last`). The solids are visited one after the
 //! other (last sample first: on most rays it meets, the most advanced

@@ -1,4 +1,4 @@
-//! Fitting speed: interpolation of a 200 × 200 grid (issue 6: "well under a
+//! Fitting speed: interpolation of a 200 × 200 grid (the aim: "well under a
 //! second") and a least-squares fit of the same grid, and evaluating the
 //! local geometry.
 

@@ -12,7 +12,7 @@ use crate::basis::{DEGREE, basis_ders, find_span};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Ends {
-    /// Zero second derivative at both ends (seed 002, DESIGN.md §5).
+    /// Zero second derivative at both ends (Li (B-spline grinding), §2).
     Natural,
     /// Continuous third derivative at the second and the second-last data
     /// parameter (the first and last interior knots). Needs 4 points.
@@ -137,7 +137,7 @@ fn check_params(params: &[f64], need: usize) -> Result<(), FitError> {
     Ok(())
 }
 
-/// The interpolation knot vector of DESIGN.md §5: the data parameters as
+/// The interpolation knot vector (Li (B-spline grinding), §2): the data parameters as
 /// knots, the end ones four-fold (open, clamped), so m points give m + 2
 /// control points.
 pub fn interpolation_knots(params: &[f64]) -> Vec<f64> {
@@ -368,7 +368,7 @@ fn end_tangent_rev<const N: usize>(t: &[f64], q: &[[f64; N]]) -> [f64; N] {
     end_tangent(&rt, &rq)
 }
 
-/// Parameters of `m` points spread uniformly over [0, 1] (DESIGN.md §5:
+/// Parameters of `m` points spread uniformly over [0, 1] (Li (B-spline grinding), §2:
 /// u_i = i / (m − 1)).
 pub fn uniform_params(m: usize) -> Vec<f64> {
     if m == 1 {

@@ -1,6 +1,6 @@
 //! Differential geometry of a parametric surface at one point: the unit
 //! normal, the first and second fundamental forms, Gaussian and mean
-//! curvature, principal curvatures and directions (seed 002 eq. 16;
+//! curvature, principal curvatures and directions (Li (B-spline grinding) eq. 16;
 //! do Carmo, *Differential Geometry of Curves and Surfaces*, §3-3).
 //!
 //! Sign convention: the normal is `r_u × r_v / |r_u × r_v|`, and a normal

@@ -1,4 +1,4 @@
-//! Cubic B-spline surfaces from measured points (seed 002, DESIGN.md §5).
+//! Cubic B-spline surfaces from measured points (Li (B-spline grinding)).
 //!
 //! * [`grid`]: grids of points from CSV files, whitespace tables and NASA
 //!   blade tables, with located diagnostics.

@@ -1,5 +1,5 @@
 //! Tensor-product cubic B-spline surfaces: fitting to a grid (interpolation
-//! as DESIGN.md §5 specifies, or least squares), evaluation with first and
+//! as Li (B-spline grinding) does, or least squares), evaluation with first and
 //! second derivatives, and the local geometry.
 
 use nalgebra::Vector3;
@@ -13,7 +13,7 @@ use crate::grid::Grid;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Parameterisation {
-    /// u_i = i / (m − 1), v_j = j / (n − 1) (DESIGN.md §5, seed 002).
+    /// u_i = i / (m − 1), v_j = j / (n − 1) (Li (B-spline grinding), §2).
     Uniform,
     /// Cumulative chord length along each grid line, normalised to [0, 1]
     /// and averaged over the lines (The NURBS Book §9.2.5).
@@ -195,7 +195,7 @@ impl Surface {
         let (rows, cols) = (fu.n_ctrl(), fv.n_ctrl());
         // Along v for every grid row, then along u for every column of
         // those intermediate control points: the tensor product of the two
-        // one-direction fits (both linear maps), as seed 002 §2 does.
+        // one-direction fits (both linear maps), as Li (B-spline grinding) §2 does.
         let mut inter = vec![[0.0; 3]; m * cols];
         let mut out = Vec::with_capacity(cols.max(rows));
         for i in 0..m {

@@ -1,4 +1,4 @@
-//! Plain SVG pictures of surfaces (seed 002 Figures 5–6: the fitted surface
+//! Plain SVG pictures of surfaces (Li (B-spline grinding) Figures 5–6: the fitted surface
 //! and its Gaussian curvature): an oblique parallel projection, the surface
 //! as a mesh of quadrilaterals drawn back to front (painter's algorithm),
 //! shaded by a fixed light and optionally coloured by curvature, with the

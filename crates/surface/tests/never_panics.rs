@@ -52,11 +52,11 @@ fn exercise_json(text: &str) {
 }
 
 fn valid_csv() -> String {
-    std::fs::read_to_string(common::seed002_path()).unwrap()
+    std::fs::read_to_string(common::li_points_path()).unwrap()
 }
 
 fn valid_json() -> String {
-    to_json(&Surface::fit(&common::seed002(), &FitOptions::default()).unwrap())
+    to_json(&Surface::fit(&common::li_points(), &FitOptions::default()).unwrap())
 }
 
 /// `text` with a few bytes replaced, inserted or removed at random places.

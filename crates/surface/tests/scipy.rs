@@ -1,7 +1,7 @@
-//! The seed-002 surface against an independent implementation of the same
+//! The surface of Li's measured points against an independent implementation of the same
 //! specification: scipy's `make_interp_spline(k=3, bc_type=…)` applied
 //! along each direction (`tests/scipy_reference.py`, which explains why that
-//! is the construction of DESIGN.md §5). Acceptance of issue 6: points
+//! is the construction of Li (B-spline grinding)). The aim: points
 //! within 1e-6 mm, normals within 1e-6, curvatures within 1e-4 relative.
 //!
 //! Needs Python 3 with scipy (Debian: `python3-scipy`, which `.ci/run`
@@ -37,7 +37,7 @@ fn reference(python: &str, ends: &str, params: &str, uv: &[(f64, f64)]) -> Vec<V
     let script = common::root().join("crates/surface/tests/scipy_reference.py");
     let mut child = Command::new(python)
         .arg(script)
-        .arg(common::seed002_path())
+        .arg(common::li_points_path())
         .args([ends, params])
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
@@ -79,19 +79,19 @@ fn sample_points() -> Vec<(f64, f64)> {
 }
 
 #[test]
-fn seed002_surface_matches_scipy() {
+fn li_surface_matches_scipy() {
     let Some(py) = python() else {
         assert!(
             std::env::var_os("CI").is_none(),
             "CI must run the scipy comparison: install python3-scipy (.ci/run does)"
         );
         eprintln!(
-            "SKIPPED: seed002_surface_matches_scipy: no Python 3 with scipy found (install \
+            "SKIPPED: li_surface_matches_scipy: no Python 3 with scipy found (install \
              python3-scipy, or set KINPOST_PYTHON)"
         );
         return;
     };
-    let grid = common::seed002();
+    let grid = common::li_points();
     let uv = sample_points();
     let mut compared = 0;
     for (ends, ends_name) in [

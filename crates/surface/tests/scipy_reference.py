@@ -2,7 +2,7 @@
 """Independent reference for kinpost's B-spline surfaces (crates/surface).
 
 Evaluates the tensor-product cubic spline interpolant of a grid of points
-with scipy, one direction at a time, exactly as DESIGN.md section 5 specifies
+with scipy, one direction at a time, exactly as Li's B-spline paper constructs it
 it: data at uniform parameters u_i = i/(m-1), v_j = j/(n-1) (or averaged
 chord-length parameters), cubic, knots at the data parameters with the end
 ones four-fold, natural end conditions (or not-a-knot, or clamped tangents
@@ -114,7 +114,7 @@ def main():
         n = cross / np.linalg.norm(cross)
         e, f, g = su @ su, su @ sv, sv @ sv
         l_, m_, n_ = suu @ n, suv @ n, svv @ n
-        k = (l_ * n_ - m_ * m_) / (e * g - f * f)  # seed 002 eq. 16
+        k = (l_ * n_ - m_ * m_) / (e * g - f * f)  # Li (B-spline grinding) eq. 16
         h = (e * n_ - 2 * f * m_ + g * l_) / (2 * (e * g - f * f))
         r = np.sqrt(max(h * h - k, 0.0))
         vals = [u, v, *s, *n, k, h, h + r, h - r]

@@ -1,4 +1,4 @@
-//! Surface fitting and geometry: seed 002's points, analytic cylinder and
+//! Surface fitting and geometry: Li (B-spline grinding)'s points, analytic cylinder and
 //! sphere, exact reproduction of polynomials, least squares on noisy data,
 //! and surface files that load back bit-identically.
 
@@ -30,11 +30,11 @@ fn natural() -> FitOptions {
 }
 
 #[test]
-fn seed002_surface_passes_through_all_35_points() {
-    let g = common::seed002();
+fn li_surface_passes_through_all_35_points() {
+    let g = common::li_points();
     assert_eq!((g.rows, g.cols), (5, 7));
     let s = Surface::fit(&g, &natural()).unwrap();
-    // (m + 2) × (n + 2) control points (DESIGN.md §5, seed 002 §2).
+    // (m + 2) × (n + 2) control points (Li (B-spline grinding), §2).
     assert_eq!(s.net_size(), (7, 9));
     for i in 0..5 {
         for j in 0..7 {
@@ -61,7 +61,7 @@ fn seed002_surface_passes_through_all_35_points() {
             );
         }
     }
-    // The clamped knots of seed 002: open, uniform.
+    // The clamped knots of Li (B-spline grinding): open, uniform.
     assert_eq!(
         s.knots_u(),
         &[0.0, 0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0, 1.0]
@@ -213,7 +213,7 @@ fn least_squares_smooths_a_noisy_scan() {
 
 #[test]
 fn surface_files_load_back_bit_identically() {
-    let g = common::seed002();
+    let g = common::li_points();
     for options in [
         natural(),
         FitOptions {
@@ -248,7 +248,7 @@ fn surface_files_load_back_bit_identically() {
 
 #[test]
 fn bad_surface_files_are_located() {
-    let s = Surface::fit(&common::seed002(), &natural()).unwrap();
+    let s = Surface::fit(&common::li_points(), &natural()).unwrap();
     let text = to_json(&s);
     // A syntax error: the missing comma's line.
     let broken = text.replacen("\"version\": 1,", "\"version\": 1", 1);

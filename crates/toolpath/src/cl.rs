@@ -19,7 +19,7 @@ pub struct ClOptions {
     /// Feed rate, mm/min.
     pub feed: f64,
     /// `PRESSURE/word,value` before the first pass (belt-grinding contact
-    /// pressure, e.g. `H1` on the MTS1600 family, seed 001).
+    /// pressure, e.g. `H1` on the MTS1600 family, Qi (thesis)).
     pub pressure: Option<(String, f64)>,
     /// Write the feed direction as the tool reference (nine-value GOTOs).
     pub reference: bool,

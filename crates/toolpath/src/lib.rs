@@ -1,10 +1,10 @@
-//! Belt-grinding paths on B-spline surfaces (issue 6, seed 002 §5).
+//! Belt-grinding paths on B-spline surfaces (Li (B-spline grinding), §5).
 //!
 //! A contact wheel of radius R and width W rolls along iso-parametric
 //! passes of a [`Surface`], zig-zag: its axis lies in the tangent plane
 //! across the pass, so a pass grinds a strip about W wide. The CL tool
 //! axis is the surface normal on the chosen side (from the contact point
-//! towards the wheel: seed 002 eq. 29 puts the wheel's grinding-face normal
+//! towards the wheel: Li (B-spline grinding) eq. 29 puts the wheel's grinding-face normal
 //! on it), the CL point the contact point, and the tool reference the feed
 //! direction of the passes (for 6-axis machines).
 //!

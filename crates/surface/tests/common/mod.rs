@@ -10,13 +10,13 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The 35 measured points of seed 002 (Tables 1–5).
-pub fn seed002_path() -> PathBuf {
+/// The 35 measured points of Li (B-spline grinding) (Tables 1–5).
+pub fn li_points_path() -> PathBuf {
     root().join("data/li-bspline/points.csv")
 }
 
-pub fn seed002() -> Grid {
-    let path = seed002_path();
+pub fn li_points() -> Grid {
+    let path = li_points_path();
     let text = std::fs::read_to_string(&path).expect("data/li-bspline/points.csv");
     read_grid(&text, &path.to_string_lossy()).expect("valid grid")
 }

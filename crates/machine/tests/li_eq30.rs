@@ -1,4 +1,4 @@
-//! The built-in `ac-grinder` against seed 002 (Li), section 5: posting a
+//! The built-in `ac-grinder` against Li (B-spline grinding), section 5: posting a
 //! surface normal gives exactly the A and C angles of eq. (30), and the whole
 //! pose of every solution, run through the paper's own transformation chain
 //! (eq. 17-25), puts the CL point on the wheel's grinding point.
@@ -25,12 +25,12 @@ use nalgebra::{Vector3, Vector4};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-mod seed002_paper;
+mod li_paper;
 
-use seed002_paper::{PHI, R_S1, eq25, eq26, eq30, eq30_angles_deg, eq30_residual, same_angle};
+use li_paper::{PHI, R_S1, eq25, eq26, eq30, eq30_angles_deg, eq30_residual, same_angle};
 
 /// A unit normal from two uniform numbers (uniform on the sphere), and a
-/// point near the measured points of seed 002 (Tables 1-5).
+/// point near the measured points of Li (B-spline grinding) (Tables 1-5).
 fn cases() -> impl Strategy<Value = (f64, f64, [f64; 3])> {
     (
         -1.0f64..1.0,

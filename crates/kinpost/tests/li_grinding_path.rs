@@ -1,13 +1,13 @@
-//! Seed 002 end to end: the 35 measured points → interpolation surface →
+//! Li (B-spline grinding) end to end: the 35 measured points → interpolation surface →
 //! grinding path → posted on the `ac-grinder` (the paper's A/C machine).
 //! Every posted block's A and C are the angles of the paper's eq. (30)
 //! for the CL normal, and the paper's eq. (25), with the posted linear
 //! axes, puts the CL point on the wheel's grinding point. The paper's side
-//! is `crates/machine/tests/seed002_paper/mod.rs`, written from the printed
+//! is `crates/machine/tests/li_paper/mod.rs`, written from the printed
 //! formulas, shared with the machine crate's eq. (30) test.
 
-#[path = "../../machine/tests/seed002_paper/mod.rs"]
-mod seed002_paper;
+#[path = "../../machine/tests/li_paper/mod.rs"]
+mod li_paper;
 
 use std::path::Path;
 
@@ -19,7 +19,7 @@ use kinpost_surface::{FitOptions, Surface};
 use kinpost_toolpath::cl::{ClOptions, write_cl};
 use kinpost_toolpath::{Direction, PathOptions, Spacing, Wheel, plan};
 use nalgebra::{Vector3, Vector4};
-use seed002_paper::{PHI, R_S1, eq25, eq30_angles_deg, same_angle_within};
+use li_paper::{PHI, R_S1, eq25, eq30_angles_deg, same_angle_within};
 
 fn cl_text(direction: Direction) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/li-bspline/points.csv");
@@ -40,7 +40,7 @@ fn cl_text(direction: Direction) -> String {
     assert!(path.report.scallop_max <= 0.002);
     let mut out = Vec::new();
     let cl = ClOptions {
-        name: "SEED002".into(),
+        name: "LI_FLANK".into(),
         feed: 600.0,
         pressure: None,
         reference: false,
@@ -71,7 +71,7 @@ fn posted_angles_are_those_of_eq_30() {
 
         // The CL poses, as the post read them.
         let mut poses = Vec::new();
-        let mut reader = ClReader::new(cl.as_bytes(), "seed002.cls");
+        let mut reader = ClReader::new(cl.as_bytes(), "li-flank.cls");
         while let Some(s) = reader.next_statement().unwrap() {
             if let ClEvent::Goto { point, axis, .. } = s.event {
                 poses.push((Vector3::from(point), Vector3::from(axis)));

@@ -1,4 +1,4 @@
-//! Golden test from seed 000: the verbatim Figure 28(a) CL file posts on the
+//! Golden test from Qiao et al. 2022: the verbatim Figure 28(a) CL file posts on the
 //! built-in `mts1600` to the feed moves printed in Figure 28(b), to the last
 //! printed decimal, with its two defects reported as warnings.
 

@@ -1,4 +1,4 @@
-//! The built-in `htm40100h` against seed 003 (Zhang, Li, Dong), the
+//! The built-in `htm40100h` against Zhang et al. (impeller) (Zhang, Li, Dong), the
 //! post-processing model of the HTM40100h turn-mill centre.
 //!
 //! Eq. (5), as printed: the cutter axis in the workpiece frame is
