@@ -3,7 +3,7 @@
 //! poses truly in contact), and parallel checks give the sequential
 //! result for any number of threads.
 
-mod common;
+use crate::common;
 
 use kinpost_collide::bound::MotionBound;
 use kinpost_collide::{ContactKind, Motion, World};

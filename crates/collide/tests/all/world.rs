@@ -3,7 +3,7 @@
 //! table flange and through its fixture, near misses, ignored pairs, the
 //! cutter and the stock, solids inside meshes.
 
-mod common;
+use crate::common;
 
 use kinpost_collide::{ContactKind, Motion, World};
 use kinpost_machine::{Machine, Role, builtin, machine_from_toml};

@@ -3,7 +3,7 @@
 //! the first error), joined by blank lines.
 //!
 //! To regenerate the expected files after a deliberate change of wording, run
-//! `KINPOST_BLESS=1 cargo test -p kinpost-cl --test malformed` and review the
+//! `KINPOST_BLESS=1 cargo test -p kinpost-cl --test all malformed::` and review the
 //! diff.
 
 use std::fs;

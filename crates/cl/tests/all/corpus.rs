@@ -10,7 +10,7 @@
 //! listing of every event, so that a change anywhere shows too.
 //!
 //! To write the listings anew after a deliberate change, run
-//! `KINPOST_BLESS=1 cargo test -p kinpost-cl --test corpus` and review the
+//! `KINPOST_BLESS=1 cargo test -p kinpost-cl --test all corpus::` and review the
 //! diff.
 
 use std::collections::BTreeSet;

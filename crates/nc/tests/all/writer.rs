@@ -17,7 +17,7 @@ fn mts_axes() -> Vec<AxisSpec> {
     ]
 }
 
-const FIGURE_28B: &str = include_str!("../../../data/qiao2022/figure28b-verbatim.mpf");
+const FIGURE_28B: &str = include_str!("../../../../data/qiao2022/figure28b-verbatim.mpf");
 
 /// The motion blocks of Qiao et al. 2022 Figure 28(b), as (X, Y, Z, B, A).
 fn figure_blocks() -> Vec<(String, [f64; 5])> {

@@ -175,7 +175,7 @@ fn a_bad_process_file_is_located() {
 
 #[test]
 fn the_shipped_mts1600_process_file_loads() {
-    let src = include_str!("../process/mts1600.toml");
+    let src = include_str!("../../process/mts1600.toml");
     let m = ProcessModel::from_toml(src, "mts1600.toml").unwrap();
     assert_eq!(m.force.axis, "H1");
     assert_eq!(m.force_n(3000.0), 300.0);

@@ -3,7 +3,7 @@
 //! diagnostics rendered in `NAME.expected`.
 //!
 //! To regenerate the expected files after a deliberate change of wording, run
-//! `KINPOST_BLESS=1 cargo test -p kinpost-machine --test malformed` and review
+//! `KINPOST_BLESS=1 cargo test -p kinpost-machine --test all malformed::` and review
 //! the diff.
 
 use std::fs;

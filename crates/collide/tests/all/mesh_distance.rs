@@ -2,7 +2,7 @@
 //! own BVH traversal, pruning nodes by their boxes) against the brute
 //! force: the least distance from the solid to every triangle.
 
-mod common;
+use crate::common;
 
 use kinpost_collide::shapes::to_pose;
 use kinpost_collide::{Motion, World};

@@ -25,7 +25,7 @@ use nalgebra::{Vector3, Vector4};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-mod li_paper;
+use crate::li_paper;
 
 use li_paper::{PHI, R_S1, eq25, eq26, eq30, eq30_angles_deg, eq30_residual, same_angle};
 
