@@ -18,8 +18,8 @@ use kinpost_surface::grid::read_grid;
 use kinpost_surface::{FitOptions, Surface};
 use kinpost_toolpath::cl::{ClOptions, write_cl};
 use kinpost_toolpath::{Direction, PathOptions, Spacing, Wheel, plan};
-use nalgebra::{Vector3, Vector4};
 use li_paper::{PHI, R_S1, eq25, eq30_angles_deg, same_angle_within};
+use nalgebra::{Vector3, Vector4};
 
 fn cl_text(direction: Direction) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/li-bspline/points.csv");

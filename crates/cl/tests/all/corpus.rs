@@ -20,6 +20,7 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use kinpost_cl::{ClEvent, ClReader, Statement, Units};
+use kinpost_testkit::Goldens;
 
 /// How a file is read: the tool axis of files that write none (SOLIDWORKS
 /// CAM, Creo 3-axis: their documentation and files take it as +Z) and the
@@ -204,7 +205,6 @@ fn listing(case: &Case, statements: &[Statement]) -> String {
 
 #[test]
 fn every_real_cl_file_reads_to_its_listing() {
-    let bless = std::env::var_os("KINPOST_BLESS").is_some();
     // Every file of data/cl/ has its case, and every case its file.
     let mut present = BTreeSet::new();
     for dir in std::fs::read_dir(data()).unwrap() {
@@ -219,24 +219,11 @@ fn every_real_cl_file_reads_to_its_listing() {
     assert_eq!(present, listed, "data/cl/ and the cases differ");
     assert!(CASES.len() >= 20);
 
-    let mut failures = Vec::new();
+    let mut goldens = Goldens::from_env();
     for case in CASES {
         let statements = statements(case);
         let text = listing(case, &statements);
-        let path = golden().join(format!("{}.events", case.path));
-        if bless {
-            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            std::fs::write(&path, &text).unwrap();
-            continue;
-        }
-        let want = std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("{}: {e} (bless with KINPOST_BLESS=1)", path.display()));
-        if want != text {
-            failures.push(case.path);
-        }
+        goldens.check(&golden().join(format!("{}.events", case.path)), &text);
     }
-    assert!(
-        failures.is_empty(),
-        "listings differ (KINPOST_BLESS=1 to write them anew, then review the diff): {failures:?}"
-    );
+    goldens.finish();
 }

@@ -9,6 +9,8 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use kinpost_testkit::{Goldens, assert_no_orphans, files_with_extension};
+
 use kinpost_cl::{ClReader, Diagnostic, Severity};
 
 fn corpus() -> PathBuf {
@@ -35,16 +37,10 @@ fn diagnostics(name: &str, bytes: &[u8]) -> Vec<Diagnostic> {
 
 #[test]
 fn malformed_corpus() {
-    let bless = std::env::var_os("KINPOST_BLESS").is_some();
-    let mut files: Vec<PathBuf> = fs::read_dir(corpus())
-        .expect("tests/malformed")
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "cls"))
-        .collect();
-    files.sort();
+    let files = files_with_extension(&corpus(), "cls");
     assert!(files.len() >= 30, "corpus too small: {}", files.len());
 
-    let mut failures = Vec::new();
+    let mut goldens = Goldens::from_env();
     for path in &files {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let bytes = fs::read(path).unwrap();
@@ -75,18 +71,13 @@ fn malformed_corpus() {
             .map(|d| format!("{d}\n"))
             .collect::<Vec<_>>()
             .join("\n");
-        let expected_path = path.with_extension("expected");
-        if bless {
-            fs::write(&expected_path, &rendered).unwrap();
-            continue;
-        }
-        match fs::read_to_string(&expected_path) {
-            Ok(expected) if expected == rendered => {}
-            Ok(expected) => failures.push(format!(
-                "{name}:\n--- expected\n{expected}--- got\n{rendered}"
-            )),
-            Err(e) => failures.push(format!("{}: {e}", expected_path.display())),
-        }
+        goldens.check(&path.with_extension("expected"), &rendered);
     }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    goldens.finish();
+}
+
+/// Every expected output has its input file.
+#[test]
+fn no_orphan_expected_files() {
+    assert_no_orphans(&corpus(), "expected", "cls");
 }

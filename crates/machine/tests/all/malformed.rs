@@ -9,6 +9,8 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use kinpost_testkit::{Goldens, assert_no_orphans, files_with_extension};
+
 use kinpost_machine::machine_from_toml;
 
 fn corpus() -> PathBuf {
@@ -17,22 +19,16 @@ fn corpus() -> PathBuf {
 
 #[test]
 fn malformed_corpus() {
-    let bless = std::env::var_os("KINPOST_BLESS").is_some();
-    let mut files: Vec<PathBuf> = fs::read_dir(corpus())
-        .expect("tests/malformed")
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
+    let files = files_with_extension(&corpus(), "toml");
     assert!(files.len() >= 20, "corpus too small: {}", files.len());
 
-    let mut failures = Vec::new();
+    let mut goldens = Goldens::from_env();
     for path in &files {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let source = fs::read_to_string(path).unwrap();
         let diags = match machine_from_toml(&source, &name) {
             Ok(m) => {
-                failures.push(format!("{name}: loaded machine `{}`", m.name));
+                goldens.fail(format!("{name}: loaded machine `{}`", m.name));
                 continue;
             }
             Err(d) => d,
@@ -56,34 +52,13 @@ fn malformed_corpus() {
             );
         }
 
-        let rendered = format!("{diags}\n");
-        let expected_path = path.with_extension("expected");
-        if bless {
-            fs::write(&expected_path, &rendered).unwrap();
-            continue;
-        }
-        match fs::read_to_string(&expected_path) {
-            Ok(expected) if expected == rendered => {}
-            Ok(expected) => failures.push(format!(
-                "{name}:\n--- expected\n{expected}--- got\n{rendered}"
-            )),
-            Err(e) => failures.push(format!("{}: {e}", expected_path.display())),
-        }
+        goldens.check(&path.with_extension("expected"), &format!("{diags}\n"));
     }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    goldens.finish();
 }
 
-/// Every file in the corpus has an expected output and vice versa.
+/// Every expected output has its input file.
 #[test]
 fn no_orphan_expected_files() {
-    for entry in fs::read_dir(corpus()).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "expected") {
-            assert!(
-                path.with_extension("toml").is_file(),
-                "{} has no .toml",
-                path.display()
-            );
-        }
-    }
+    assert_no_orphans(&corpus(), "expected", "toml");
 }

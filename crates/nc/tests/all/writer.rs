@@ -21,7 +21,8 @@ const FIGURE_28B: &str = include_str!("../../../../data/qiao2022/figure28b-verba
 
 /// The motion blocks of Qiao et al. 2022 Figure 28(b), as (X, Y, Z, B, A).
 fn figure_blocks() -> Vec<(String, [f64; 5])> {
-    FIGURE_28B.lines()
+    FIGURE_28B
+        .lines()
         .filter(|l| l.starts_with("X="))
         .map(|l| {
             let v: Vec<f64> = l
