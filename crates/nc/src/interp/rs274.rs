@@ -4,7 +4,7 @@
 //! Rules followed: LinuxCNC documentation ("G-code overview": order of
 //! execution, parameters, expressions, O-codes; "G codes": G2/G3 centre and
 //! radius formats, canned cycles) checked against LinuxCNC's own `rs274`
-//! (tests `crates/nc/tests/interp_rs274.rs`); Fanuc 0i-MF / 30i operator's
+//! (tests `crates/nc/tests/all/interp_rs274.rs`); Fanuc 0i-MF / 30i operator's
 //! manuals (B-64604EN, B-63944EN): "Decimal point programming", "Custom
 //! macro" (variables, operations, GOTO, IF, WHILE, G65), "Canned cycles for
 //! drilling", "Subprogram" (M98/M99), "Tool center point control" (G43.4).
