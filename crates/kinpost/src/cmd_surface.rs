@@ -12,7 +12,7 @@ use kinpost_surface::svg::{Curvature, plot_surface};
 use kinpost_surface::{Ends, FitOptions, Method, Parameterisation, Surface};
 use kinpost_toolpath::cl::{ClOptions, write_cl};
 use kinpost_toolpath::plot::plot_path;
-use kinpost_toolpath::{Direction, PathError, PathOptions, Side, Spacing, Wheel, plan};
+use kinpost_toolpath::{Direction, PathError, PathOptions, Report, Side, Spacing, Wheel, plan};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 use crate::sinks::{deliver, open_outputs};
@@ -515,41 +515,9 @@ pub fn path(args: PathArgs) -> Result<()> {
         (None, Some(h)) => Spacing::Scallop(h),
         (None, None) => Spacing::Overlap(args.overlap),
     };
-    let side = match args.side.trim() {
-        "+" | "plus" => Side::Plus,
-        "-" | "minus" => Side::Minus,
-        s => return Err(usage(format!("--side `{s}`: + or -"))),
-    };
-    let region = match &args.region {
-        None => [0.0, 1.0, 0.0, 1.0],
-        Some(r) => {
-            let v = numbers(r, 4, "--region")?;
-            [v[0], v[1], v[2], v[3]]
-        }
-    };
-    let pressure = match &args.pressure {
-        None => None,
-        Some(p) => {
-            let (word, value) = p.split_once('=').unwrap_or(("H1", p.as_str()));
-            let value: f64 = value
-                .trim()
-                .parse()
-                .ok()
-                .filter(|v: &f64| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| {
-                    usage(format!(
-                        "--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0"
-                    ))
-                })?;
-            let word = word.trim();
-            if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric()) {
-                return Err(usage(format!(
-                    "--pressure `{p}`: the word is letters and digits, e.g. H1"
-                )));
-            }
-            Some((word.to_string(), value))
-        }
-    };
+    let side = parse_side(&args.side)?;
+    let region = parse_region(args.region.as_deref())?;
+    let pressure = parse_pressure(args.pressure.as_deref())?;
     if !(args.feed.is_finite() && args.feed > 0.0) {
         return Err(usage("--feed must be a positive number of mm/min"));
     }
@@ -581,33 +549,13 @@ pub fn path(args: PathArgs) -> Result<()> {
         || "GRIND".to_string(),
         |s| s.to_string_lossy().to_uppercase(),
     );
-    let limit = match spacing {
-        Spacing::Scallop(h) => format!(" (limit {h})"),
-        _ => String::new(),
-    };
-    let comments = vec![
-        format!("kinpost path on {}", args.surface.display()),
-        format!(
-            "wheel radius {} mm, width {} mm; tool axis = surface normal ({} side); reference = {}",
-            wheel.radius,
-            wheel.width,
-            if side == Side::Plus { "+" } else { "-" },
-            match args.reference {
-                ReferenceArg::Feed => "feed direction of the passes",
-                ReferenceArg::None => "none",
-            }
-        ),
-        format!(
-            "{} passes, step-over {:.4}-{:.4} mm, scallop max {:.5} mm{limit}, chord error max {:.5} mm",
-            r.passes, r.stepover_min, r.stepover_max, r.scallop_max, r.chord_error_max
-        ),
-    ];
+    let limit = scallop_limit_note(spacing);
     let cl = ClOptions {
         name: args.name.clone().unwrap_or(stem),
         feed: args.feed,
         pressure,
         reference: matches!(args.reference, ReferenceArg::Feed),
-        comments,
+        comments: path_comments(&args, &options, r, &limit),
     };
     // The sinks in the order opened: the CL file, then the plot and the
     // report if asked for.
@@ -621,28 +569,123 @@ pub fn path(args: PathArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", svg.display()))?;
     }
     if let Some(json) = &args.json {
-        let report = serde_json::json!({
-            "passes": r.passes,
-            "cl_points": r.points,
-            "feed_length_mm": r.length_mm,
-            "stepover_min_mm": r.stepover_min,
-            "stepover_max_mm": r.stepover_max,
-            "scallop_max_mm": r.scallop_max,
-            "scallop_limit_mm": match spacing { Spacing::Scallop(h) => Some(h), _ => None },
-            "wheel_edge_interference_max_mm": r.interference_max,
-            "chord_error_max_mm": r.chord_error_max,
-            "chord_tolerance_mm": options.chord_tolerance,
-            "concave_feed_radius_min_mm": r.concave_feed_radius_min,
-            "gaps": r.gaps.iter().map(|g| serde_json::json!({
-                "stepover_mm": g.stepover, "scallop_mm": g.scallop, "interference_mm": g.interference
-            })).collect::<Vec<_>>(),
-        });
-        let text = serde_json::to_string_pretty(&report).expect("plain data") + "\n";
+        let text = serde_json::to_string_pretty(&path_report_json(r, &options))
+            .expect("plain data")
+            + "\n";
         sink()
             .write_all(text.as_bytes())
             .with_context(|| format!("cannot write {}", json.display()))?;
     }
     deliver(sinks)?;
+    note_path_summary(r, &options, &limit);
+    Ok(())
+}
+
+/// `--side`: which side of the surface the wheel is on (`+` along the
+/// normal, `-` against it).
+fn parse_side(side: &str) -> Result<Side> {
+    match side.trim() {
+        "+" | "plus" => Ok(Side::Plus),
+        "-" | "minus" => Ok(Side::Minus),
+        s => Err(usage(format!("--side `{s}`: + or -"))),
+    }
+}
+
+/// `--region U0,U1,V0,V1`: the parameter window to grind (the whole
+/// surface without it).
+fn parse_region(region: Option<&str>) -> Result<[f64; 4]> {
+    match region {
+        None => Ok([0.0, 1.0, 0.0, 1.0]),
+        Some(r) => {
+            let v = numbers(r, 4, "--region")?;
+            Ok([v[0], v[1], v[2], v[3]])
+        }
+    }
+}
+
+/// `--pressure VALUE` or `WORD=VALUE`: the process pressure written on the
+/// CL file (word `H1` unless named), a number ≥ 0 and a word of letters and
+/// digits.
+fn parse_pressure(pressure: Option<&str>) -> Result<Option<(String, f64)>> {
+    let Some(p) = pressure else {
+        return Ok(None);
+    };
+    let (word, value) = p.split_once('=').unwrap_or(("H1", p));
+    let value: f64 = value
+        .trim()
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| {
+            usage(format!(
+                "--pressure `{p}`: expected VALUE or WORD=VALUE, a number ≥ 0"
+            ))
+        })?;
+    let word = word.trim();
+    if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric()) {
+        return Err(usage(format!(
+            "--pressure `{p}`: the word is letters and digits, e.g. H1"
+        )));
+    }
+    Ok(Some((word.to_string(), value)))
+}
+
+/// ` (limit H)` after the largest scallop when the passes are spaced by a
+/// scallop height, else nothing.
+fn scallop_limit_note(spacing: Spacing) -> String {
+    match spacing {
+        Spacing::Scallop(h) => format!(" (limit {h})"),
+        _ => String::new(),
+    }
+}
+
+/// The comments at the top of the CL file: the surface, the wheel and its
+/// orientation, and what the planned path achieves.
+fn path_comments(args: &PathArgs, options: &PathOptions, r: &Report, limit: &str) -> Vec<String> {
+    vec![
+        format!("kinpost path on {}", args.surface.display()),
+        format!(
+            "wheel radius {} mm, width {} mm; tool axis = surface normal ({} side); reference = {}",
+            options.wheel.radius,
+            options.wheel.width,
+            if options.side == Side::Plus { "+" } else { "-" },
+            match args.reference {
+                ReferenceArg::Feed => "feed direction of the passes",
+                ReferenceArg::None => "none",
+            }
+        ),
+        format!(
+            "{} passes, step-over {:.4}-{:.4} mm, scallop max {:.5} mm{limit}, chord error max {:.5} mm",
+            r.passes, r.stepover_min, r.stepover_max, r.scallop_max, r.chord_error_max
+        ),
+    ]
+}
+
+/// The `--json` report of a planned path: its figures, the limits asked
+/// for, and every gap between passes.
+fn path_report_json(r: &Report, options: &PathOptions) -> serde_json::Value {
+    serde_json::json!({
+        "passes": r.passes,
+        "cl_points": r.points,
+        "feed_length_mm": r.length_mm,
+        "stepover_min_mm": r.stepover_min,
+        "stepover_max_mm": r.stepover_max,
+        "scallop_max_mm": r.scallop_max,
+        "scallop_limit_mm": match options.spacing { Spacing::Scallop(h) => Some(h), _ => None },
+        "wheel_edge_interference_max_mm": r.interference_max,
+        "chord_error_max_mm": r.chord_error_max,
+        "chord_tolerance_mm": options.chord_tolerance,
+        "concave_feed_radius_min_mm": r.concave_feed_radius_min,
+        "gaps": r.gaps.iter().map(|g| serde_json::json!({
+            "stepover_mm": g.stepover, "scallop_mm": g.scallop, "interference_mm": g.interference
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The summary on standard error, and a warning where the wheel cuts into
+/// the surface: along the feed (a concave radius under the wheel's) or
+/// with its edge between passes (beyond the chord tolerance).
+fn note_path_summary(r: &Report, options: &PathOptions, limit: &str) {
     note!(
         "{} passes along {}, {} CL points, {:.1} mm of feed moves; step-over {:.4}–{:.4} mm; scallop max {:.5} mm{limit}; wheel-edge interference max {:.5} mm; chord error max {:.5} mm (tolerance {})",
         r.passes,
@@ -661,11 +704,11 @@ pub fn path(args: PathArgs) -> Result<()> {
         options.chord_tolerance
     );
     if let Some(rc) = r.concave_feed_radius_min
-        && rc < wheel.radius
+        && rc < options.wheel.radius
     {
         note!(
             "warning: the surface is concave along the feed with radius {rc:.3} mm, less than the wheel radius {} mm: the wheel cuts in there",
-            wheel.radius
+            options.wheel.radius
         );
     }
     if r.interference_max > options.chord_tolerance {
@@ -674,5 +717,4 @@ pub fn path(args: PathArgs) -> Result<()> {
             r.interference_max
         );
     }
-    Ok(())
 }

@@ -392,6 +392,64 @@ pub fn machine_from_toml_with(
     file: &str,
     meshes: MeshFiles,
 ) -> Result<Machine, Diagnostics> {
+    let (raw, unknown) = parse_raw_machine(source, file)?;
+    let mut c = Checker {
+        file,
+        source,
+        errors: unknown,
+    };
+
+    let name = check_name(&mut c, raw.name.as_ref());
+    let Some(axes) = check_axes(&mut c, &raw.axis) else {
+        return Err(Diagnostics(c.errors));
+    };
+    let (workpiece_rotation, workpiece_origin) = check_workpiece(&mut c, raw.workpiece.as_ref());
+    let Some(tool) = &raw.tool else {
+        c.error(
+            0..0,
+            "the machine file has no [tool] table (the tool `point` and `axis` at home)",
+        );
+        return Err(Diagnostics(c.errors));
+    };
+    let tool = check_tool(&mut c, tool, &axes);
+    let post = check_post(&mut c, raw.post);
+    let pressure = raw
+        .pressure
+        .as_ref()
+        .and_then(|p| check_pressure(&mut c, p, &axes));
+    let (solids, declared) = solids::check_solids(&mut c, &raw.solid, &axes, meshes);
+    let collision = raw
+        .collision
+        .as_ref()
+        .map(|r| solids::check_collision(&mut c, r, &declared))
+        .unwrap_or_default();
+
+    if !c.errors.is_empty() {
+        return Err(Diagnostics(c.errors));
+    }
+    Ok(Machine {
+        name,
+        description: raw.description,
+        axes,
+        workpiece_rotation,
+        workpiece_origin,
+        tool,
+        post,
+        pressure,
+        solids,
+        collision,
+    })
+}
+
+/// The machine file as read by serde, with every unknown key and value
+/// (in file order), or the file's first fatal mistake: more than
+/// [`MAX_MACHINE_FILE_BYTES`] (refused before it is parsed), a TOML
+/// syntax error, or a key of the wrong type (reported after the unknown
+/// names found before it).
+fn parse_raw_machine(
+    source: &str,
+    file: &str,
+) -> Result<(RawMachine, Vec<Diagnostic>), Diagnostics> {
     if source.len() > MAX_MACHINE_FILE_BYTES {
         return Err(Diagnostic::error(
             file,
@@ -413,24 +471,23 @@ pub fn machine_from_toml_with(
     }
     // serde would stop at the first unknown key or value: they are all
     // found here (the `Raw*` types let unknown keys pass), and reported with
-    // the mistakes the checks below find.
+    // the mistakes the checks after it find.
     let unknown = unknown_names(source, file);
-    let raw: RawMachine = match toml::from_str(source) {
-        Ok(raw) => raw,
+    match toml::from_str(source) {
+        Ok(raw) => Ok((raw, unknown)),
         Err(e) => {
             let first = toml_error(&e, file, source, false);
-            return Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
+            Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
                 unknown, first,
-            )));
+            )))
         }
-    };
-    let mut c = Checker {
-        file,
-        source,
-        errors: unknown,
-    };
+    }
+}
 
-    let name = match &raw.name {
+/// The machine's `name`, trimmed: it must be given and not blank (the
+/// post names the machine in its output and messages).
+fn check_name(c: &mut Checker, name: Option<&Spanned<String>>) -> String {
+    match name {
         Some(n) => {
             let name = n.get_ref().trim().to_string();
             if name.is_empty() {
@@ -445,29 +502,42 @@ pub fn machine_from_toml_with(
             );
             String::new()
         }
-    };
+    }
+}
 
+/// Checks every `[[axis]]` ([`check_axis`]) and then their counts
+/// ([`check_axis_counts`]). `None` when there are more than [`MAX_AXES`]:
+/// that is reported and nothing after the axes is checked.
+fn check_axes(c: &mut Checker, raw: &[RawAxis]) -> Option<Vec<Axis>> {
     // Past the limit, only the axes up to it are checked (each against the
     // others, for duplicate names): the first table past it is the error,
     // and a file of 300 000 tables takes no quadratic work.
-    let listed = &raw.axis[..raw.axis.len().min(MAX_AXES)];
+    let listed = &raw[..raw.len().min(MAX_AXES)];
     let mut axes = Vec::with_capacity(listed.len());
     let mut direction_ok = Vec::with_capacity(listed.len());
     for a in listed {
-        let (axis, ok) = check_axis(&mut c, a, listed);
+        let (axis, ok) = check_axis(c, a, listed);
         axes.push(axis);
         direction_ok.push(ok);
     }
-    if raw.axis.len() > MAX_AXES {
+    if raw.len() > MAX_AXES {
         c.error(
-            raw.axis[MAX_AXES].name.span(),
+            raw[MAX_AXES].name.span(),
             format!("a machine has at most {MAX_AXES} axes"),
         );
-        return Err(Diagnostics(c.errors));
+        return None;
     }
-    check_axis_counts(&mut c, &raw.axis, &axes, &direction_ok);
+    check_axis_counts(c, raw, &axes, &direction_ok);
+    Some(axes)
+}
 
-    let (workpiece_rotation, workpiece_origin) = match &raw.workpiece {
+/// The workpiece frame of `[workpiece]` (rotation and origin; identity
+/// without the table): unit `x` and `z` at right angles, `y = z × x`.
+fn check_workpiece(
+    c: &mut Checker,
+    workpiece: Option<&RawWorkpiece>,
+) -> (Matrix3<f64>, Vector3<f64>) {
+    match workpiece {
         None => (Matrix3::identity(), Vector3::zeros()),
         Some(w) => {
             let origin = c.point(&w.origin, "workpiece origin");
@@ -491,15 +561,14 @@ pub fn machine_from_toml_with(
             let y = z.cross(&x);
             (Matrix3::from_columns(&[x, y, z]), origin)
         }
-    };
+    }
+}
 
-    let Some(tool) = &raw.tool else {
-        c.error(
-            0..0,
-            "the machine file has no [tool] table (the tool `point` and `axis` at home)",
-        );
-        return Err(Diagnostics(c.errors));
-    };
+/// The tool at home (`[tool]`): its point, unit axis and optional
+/// reference direction at right angles to the axis. The reference fixes
+/// the rotation about the tool axis, so it is needed (and allowed) only
+/// when the free rotary axes number three.
+fn check_tool(c: &mut Checker, tool: &Spanned<RawTool>, axes: &[Axis]) -> Tool {
     let t = tool.get_ref();
     let tool_point = c.point(&t.point, "tool point");
     let tool_axis = c.unit(&t.axis, "tool axis");
@@ -534,8 +603,18 @@ pub fn machine_from_toml_with(
             "three free rotary axes need a tool `reference` direction (or lock one with `fixed`)",
         );
     }
+    Tool {
+        point: tool_point,
+        axis: tool_axis.unwrap_or_else(Vector3::z),
+        reference,
+    }
+}
 
-    let retract = raw.post.retract.as_ref().map(|r| {
+/// The post settings of `[post]`: a retract distance above zero and a
+/// singular cone from 0 to under 45° (a wider cone would take most
+/// orientations for singular).
+fn check_post(c: &mut Checker, post: RawPost) -> PostSettings {
+    let retract = post.retract.as_ref().map(|r| {
         let v = *r.get_ref();
         if !(v.is_finite() && v > 0.0) {
             c.error(
@@ -545,7 +624,7 @@ pub fn machine_from_toml_with(
         }
         v
     });
-    let singular_cone_deg = raw.post.singular_cone.as_ref().map(|r| {
+    let singular_cone_deg = post.singular_cone.as_ref().map(|r| {
         let v = *r.get_ref();
         if !(v.is_finite() && (0.0..45.0).contains(&v)) {
             c.error(
@@ -555,49 +634,22 @@ pub fn machine_from_toml_with(
         }
         v
     });
-    let pressure = raw
-        .pressure
-        .as_ref()
-        .and_then(|p| check_pressure(&mut c, p, &axes));
-    let (solids, declared) = solids::check_solids(&mut c, &raw.solid, &axes, meshes);
-    let collision = raw
-        .collision
-        .as_ref()
-        .map(|r| solids::check_collision(&mut c, r, &declared))
-        .unwrap_or_default();
-
-    if !c.errors.is_empty() {
-        return Err(Diagnostics(c.errors));
+    PostSettings {
+        dialect: post.dialect,
+        header: post.header,
+        footer: post.footer,
+        output: post.output.map(|o| match o {
+            RawOutput::Joint => OutputMode::Joint,
+            RawOutput::Tcp => OutputMode::Tcp,
+        }),
+        retract,
+        singular_cone_deg,
     }
-    Ok(Machine {
-        name,
-        description: raw.description,
-        axes,
-        workpiece_rotation,
-        workpiece_origin,
-        tool: Tool {
-            point: tool_point,
-            axis: tool_axis.unwrap_or_else(Vector3::z),
-            reference,
-        },
-        post: PostSettings {
-            dialect: raw.post.dialect,
-            header: raw.post.header,
-            footer: raw.post.footer,
-            output: raw.post.output.map(|o| match o {
-                RawOutput::Joint => OutputMode::Joint,
-                RawOutput::Tcp => OutputMode::Tcp,
-            }),
-            retract,
-            singular_cone_deg,
-        },
-        pressure,
-        solids,
-        collision,
-    })
 }
 
-/// Checks the `[pressure]` table against the axes.
+/// Checks the `[pressure]` table against the axes: its name, reference,
+/// linkage plane, wheel model, and the reference within the calibration.
+/// `None` when any of them is wrong (each mistake is reported).
 fn check_pressure(
     c: &mut Checker,
     raw: &Spanned<RawPressure>,
@@ -605,79 +657,114 @@ fn check_pressure(
 ) -> Option<PressureAxis> {
     let p = raw.get_ref();
     let errors_before = c.errors.len();
-    let name = p.name.get_ref().trim().to_string();
-    if !name.starts_with(|ch: char| ch.is_ascii_alphabetic())
-        || !name.chars().all(|ch| ch.is_ascii_alphanumeric())
-    {
-        c.error(
-            p.name.span(),
-            "pressure name must be a letter followed by letters and digits (the NC word, e.g. \"H1\")",
-        );
-    } else if let Some(a) = axes.iter().find(|a| a.name.eq_ignore_ascii_case(&name)) {
-        c.error(
-            p.name.span(),
-            format!(
-                "pressure name `{name}` is also the name of axis `{}`",
-                a.name
-            ),
-        );
-    }
+    let name = check_pressure_name(c, &p.name, axes);
     let reference = *p.reference.get_ref();
     if !reference.is_finite() {
         c.error(p.reference.span(), "reference must be a finite number");
     }
+    let plane = check_linkage_plane(c, &p.plane, axes);
+    let model = check_wheel_model(c, raw);
+    check_reference_in_calibration(c, &p.reference, model.as_ref());
+    if c.errors.len() > errors_before {
+        return None;
+    }
+    Some(PressureAxis {
+        name,
+        reference,
+        directions: [axes[plane[0]].direction, axes[plane[1]].direction],
+        plane,
+        model: model?,
+    })
+}
 
-    // The linkage plane: two perpendicular linear axes.
+/// The pressure's NC word (`H1`), trimmed: a letter then letters and
+/// digits, and no axis's name (the word would be read as the axis).
+fn check_pressure_name(c: &mut Checker, name: &Spanned<String>, axes: &[Axis]) -> String {
+    let trimmed = name.get_ref().trim().to_string();
+    if !trimmed.starts_with(|ch: char| ch.is_ascii_alphabetic())
+        || !trimmed.chars().all(|ch| ch.is_ascii_alphanumeric())
+    {
+        c.error(
+            name.span(),
+            "pressure name must be a letter followed by letters and digits (the NC word, e.g. \"H1\")",
+        );
+    } else if let Some(a) = axes.iter().find(|a| a.name.eq_ignore_ascii_case(&trimmed)) {
+        c.error(
+            name.span(),
+            format!(
+                "pressure name `{trimmed}` is also the name of axis `{}`",
+                a.name
+            ),
+        );
+    }
+    trimmed
+}
+
+/// The linkage plane: two distinct, perpendicular linear axes of the
+/// machine, as indices into `axes`; an index that cannot be had is
+/// `usize::MAX` (and reported).
+fn check_linkage_plane(
+    c: &mut Checker,
+    plane_names: &Spanned<Vec<Spanned<String>>>,
+    axes: &[Axis],
+) -> [usize; 2] {
     let mut plane = [usize::MAX; 2];
-    let names = p.plane.get_ref();
+    let names = plane_names.get_ref();
     if names.len() != 2 {
         c.error(
-            p.plane.span(),
+            plane_names.span(),
             format!(
                 "plane names the two linear axes that span the linkage plane, e.g. [\"Y\", \"Z\"]; found {} names",
                 names.len()
             ),
         );
-    } else {
-        for (k, n) in names.iter().enumerate() {
-            let wanted = n.get_ref().trim();
-            match axes
-                .iter()
-                .position(|a| a.name.eq_ignore_ascii_case(wanted))
-            {
-                None => c.error(n.span(), format!("the machine has no axis `{wanted}`")),
-                Some(i) if axes[i].is_rotary() => c.error(
-                    n.span(),
-                    format!(
-                        "plane axis `{}` is rotary; the plane is spanned by linear axes",
-                        axes[i].name
-                    ),
+        return plane;
+    }
+    for (k, n) in names.iter().enumerate() {
+        let wanted = n.get_ref().trim();
+        match axes
+            .iter()
+            .position(|a| a.name.eq_ignore_ascii_case(wanted))
+        {
+            None => c.error(n.span(), format!("the machine has no axis `{wanted}`")),
+            Some(i) if axes[i].is_rotary() => c.error(
+                n.span(),
+                format!(
+                    "plane axis `{}` is rotary; the plane is spanned by linear axes",
+                    axes[i].name
                 ),
-                Some(i) => plane[k] = i,
-            }
-        }
-        if plane[0] != usize::MAX && plane[0] == plane[1] {
-            c.error(p.plane.span(), "plane names the same axis twice");
-            plane[1] = usize::MAX;
-        }
-        if plane.iter().all(|&i| i != usize::MAX) {
-            let (a, b) = (&axes[plane[0]], &axes[plane[1]]);
-            let cos = a.direction.dot(&b.direction);
-            if cos.abs() > UNIT_TOLERANCE {
-                c.error(
-                    p.plane.span(),
-                    format!(
-                        "plane axes `{}` and `{}` must be perpendicular (they are {}° apart)",
-                        a.name,
-                        b.name,
-                        short(a.direction.angle(&b.direction).to_degrees(), 3)
-                    ),
-                );
-            }
+            ),
+            Some(i) => plane[k] = i,
         }
     }
+    if plane[0] != usize::MAX && plane[0] == plane[1] {
+        c.error(plane_names.span(), "plane names the same axis twice");
+        plane[1] = usize::MAX;
+    }
+    if plane.iter().all(|&i| i != usize::MAX) {
+        let (a, b) = (&axes[plane[0]], &axes[plane[1]]);
+        let cos = a.direction.dot(&b.direction);
+        if cos.abs() > UNIT_TOLERANCE {
+            c.error(
+                plane_names.span(),
+                format!(
+                    "plane axes `{}` and `{}` must be perpendicular (they are {}° apart)",
+                    a.name,
+                    b.name,
+                    short(a.direction.angle(&b.direction).to_degrees(), 3)
+                ),
+            );
+        }
+    }
+    plane
+}
 
-    let model = match (&p.link_length, &p.alpha_deg, &p.offsets) {
+/// The wheel model: the four-bar linkage (`link_length` with
+/// `alpha_deg`) or measured `offsets`, exactly one of the two, with its
+/// calibration table checked.
+fn check_wheel_model(c: &mut Checker, raw: &Spanned<RawPressure>) -> Option<WheelModel> {
+    let p = raw.get_ref();
+    match (&p.link_length, &p.alpha_deg, &p.offsets) {
         (Some(l), Some(t), None) => {
             let length = *l.get_ref();
             if !(length.is_finite() && length > 0.0) {
@@ -726,43 +813,41 @@ fn check_pressure(
             );
             None
         }
-    };
-    // The tool point was measured at the reference: it must lie on the
-    // calibration (a reference beyond a stop is ambiguous; a row on the stop
-    // says what is meant).
+    }
+}
+
+/// The tool point was measured at the reference: it must lie on the
+/// calibration (a reference beyond a stop is ambiguous; a row on the stop
+/// says what is meant). A non-finite reference was reported already.
+fn check_reference_in_calibration(
+    c: &mut Checker,
+    reference: &Spanned<f64>,
+    model: Option<&WheelModel>,
+) {
     fn ends<const N: usize>(rows: &[[f64; N]]) -> Option<(f64, f64)> {
         (rows.len() >= 2).then(|| (rows[0][0], rows[rows.len() - 1][0]))
     }
-    let ends = match &model {
+    let ends = match model {
         Some(WheelModel::Linkage { alpha_deg, .. }) => ends(alpha_deg),
         Some(WheelModel::Offsets(rows)) => ends(rows),
         None => None,
     };
+    let value = *reference.get_ref();
     if let Some((lo, hi)) = ends
-        && reference.is_finite()
-        && (reference < lo || reference > hi)
+        && value.is_finite()
+        && (value < lo || value > hi)
     {
         c.error(
-            p.reference.span(),
+            reference.span(),
             format!(
                 "reference {} is outside the calibration ({} .. {}); if the wheel is on a stop there, add a row at {} with the stop's value",
-                short(reference, 9),
+                short(value, 9),
                 short(lo, 9),
                 short(hi, 9),
-                short(reference, 9)
+                short(value, 9)
             ),
         );
     }
-    if c.errors.len() > errors_before {
-        return None;
-    }
-    Some(PressureAxis {
-        name,
-        reference,
-        directions: [axes[plane[0]].direction, axes[plane[1]].direction],
-        plane,
-        model: model?,
-    })
 }
 
 /// The rows of a calibration table: `N` finite numbers each, at least two
@@ -810,6 +895,42 @@ fn table<const N: usize>(c: &mut Checker, t: &Table, key: &str, row: &str) -> Ve
 
 /// Checks one axis; also says whether its direction is usable.
 fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
+    let name = check_axis_name(c, a, all);
+    let direction = c.unit(&a.direction, "axis direction");
+    let direction_ok = direction.is_some();
+    let direction = direction.unwrap_or_else(Vector3::z);
+    let kind = match a.kind {
+        RawKind::Linear => AxisKind::Linear,
+        RawKind::Rotary => AxisKind::Rotary,
+    };
+    let point = check_axis_point(c, a, kind, &name);
+    let offset = check_machine_offset(c, a.machine_offset.as_ref());
+    let (limits, limits_ok) = check_limits(c, a.limits.as_ref(), kind, offset);
+    let fixed = check_fixed(c, a.fixed.as_ref(), limits.filter(|_| limits_ok));
+    let mut axis = Axis {
+        name,
+        kind,
+        side: match a.side {
+            RawSide::Workpiece => Side::Workpiece,
+            RawSide::Tool => Side::Tool,
+        },
+        direction,
+        point,
+        wrap: Axis::default_wrap(kind, limits),
+        limits,
+        fixed,
+        free_with_reference: false,
+        prefer: None,
+        max_velocity: None,
+    };
+    check_axis_options(c, a, &mut axis);
+    (axis, direction_ok)
+}
+
+/// The axis name, trimmed: letters and digits (the NC address), and no
+/// earlier axis of the same name (names are not case-sensitive); a
+/// duplicate names the line of the first.
+fn check_axis_name(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> String {
     let name = a.name.get_ref().trim().to_string();
     if name.is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric()) {
         c.error(
@@ -832,14 +953,13 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
             ),
         );
     }
-    let direction = c.unit(&a.direction, "axis direction");
-    let direction_ok = direction.is_some();
-    let direction = direction.unwrap_or_else(Vector3::z);
-    let kind = match a.kind {
-        RawKind::Linear => AxisKind::Linear,
-        RawKind::Rotary => AxisKind::Rotary,
-    };
-    let point = match (kind, &a.point) {
+    name
+}
+
+/// A point on a rotary axis's rotation line: required for a rotary axis,
+/// refused on a linear one (zero where missing or refused).
+fn check_axis_point(c: &mut Checker, a: &RawAxis, kind: AxisKind, name: &str) -> Vector3<f64> {
+    match (kind, &a.point) {
         (AxisKind::Rotary, Some(p)) => c.point(p, "axis point"),
         (AxisKind::Rotary, None) => {
             c.error(
@@ -856,8 +976,13 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
             Vector3::zeros()
         }
         (AxisKind::Linear, None) => Vector3::zeros(),
-    };
-    let offset = match &a.machine_offset {
+    }
+}
+
+/// The machine offset (machine value − NC value): finite and within
+/// ±[`MAX_COORDINATE_MM`]; 0 where missing or wrong.
+fn check_machine_offset(c: &mut Checker, offset: Option<&Spanned<f64>>) -> f64 {
+    match offset {
         Some(o) if !o.get_ref().is_finite() => {
             c.error(o.span(), "machine_offset must be a finite number");
             0.0
@@ -871,9 +996,21 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         }
         Some(o) => *o.get_ref(),
         None => 0.0,
-    };
+    }
+}
+
+/// The axis limits as NC values (machine limits − `offset`), and whether
+/// they are usable: finite and within ±[`MAX_COORDINATE_MM`] as machine
+/// and NC values, in order, and for a rotary axis at most
+/// [`MAX_ROTARY_TRAVEL`] apart. The first mistake is reported.
+fn check_limits(
+    c: &mut Checker,
+    limits: Option<&Spanned<Nums<2>>>,
+    kind: AxisKind,
+    offset: f64,
+) -> (Option<[f64; 2]>, bool) {
     let mut limits_ok = true;
-    let limits = a.limits.as_ref().map(|l| {
+    let limits = limits.map(|l| {
         let [lo, hi] = l.get_ref().0;
         let (nc_lo, nc_hi) = (lo - offset, hi - offset);
         limits_ok = false;
@@ -910,7 +1047,18 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         }
         [nc_lo, nc_hi]
     });
-    let fixed = a.fixed.as_ref().map(|f| {
+    (limits, limits_ok)
+}
+
+/// The value a locked (`fixed`) axis keeps: finite, within
+/// ±[`MAX_COORDINATE_MM`], and within the axis's usable limits (NC values)
+/// if it has them.
+fn check_fixed(
+    c: &mut Checker,
+    fixed: Option<&Spanned<f64>>,
+    usable_limits: Option<[f64; 2]>,
+) -> Option<f64> {
+    fixed.map(|f| {
         let v = *f.get_ref();
         if !v.is_finite() {
             c.error(f.span(), "fixed value must be a finite number");
@@ -919,8 +1067,7 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
                 f.span(),
                 format!("fixed value must lie within ±{MAX_COORDINATE_MM:e}"),
             );
-        } else if let Some([lo, hi]) = limits
-            && limits_ok
+        } else if let Some([lo, hi]) = usable_limits
             && (v < lo || v > hi)
         {
             c.error(
@@ -929,24 +1076,14 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
             );
         }
         v
-    });
-    let axis = Axis {
-        name,
-        kind,
-        side: match a.side {
-            RawSide::Workpiece => Side::Workpiece,
-            RawSide::Tool => Side::Tool,
-        },
-        direction,
-        point,
-        wrap: Axis::default_wrap(kind, limits),
-        limits,
-        fixed,
-        free_with_reference: false,
-        prefer: None,
-        max_velocity: None,
-    };
-    let mut axis = axis;
+    })
+}
+
+/// The optional settings of an axis, set on `axis`: `wrap` and `prefer`
+/// (rotary axes only), `max_velocity` (above zero), and
+/// `free_with_reference` (a locked rotary axis only).
+fn check_axis_options(c: &mut Checker, a: &RawAxis, axis: &mut Axis) {
+    let kind = axis.kind;
     if let Some(w) = &a.wrap {
         if kind != AxisKind::Rotary {
             c.error(w.span(), "`wrap` applies to rotary axes only");
@@ -987,7 +1124,6 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
             );
         }
     }
-    (axis, direction_ok)
 }
 
 fn check_axis_counts(c: &mut Checker, raw: &[RawAxis], axes: &[Axis], direction_ok: &[bool]) {

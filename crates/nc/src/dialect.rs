@@ -321,40 +321,7 @@ impl Dialect {
     /// Parses and validates a dialect file. Every problem is reported as a
     /// diagnostic naming `file_name`, line and column.
     pub fn from_toml(source: &str, file_name: &str) -> Result<Dialect, Diagnostics> {
-        if source.len() > MAX_DIALECT_FILE_BYTES {
-            return Err(Diagnostic::error(
-                file_name,
-                1,
-                1,
-                1,
-                source.lines().next().unwrap_or(""),
-                format!(
-                    "the dialect file has {} bytes, more than {MAX_DIALECT_FILE_BYTES}: a dialect \
-                     file is a few kilobytes (is this a dialect file?)",
-                    source.len()
-                ),
-            )
-            .into());
-        }
-        // serde would stop at the first unknown key or value: they are all
-        // found here (the `Raw*` types let unknown keys pass), and reported
-        // with the mistakes the checks below find.
-        let unknown = unknown_names(source, file_name);
-        let raw: RawDialect = match toml::from_str(source) {
-            Ok(raw) => raw,
-            Err(e) => {
-                let first = Diagnostic::at_byte_span(
-                    Severity::Error,
-                    file_name,
-                    source,
-                    e.span().unwrap_or(0..0),
-                    e.message().trim_end().to_string(),
-                );
-                return Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
-                    unknown, first,
-                )));
-            }
-        };
+        let (raw, unknown) = parse_raw_dialect(source, file_name)?;
         let mut errors = unknown;
         let mut err = |span: std::ops::Range<usize>, msg: String| {
             errors.push(Diagnostic::at_byte_span(
@@ -367,267 +334,27 @@ impl Dialect {
         };
 
         let kind = raw.kind;
-        if raw.name.get_ref().trim().is_empty() {
-            err(raw.name.span(), "`name` must not be empty".into());
-        }
-        if raw.extension.get_ref().contains(['.', '/', '\\']) {
-            err(
-                raw.extension.span(),
-                "`extension` is the bare extension, without a dot (e.g. `mpf`)".into(),
-            );
-        }
-
-        // Word formats.
-        let base = PartialWord::base(kind);
-        let check_word = |w: &RawWord, err: &mut dyn FnMut(std::ops::Range<usize>, String)| {
-            if let Some(p) = &w.prefix
-                && p.get_ref().len() > MAX_PREFIX
-            {
-                err(
-                    p.span(),
-                    format!("`prefix` may have at most {MAX_PREFIX} bytes"),
-                );
-            }
-            if let Some(p) = &w.suffix
-                && p.get_ref().len() > MAX_SUFFIX
-            {
-                err(
-                    p.span(),
-                    format!("`suffix` may have at most {MAX_SUFFIX} bytes"),
-                );
-            }
-            if let Some(d) = &w.decimals
-                && *d.get_ref() > MAX_DECIMALS
-            {
-                err(
-                    d.span(),
-                    format!("`decimals` must be between 0 and {MAX_DECIMALS}"),
-                );
-            }
-        };
-        check_word(&raw.linear, &mut err);
-        check_word(&raw.rotary, &mut err);
-        check_word(&raw.endless, &mut err);
-        for w in raw.axis.values() {
-            check_word(w, &mut err);
-        }
-        if let Some(p) = &raw.pressure {
-            let w = p.get_ref();
-            check_word(w, &mut err);
-            if w.modal == Some(false) {
-                err(
-                    p.span(),
-                    "the pressure word is always modal (written when its value changes): leave `modal` out".into(),
-                );
-            }
-            if let Some(m) = &w.modulo {
-                err(
-                    m.span(),
-                    "`modulo` does not apply to the pressure word".into(),
-                );
-            }
-            if kind == DialectKind::Words
-                && w.prefix.as_ref().is_some_and(|p| p.get_ref().is_empty())
-            {
-                err(
-                    w.prefix.as_ref().map_or(p.span(), |p| p.span()),
-                    "the pressure word needs a `prefix` (e.g. \"{name}=\" for `H1=3000`)".into(),
-                );
-            }
-        }
+        check_name_and_extension(&raw, &mut err);
         let raw_feed_word = raw.feed.as_word();
-        check_word(&raw_feed_word, &mut err);
-
-        let linear = base.over(&PartialWord::from(&raw.linear));
-        let rotary = base.over(&PartialWord::from(&raw.rotary));
-        let endless = PartialWord::from(&raw.endless);
-        let axis: BTreeMap<String, PartialWord> = raw
-            .axis
-            .iter()
-            .map(|(k, w)| (k.clone(), PartialWord::from(w)))
-            .collect();
-        // Whole formats (modulo against decimals) once the fields are sane.
-        let mut whole = |w: &RawWord, resolved: &[WordFormat]| {
-            for r in resolved {
-                if r.number.decimals <= MAX_DECIMALS
-                    && let Err(msg) = r.number.validate()
-                {
-                    let span = w
-                        .modulo
-                        .as_ref()
-                        .map(|m| m.span())
-                        .or_else(|| w.decimals.as_ref().map(|d| d.span()))
-                        .unwrap_or(0..0);
-                    err(span, msg.to_string());
-                    break;
-                }
-            }
-        };
-        whole(&raw.linear, &[linear.resolve("X")]);
-        whole(&raw.rotary, &[rotary.resolve("A")]);
-        whole(&raw.endless, &[rotary.over(&endless).resolve("A")]);
-        for (name, w) in &raw.axis {
-            let o = PartialWord::from(w);
-            whole(
-                w,
-                &[linear.over(&o).resolve(name), rotary.over(&o).resolve(name)],
-            );
-        }
-        let pressure = raw
-            .pressure
-            .as_ref()
-            .map(|p| PartialWord::pressure_base(kind).over(&PartialWord::from(p.get_ref())));
-        if let (Some(p), Some(w)) = (&pressure, &raw.pressure) {
-            whole(w.get_ref(), &[p.resolve("H1")]);
-        }
-        let feed_word = PartialWord::feed_base()
-            .over(&PartialWord::from(&raw_feed_word))
-            .resolve("F");
-        whole(&raw_feed_word, std::slice::from_ref(&feed_word));
+        check_word_fields(&raw, &raw_feed_word, &mut err);
+        let words = ResolvedWords::resolve(&raw, &raw_feed_word, &mut err);
 
         check_numbering(&raw.numbering, &mut err);
-        let numbering = Numbering {
-            enabled: raw.numbering.enabled,
-            prefix: raw.numbering.prefix,
-            start: *raw.numbering.start.get_ref(),
-            step: *raw.numbering.step.get_ref(),
-            digits: *raw.numbering.digits.get_ref(),
-            wrap_after: raw.numbering.wrap_after.map(Spanned::into_inner),
-            header: raw.numbering.header,
-            commands: raw.numbering.commands,
-            comments: raw.numbering.comments,
-        };
-        let mut replace = Vec::new();
-        for (from, to) in raw.comment.replace {
-            if from.is_empty() {
-                err(0..0, "`comment.replace` has an empty key".into());
-            }
-            replace.push((from, to));
-        }
+        let numbering = numbering_from(raw.numbering);
+        let replace = comment_replacements(raw.comment.replace, &mut err);
+        let (env, templates) = compile_templates(source, &raw.templates, &mut err);
+        let outside_tcp = outside_tcp_templates(raw.templates.outside_tcp.as_deref(), &mut err);
+        let motion = motion_words(raw.motion);
 
-        // Templates: compile once, errors point into the TOML file.
-        let mut env = template::environment();
-        let mut templates = BTreeMap::new();
-        for kind_t in TemplateKind::ALL {
-            let Some(t) = raw.templates.get(kind_t) else {
-                continue;
-            };
-            if let Err(e) = env.add_template_owned(kind_t.key(), t.get_ref().clone()) {
-                let span = template::error_span_in_toml(source, t.span(), t.get_ref(), &e);
-                err(
-                    span,
-                    format!(
-                        "template `{}`: {}",
-                        kind_t.key(),
-                        template::error_message(&e)
-                    ),
-                );
-            }
-            check_variables(&env, kind_t, t, source, &mut err);
-            check_budget(&env, kind_t, t, source, &mut err);
-            templates.insert(kind_t, t.get_ref().clone());
-        }
-
-        // A tool change moves the axes, and takes the new tool's length:
-        // outside tool-centre-point control unless the file says otherwise.
-        let mut outside_tcp = Vec::new();
-        match &raw.templates.outside_tcp {
-            None => outside_tcp.push(TemplateKind::ToolChange),
-            Some(names) => {
-                for name in names {
-                    match TemplateKind::ALL
-                        .into_iter()
-                        .find(|k| k.key() == name.get_ref())
-                    {
-                        Some(k) if k.is_command() => outside_tcp.push(k),
-                        _ => err(
-                            name.span(),
-                            format!(
-                                "`templates.outside_tcp`: `{}` is not a command template (one of {})",
-                                name.get_ref(),
-                                TemplateKind::ALL
-                                    .into_iter()
-                                    .filter(|k| k.is_command())
-                                    .map(TemplateKind::key)
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ),
-                        ),
-                    }
-                }
-            }
-        }
-
-        let motion = MotionWords {
-            rapid: raw.motion.rapid,
-            feed: raw.motion.feed,
-            modal: raw.motion.modal,
-            initial: match raw.motion.initial {
-                RawInitial::None => None,
-                RawInitial::Rapid => Some(Motion::Rapid),
-                RawInitial::Feed => Some(Motion::Feed),
-            },
-            rapid_aliases: raw.motion.rapid_aliases,
-            feed_aliases: raw.motion.feed_aliases,
-        };
-        let block = BlockFormat {
-            order: raw.block.order,
-            write_fixed: raw.block.write_fixed,
-            separator: raw
-                .block
-                .separator
-                .as_ref()
-                .map(|s| s.get_ref().clone())
-                .unwrap_or_else(|| match kind {
-                    DialectKind::Words => " ".into(),
-                    DialectKind::Csv => ",".into(),
-                }),
-            line_end: raw.block.line_end.get_ref().clone(),
-            after_axes: raw.block.after_axes,
-            max_line_length: raw.block.max_line_length.as_ref().map(|m| *m.get_ref()),
-        };
-        if let Some(sep) = &raw.block.separator
-            && sep.get_ref().len() > MAX_LEAD - MAX_PREFIX
-        {
-            err(
-                sep.span(),
-                format!(
-                    "`separator` may have at most {} bytes",
-                    MAX_LEAD - MAX_PREFIX
-                ),
-            );
-        }
-        if let Some(mode) = &raw.feed.mode
-            && !FEED_MODES.contains(&mode.get_ref().as_str())
-        {
-            err(
-                mode.span(),
-                format!(
-                    "unknown feed mode `{}`: use one of {}",
-                    mode.get_ref(),
-                    FEED_MODES.join(", ")
-                ),
-            );
-        }
-        if !block.line_end.ends_with('\n') {
-            err(
-                raw.block.line_end.span(),
-                "`line_end` must end with a newline".into(),
-            );
-        }
-        // The shortest line a limit must hold: an empty comment.
-        let least = block.line_end.len() + raw.comment.prefix.len() + raw.comment.suffix.len();
-        if let Some(max) = &raw.block.max_line_length
-            && *max.get_ref() <= least
-        {
-            err(
-                max.span(),
-                format!(
-                    "`max_line_length` counts the line end: it must be more than {least} bytes \
-                     (line end, comment prefix and suffix)"
-                ),
-            );
-        }
+        check_separator(&raw.block, &mut err);
+        check_feed_mode(&raw.feed, &mut err);
+        check_line_end_and_length(
+            &raw.block,
+            &raw.comment.prefix,
+            &raw.comment.suffix,
+            &mut err,
+        );
+        let block = block_format(raw.block, kind);
 
         if !errors.is_empty() {
             return Err(Diagnostics(errors));
@@ -638,19 +365,21 @@ impl Dialect {
             description: raw.description,
             kind,
             block,
-            linear,
-            rotary,
-            endless,
-            axis,
+            linear: words.linear,
+            rotary: words.rotary,
+            endless: words.endless,
+            axis: words.axis,
             pressure: match kind {
                 // A table always has the pressure column.
-                DialectKind::Csv => {
-                    Some(pressure.unwrap_or_else(|| PartialWord::pressure_base(kind)))
-                }
-                DialectKind::Words => pressure,
+                DialectKind::Csv => Some(
+                    words
+                        .pressure
+                        .unwrap_or_else(|| PartialWord::pressure_base(kind)),
+                ),
+                DialectKind::Words => words.pressure,
             },
             feed: FeedFormat {
-                word: feed_word,
+                word: words.feed,
                 rapid: raw.feed.rapid,
                 mode: raw.feed.mode.map(Spanned::into_inner),
             },
@@ -881,6 +610,445 @@ impl From<&RawWord> for PartialWord {
             modulo: w.modulo.as_ref().map(|m| *m.get_ref()),
             modal: w.modal,
         }
+    }
+}
+
+// ------------------------------------------------------ dialect file checks
+//
+// The pieces of `Dialect::from_toml`, in the order it runs them: every
+// mistake goes to `err` in file-reading order, so the diagnostics come out
+// in the same order whatever the mistakes.
+
+/// The dialect file as read by serde, with every unknown key and value (in
+/// file order), or the file's first fatal mistake: too large (see
+/// [`refuse_oversized`]), a TOML syntax error or a key of the wrong type
+/// (reported after the unknown names found before it).
+fn parse_raw_dialect(
+    source: &str,
+    file_name: &str,
+) -> Result<(RawDialect, Vec<Diagnostic>), Diagnostics> {
+    refuse_oversized(source, file_name)?;
+    // serde would stop at the first unknown key or value: they are all
+    // found here (the `Raw*` types let unknown keys pass), and reported
+    // with the mistakes the checks after it find.
+    let unknown = unknown_names(source, file_name);
+    match toml::from_str(source) {
+        Ok(raw) => Ok((raw, unknown)),
+        Err(e) => {
+            let first = Diagnostic::at_byte_span(
+                Severity::Error,
+                file_name,
+                source,
+                e.span().unwrap_or(0..0),
+                e.message().trim_end().to_string(),
+            );
+            Err(Diagnostics(kinpost_diag::toml_names::with_serde_error(
+                unknown, first,
+            )))
+        }
+    }
+}
+
+/// A file over [`MAX_DIALECT_FILE_BYTES`] is refused before it is parsed:
+/// it is not a dialect file, and parsing it would only cost time.
+fn refuse_oversized(source: &str, file_name: &str) -> Result<(), Diagnostics> {
+    if source.len() > MAX_DIALECT_FILE_BYTES {
+        return Err(Diagnostic::error(
+            file_name,
+            1,
+            1,
+            1,
+            source.lines().next().unwrap_or(""),
+            format!(
+                "the dialect file has {} bytes, more than {MAX_DIALECT_FILE_BYTES}: a dialect \
+                 file is a few kilobytes (is this a dialect file?)",
+                source.len()
+            ),
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// The dialect names itself (`name` not blank) and its programs' bare
+/// extension (no dot or path separator: the writer appends it to a stem).
+fn check_name_and_extension(raw: &RawDialect, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    if raw.name.get_ref().trim().is_empty() {
+        err(raw.name.span(), "`name` must not be empty".into());
+    }
+    if raw.extension.get_ref().contains(['.', '/', '\\']) {
+        err(
+            raw.extension.span(),
+            "`extension` is the bare extension, without a dot (e.g. `mpf`)".into(),
+        );
+    }
+}
+
+/// The fields of every word table (`[linear]`, `[rotary]`, `[endless]`,
+/// each `[axis.NAME]`, `[pressure]`, the feed word), in that order, fit
+/// the writer's fixed room and the number formatter's decimals.
+fn check_word_fields(
+    raw: &RawDialect,
+    raw_feed_word: &RawWord,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    check_word(&raw.linear, err);
+    check_word(&raw.rotary, err);
+    check_word(&raw.endless, err);
+    for w in raw.axis.values() {
+        check_word(w, err);
+    }
+    if let Some(p) = &raw.pressure {
+        check_pressure_word(p, raw.kind, err);
+    }
+    check_word(raw_feed_word, err);
+}
+
+/// One word table's prefix and suffix fit the writer's fixed room
+/// ([`MAX_PREFIX`], [`MAX_SUFFIX`]) and its decimals the number formatter
+/// ([`MAX_DECIMALS`]).
+fn check_word(w: &RawWord, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    if let Some(p) = &w.prefix
+        && p.get_ref().len() > MAX_PREFIX
+    {
+        err(
+            p.span(),
+            format!("`prefix` may have at most {MAX_PREFIX} bytes"),
+        );
+    }
+    if let Some(p) = &w.suffix
+        && p.get_ref().len() > MAX_SUFFIX
+    {
+        err(
+            p.span(),
+            format!("`suffix` may have at most {MAX_SUFFIX} bytes"),
+        );
+    }
+    if let Some(d) = &w.decimals
+        && *d.get_ref() > MAX_DECIMALS
+    {
+        err(
+            d.span(),
+            format!("`decimals` must be between 0 and {MAX_DECIMALS}"),
+        );
+    }
+}
+
+/// `[pressure]`: the fields of any word, and what only the pressure word
+/// asks: it is always modal, never taken modulo, and in an NC program it
+/// has a prefix (a bare number would be read as something else).
+fn check_pressure_word(
+    p: &Spanned<RawWord>,
+    kind: DialectKind,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    let w = p.get_ref();
+    check_word(w, err);
+    if w.modal == Some(false) {
+        err(
+            p.span(),
+            "the pressure word is always modal (written when its value changes): leave `modal` out"
+                .into(),
+        );
+    }
+    if let Some(m) = &w.modulo {
+        err(
+            m.span(),
+            "`modulo` does not apply to the pressure word".into(),
+        );
+    }
+    if kind == DialectKind::Words && w.prefix.as_ref().is_some_and(|p| p.get_ref().is_empty()) {
+        err(
+            w.prefix.as_ref().map_or(p.span(), |p| p.span()),
+            "the pressure word needs a `prefix` (e.g. \"{name}=\" for `H1=3000`)".into(),
+        );
+    }
+}
+
+/// The word layers of a dialect file over the built-in defaults, and the
+/// resolved feed word.
+struct ResolvedWords {
+    linear: PartialWord,
+    rotary: PartialWord,
+    endless: PartialWord,
+    axis: BTreeMap<String, PartialWord>,
+    pressure: Option<PartialWord>,
+    feed: WordFormat,
+}
+
+impl ResolvedWords {
+    /// Lays the word tables over the defaults and checks each whole format
+    /// as it will be written (modulo against decimals: only a combination
+    /// of layers can be wrong), in the order of [`check_word_fields`].
+    fn resolve(
+        raw: &RawDialect,
+        raw_feed_word: &RawWord,
+        err: &mut dyn FnMut(std::ops::Range<usize>, String),
+    ) -> ResolvedWords {
+        let kind = raw.kind;
+        let base = PartialWord::base(kind);
+        let linear = base.over(&PartialWord::from(&raw.linear));
+        let rotary = base.over(&PartialWord::from(&raw.rotary));
+        let endless = PartialWord::from(&raw.endless);
+        let axis: BTreeMap<String, PartialWord> = raw
+            .axis
+            .iter()
+            .map(|(k, w)| (k.clone(), PartialWord::from(w)))
+            .collect();
+        check_whole_format(&raw.linear, &[linear.resolve("X")], err);
+        check_whole_format(&raw.rotary, &[rotary.resolve("A")], err);
+        check_whole_format(&raw.endless, &[rotary.over(&endless).resolve("A")], err);
+        for (name, w) in &raw.axis {
+            let o = PartialWord::from(w);
+            check_whole_format(
+                w,
+                &[linear.over(&o).resolve(name), rotary.over(&o).resolve(name)],
+                err,
+            );
+        }
+        let pressure = raw
+            .pressure
+            .as_ref()
+            .map(|p| PartialWord::pressure_base(kind).over(&PartialWord::from(p.get_ref())));
+        if let (Some(p), Some(w)) = (&pressure, &raw.pressure) {
+            check_whole_format(w.get_ref(), &[p.resolve("H1")], err);
+        }
+        let feed = PartialWord::feed_base()
+            .over(&PartialWord::from(raw_feed_word))
+            .resolve("F");
+        check_whole_format(raw_feed_word, std::slice::from_ref(&feed), err);
+        ResolvedWords {
+            linear,
+            rotary,
+            endless,
+            axis,
+            pressure,
+            feed,
+        }
+    }
+}
+
+/// The first of `resolved` (the formats table `w` takes part in) whose
+/// number format is invalid, reported once at `w`'s `modulo` (else its
+/// `decimals`). Decimals out of range were reported by [`check_word`].
+fn check_whole_format(
+    w: &RawWord,
+    resolved: &[WordFormat],
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    for r in resolved {
+        if r.number.decimals <= MAX_DECIMALS
+            && let Err(msg) = r.number.validate()
+        {
+            let span = w
+                .modulo
+                .as_ref()
+                .map(|m| m.span())
+                .or_else(|| w.decimals.as_ref().map(|d| d.span()))
+                .unwrap_or(0..0);
+            err(span, msg.to_string());
+            break;
+        }
+    }
+}
+
+/// The block numbering of `[numbering]` (checked by [`check_numbering`]).
+fn numbering_from(n: RawNumbering) -> Numbering {
+    Numbering {
+        enabled: n.enabled,
+        prefix: n.prefix,
+        start: *n.start.get_ref(),
+        step: *n.step.get_ref(),
+        digits: *n.digits.get_ref(),
+        wrap_after: n.wrap_after.map(Spanned::into_inner),
+        header: n.header,
+        commands: n.commands,
+        comments: n.comments,
+    }
+}
+
+/// The replacements of `comment.replace`, in key order; an empty key
+/// (which would match between every two characters) is an error.
+fn comment_replacements(
+    replace: BTreeMap<String, String>,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) -> Vec<(String, String)> {
+    let mut replacements = Vec::new();
+    for (from, to) in replace {
+        if from.is_empty() {
+            err(0..0, "`comment.replace` has an empty key".into());
+        }
+        replacements.push((from, to));
+    }
+    replacements
+}
+
+/// Compiles every template once, in [`TemplateKind::ALL`] order, so a
+/// syntax error, an unknown variable or a template over the render budget
+/// is found at load and points into the TOML file, not at post time.
+fn compile_templates(
+    source: &str,
+    raw: &RawTemplates,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) -> (Environment<'static>, BTreeMap<TemplateKind, String>) {
+    let mut env = template::environment();
+    let mut templates = BTreeMap::new();
+    for kind_t in TemplateKind::ALL {
+        let Some(t) = raw.get(kind_t) else {
+            continue;
+        };
+        if let Err(e) = env.add_template_owned(kind_t.key(), t.get_ref().clone()) {
+            let span = template::error_span_in_toml(source, t.span(), t.get_ref(), &e);
+            err(
+                span,
+                format!(
+                    "template `{}`: {}",
+                    kind_t.key(),
+                    template::error_message(&e)
+                ),
+            );
+        }
+        check_variables(&env, kind_t, t, source, err);
+        check_budget(&env, kind_t, t, source, err);
+        templates.insert(kind_t, t.get_ref().clone());
+    }
+    (env, templates)
+}
+
+/// The templates written outside tool-centre-point control
+/// (`templates.outside_tcp`): command templates only. A tool change moves
+/// the axes and takes the new tool's length, so without the key it is the
+/// tool change alone.
+fn outside_tcp_templates(
+    names: Option<&[Spanned<String>]>,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) -> Vec<TemplateKind> {
+    let mut outside_tcp = Vec::new();
+    match names {
+        None => outside_tcp.push(TemplateKind::ToolChange),
+        Some(names) => {
+            for name in names {
+                match TemplateKind::ALL
+                    .into_iter()
+                    .find(|k| k.key() == name.get_ref())
+                {
+                    Some(k) if k.is_command() => outside_tcp.push(k),
+                    _ => err(
+                        name.span(),
+                        format!(
+                            "`templates.outside_tcp`: `{}` is not a command template (one of {})",
+                            name.get_ref(),
+                            TemplateKind::ALL
+                                .into_iter()
+                                .filter(|k| k.is_command())
+                                .map(TemplateKind::key)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
+                    ),
+                }
+            }
+        }
+    }
+    outside_tcp
+}
+
+/// The motion words of `[motion]` (serde has checked them).
+fn motion_words(m: RawMotion) -> MotionWords {
+    MotionWords {
+        rapid: m.rapid,
+        feed: m.feed,
+        modal: m.modal,
+        initial: match m.initial {
+            RawInitial::None => None,
+            RawInitial::Rapid => Some(Motion::Rapid),
+            RawInitial::Feed => Some(Motion::Feed),
+        },
+        rapid_aliases: m.rapid_aliases,
+        feed_aliases: m.feed_aliases,
+    }
+}
+
+/// The word separator fits the writer's fixed room before a word's prefix
+/// ([`MAX_LEAD`] − [`MAX_PREFIX`] bytes).
+fn check_separator(block: &RawBlock, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    if let Some(sep) = &block.separator
+        && sep.get_ref().len() > MAX_LEAD - MAX_PREFIX
+    {
+        err(
+            sep.span(),
+            format!(
+                "`separator` may have at most {} bytes",
+                MAX_LEAD - MAX_PREFIX
+            ),
+        );
+    }
+}
+
+/// The default feed mode, when given, is one of [`FEED_MODES`].
+fn check_feed_mode(feed: &RawFeed, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    if let Some(mode) = &feed.mode
+        && !FEED_MODES.contains(&mode.get_ref().as_str())
+    {
+        err(
+            mode.span(),
+            format!(
+                "unknown feed mode `{}`: use one of {}",
+                mode.get_ref(),
+                FEED_MODES.join(", ")
+            ),
+        );
+    }
+}
+
+/// Every line ends with a newline, and a line length limit leaves room
+/// for the shortest line it must hold: an empty comment (line end,
+/// comment prefix and suffix).
+fn check_line_end_and_length(
+    block: &RawBlock,
+    comment_prefix: &str,
+    comment_suffix: &str,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) {
+    let line_end = block.line_end.get_ref();
+    if !line_end.ends_with('\n') {
+        err(
+            block.line_end.span(),
+            "`line_end` must end with a newline".into(),
+        );
+    }
+    // The shortest line a limit must hold: an empty comment.
+    let least = line_end.len() + comment_prefix.len() + comment_suffix.len();
+    if let Some(max) = &block.max_line_length
+        && *max.get_ref() <= least
+    {
+        err(
+            max.span(),
+            format!(
+                "`max_line_length` counts the line end: it must be more than {least} bytes \
+                 (line end, comment prefix and suffix)"
+            ),
+        );
+    }
+}
+
+/// The block layout of `[block]`; the separator defaults to a blank
+/// between NC words and a comma between CSV columns.
+fn block_format(b: RawBlock, kind: DialectKind) -> BlockFormat {
+    BlockFormat {
+        order: b.order,
+        write_fixed: b.write_fixed,
+        separator: b
+            .separator
+            .as_ref()
+            .map(|s| s.get_ref().clone())
+            .unwrap_or_else(|| match kind {
+                DialectKind::Words => " ".into(),
+                DialectKind::Csv => ",".into(),
+            }),
+        line_end: b.line_end.get_ref().clone(),
+        after_axes: b.after_axes,
+        max_line_length: b.max_line_length.as_ref().map(|m| *m.get_ref()),
     }
 }
 

@@ -884,29 +884,15 @@ impl<R: BufRead> ClReader<R> {
             self.goto_count = 0;
             return Ok(None); // CAMWorks display / tool-library records
         }
-        let mut key = [0u8; 12];
-        let n = word_end - start;
-        let key: &[u8] = if n <= key.len() {
-            for (k, &c) in key.iter_mut().zip(&b[start..word_end]) {
-                *k = c.to_ascii_uppercase();
-            }
-            &key[..n]
+        let (key, key_len) = statement_key(&b[start..word_end]);
+        let key: &[u8] = &key[..key_len];
+        let path_end = if key == b"TOOL" {
+            tool_path_end(b, word_end)
         } else {
-            b""
+            None
         };
-        let mut word: Span = (start, word_end);
-        let mut tool_path = false;
-        if key == b"TOOL" {
-            let p = skip_blanks(b, word_end);
-            if p > word_end
-                && b.len() >= p + 4
-                && b[p..p + 4].eq_ignore_ascii_case(b"PATH")
-                && b.get(p + 4).is_none_or(|&c| !is_word_byte(c))
-            {
-                word.1 = p + 4;
-                tool_path = true;
-            }
-        }
+        let tool_path = path_end.is_some();
+        let word: Span = (start, path_end.unwrap_or(word_end));
         let after = skip_blanks(b, word.1);
         let slash = after < b.len() && b[after] == b'/';
         let args: Span = (if slash { after + 1 } else { after }, b.len());
@@ -927,45 +913,24 @@ impl<R: BufRead> ClReader<R> {
             self.no_pending_circle(word)?;
             return self.tool_path(args).map(Some);
         }
-        // Statements that take arguments after a slash.
-        let needs_slash = matches!(
-            key,
-            b"GOTO"
-                | b"FEDRAT"
-                | b"TLDATA"
-                | b"CUTTER"
-                | b"MSYS"
-                | b"LOAD"
-                | b"SELECT"
-                | b"SPINDL"
-                | b"COOLNT"
-                | b"UNITS"
-                | b"UNIT"
-                | b"PRESSURE"
-                | b"CSYS"
-                | b"MULTAX"
-                | b"CIRCLE"
-                | b"CYCLE"
-                | b"FROM"
-                | b"GOHOME"
-                | b"CUTCOM"
-                | b"DELAY"
-                | b"DWELL"
-                | b"MACHIN"
-                | b"CLAMP"
-                | b"ORIGIN"
-                | b"SETUP"
-                | b"KNOT"
-                | b"CNTRL"
-                | b"TLAXIS"
-                | b"GODLTA"
-                | b"LOADTL"
-                | b"OPNAME"
-        );
-        if needs_slash && !slash && has_args {
+        if takes_slash_arguments(key) && !slash && has_args {
             let name = self.text()[word.0..word.1].to_ascii_uppercase();
             return Err(self.error((after, after + 1), format!("expected `/` after `{name}`")));
         }
+        self.statement(key, start, word, args)
+    }
+
+    /// Acts on one statement, named by its upper-case `key` (its `word` in
+    /// the text, which starts at `start`); `args` are its arguments, after
+    /// the slash if it has one.
+    #[inline(always)]
+    fn statement(
+        &mut self,
+        key: &[u8],
+        start: usize,
+        word: Span,
+        args: Span,
+    ) -> Result<Option<ClEvent>, Diagnostic> {
         match key {
             b"GOTO" => self.goto(args).map(Some),
             b"RAPID" => {
@@ -1730,6 +1695,75 @@ struct PlainGoto {
     end: usize,
     /// The length of the line with its line end.
     next: usize,
+}
+
+/// The statement key of a major word: the word in upper case, in a fixed
+/// buffer with its length (no allocation per statement); length 0 for a
+/// word longer than any statement's (it is then unknown).
+#[inline(always)]
+fn statement_key(word: &[u8]) -> ([u8; 12], usize) {
+    let mut key = [0u8; 12];
+    if word.len() > key.len() {
+        return (key, 0);
+    }
+    for (k, &c) in key.iter_mut().zip(word) {
+        *k = c.to_ascii_uppercase();
+    }
+    (key, word.len())
+}
+
+/// Where `PATH` ends when the `TOOL` word ending at `word_end` is followed
+/// by blanks and a whole word `PATH` (the two-word `TOOL PATH` statement of
+/// NX), else `None`.
+#[inline(always)]
+fn tool_path_end(b: &[u8], word_end: usize) -> Option<usize> {
+    let p = skip_blanks(b, word_end);
+    (p > word_end
+        && b.len() >= p + 4
+        && b[p..p + 4].eq_ignore_ascii_case(b"PATH")
+        && b.get(p + 4).is_none_or(|&c| !is_word_byte(c)))
+    .then_some(p + 4)
+}
+
+/// Whether the statement named by `key` takes its arguments after a slash
+/// (`GOTO/…`): one without the slash but with arguments is an error, not a
+/// statement read some other way.
+#[inline(always)]
+fn takes_slash_arguments(key: &[u8]) -> bool {
+    matches!(
+        key,
+        b"GOTO"
+            | b"FEDRAT"
+            | b"TLDATA"
+            | b"CUTTER"
+            | b"MSYS"
+            | b"LOAD"
+            | b"SELECT"
+            | b"SPINDL"
+            | b"COOLNT"
+            | b"UNITS"
+            | b"UNIT"
+            | b"PRESSURE"
+            | b"CSYS"
+            | b"MULTAX"
+            | b"CIRCLE"
+            | b"CYCLE"
+            | b"FROM"
+            | b"GOHOME"
+            | b"CUTCOM"
+            | b"DELAY"
+            | b"DWELL"
+            | b"MACHIN"
+            | b"CLAMP"
+            | b"ORIGIN"
+            | b"SETUP"
+            | b"KNOT"
+            | b"CNTRL"
+            | b"TLAXIS"
+            | b"GODLTA"
+            | b"LOADTL"
+            | b"OPNAME"
+    )
 }
 
 fn is_word_byte(c: u8) -> bool {
