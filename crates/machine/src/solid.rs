@@ -249,7 +249,7 @@ impl crate::Machine {
     }
 
     /// Whether the collision check looks at the pair of two different
-    /// solids `a` and `b` (of [`Machine::solids`], or added at run time,
+    /// solids `a` and `b` (of the machine's `solids`, or added at run time,
     /// e.g. the part): not on one body, not named by an `ignore` entry, and
     /// not on neighbouring bodies unless a `check` entry names them (see
     /// [`CollisionSettings`]).
