@@ -192,6 +192,10 @@ struct PostArgs {
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
+    /// Length units of a CL file that declares none (NX writes no UNITS):
+    /// inch or mm. An inch feed in a file without either is an error.
+    #[arg(long, value_enum)]
+    units: Option<UnitsArg>,
     /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
     /// points before any PRESSURE statement. Without it and without
     /// PRESSURE, no pressure word is written and the wheel is where it is
@@ -218,6 +222,12 @@ enum FeedModeArg {
     Tip,
     InverseTime,
     Dpm,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum UnitsArg {
+    Inch,
+    Mm,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -694,6 +704,10 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        units: args.units.map(|u| match u {
+            UnitsArg::Inch => kinpost_post::cl::Units::Inch,
+            UnitsArg::Mm => kinpost_post::cl::Units::Mm,
+        }),
         pressure: args.pressure,
         no_pressure_compensation: args.no_pressure_compensation,
         axis_rounding_rad: args.axis_rounding,

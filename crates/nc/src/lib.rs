@@ -46,7 +46,7 @@ pub use template::{
     MAX_TEMPLATE_OUTPUT_BYTES, TEMPLATE_FUEL, TEMPLATE_RECURSION_LIMIT, TemplateError,
     template_span_in_toml,
 };
-pub use writer::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
+pub use writer::{MAX_DWELL_SECONDS, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
 
 /// One machine axis as the writer and reader need it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -269,6 +269,14 @@ pub enum NcError {
         /// The dialect's `max_line_length`.
         max: usize,
     },
+    /// The program asks for something the dialect has no template for (a
+    /// dwell, a stop, cutter compensation): never left out in silence.
+    MissingTemplate {
+        /// The template's key (`dwell`, `cutcom_on`, …).
+        template: &'static str,
+        /// The dialect's name.
+        dialect: String,
+    },
 }
 
 impl std::fmt::Display for NcError {
@@ -293,6 +301,10 @@ impl std::fmt::Display for NcError {
                 reason,
             } => write!(f, "cannot write the {what} {value}: {reason}"),
             NcError::Numbers(e) => e.fmt(f),
+            NcError::MissingTemplate { template, dialect } => write!(
+                f,
+                "dialect `{dialect}` has no `{template}` template: add one to its [templates] to post this statement"
+            ),
             NcError::LineTooLong {
                 source,
                 text,
@@ -318,7 +330,8 @@ impl std::error::Error for NcError {
             NcError::Template { .. }
             | NcError::Value { .. }
             | NcError::Numbers(_)
-            | NcError::LineTooLong { .. } => None,
+            | NcError::LineTooLong { .. }
+            | NcError::MissingTemplate { .. } => None,
         }
     }
 }

@@ -204,6 +204,10 @@ pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<Strin
             "mode" => Value::from("flood"),
             "pressure" => Value::from(3000.0),
             "pressure_word" => Value::from("H1"),
+            "seconds" => Value::from(1.5),
+            "milliseconds" => Value::from(1500),
+            "side" => Value::from("left"),
+            "register" => Value::from(1),
             _ => Value::from(""),
         };
         vars.insert((*name).to_string(), v);

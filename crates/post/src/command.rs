@@ -18,6 +18,17 @@ pub enum Command {
     Coolant(Option<String>),
     /// Text for the controller, verbatim (`INSERT`).
     Insert(String),
+    /// A program stop (`STOP`, `END`) or an optional stop (`OPSTOP`:
+    /// `true`).
+    Stop {
+        /// Optional stop (M01).
+        optional: bool,
+    },
+    /// A dwell, seconds (`DELAY`, a cycle's dwell).
+    Dwell(f64),
+    /// Cutter radius compensation on (`Some((left, register))`) or off
+    /// (`CUTCOM`).
+    CutterCompensation(Option<(bool, u32)>),
 }
 
 /// A command with its CL statement: it is written after the reader has

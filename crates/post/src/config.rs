@@ -30,6 +30,8 @@ pub struct PostOptions {
     pub tolerance_mm: Option<f64>,
     /// Tool axis for `GOTO/x,y,z` before any axis is given (3-axis APT).
     pub default_axis: Option<[f64; 3]>,
+    /// The CL file's length units when it does not say (`--units`).
+    pub units: Option<kinpost_cl::Units>,
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
@@ -116,6 +118,8 @@ pub struct Config {
     pub tolerance_mm: Option<f64>,
     /// Tool axis of `GOTO/x,y,z` before any axis is given.
     pub default_axis: Option<[f64; 3]>,
+    /// The CL file's length units when it does not say.
+    pub units: Option<kinpost_cl::Units>,
     /// Joint or tool-centre-point output.
     pub output: OutputMode,
     /// What the feed words mean.
@@ -203,6 +207,7 @@ impl Config {
             date: options.date.clone(),
             tolerance_mm: tolerance,
             default_axis: options.default_axis,
+            units: options.units,
             output: options.output.or(machine.post.output).unwrap_or_default(),
             feed_mode: options
                 .feed_mode

@@ -48,6 +48,7 @@
 pub mod check;
 mod command;
 pub mod config;
+pub mod cycle;
 mod error;
 mod machine_templates;
 pub mod motion;
@@ -142,7 +143,7 @@ fn run<R: BufRead, P: ProgramWriter>(
     config: &Config,
 ) -> Result<(Summary, P::Finished), PostError> {
     let started = Instant::now();
-    let mut reader = ClReader::new(input, config.cl_file.clone());
+    let mut reader = ClReader::new(input, config.cl_file.clone()).with_units(config.units);
     if let Some(axis) = config.default_axis {
         reader = reader.with_default_axis(axis);
     }

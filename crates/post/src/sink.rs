@@ -28,6 +28,9 @@ impl<W: Write> BlockSink for NcWriter<W> {
             Command::Spindle(state) => self.spindle(*state),
             Command::Coolant(mode) => self.coolant(mode.as_deref()),
             Command::Insert(text) => self.insert(text),
+            Command::Stop { optional } => self.stop(*optional),
+            Command::Dwell(seconds) => self.dwell(*seconds),
+            Command::CutterCompensation(on) => self.cutter_compensation(*on),
         };
         written.map_err(|e| p.locate(e).into())
     }
