@@ -166,6 +166,15 @@ pub struct ProgramInfo {
     pub tool_number: u32,
     /// CL file the program was made from (`cl_file`).
     pub cl_file: String,
+    /// The CL loads the header's tool (`tool_loaded`): only then does the
+    /// header call it (`T… M06`).
+    pub tool_loaded: bool,
+    /// The tool length offset register of the header's tool
+    /// (`length_register`: the CL's `ADJUST`, else the tool number).
+    pub length_register: u32,
+    /// The program is tool-centre-point output (`tcp_output`): the
+    /// `tcp_on` template applies the tool length, not `G43`.
+    pub tcp_output: bool,
     /// Further variables: each is available by its own name (unless it
     /// collides with a built-in one) and in the map `extra`.
     pub extra: BTreeMap<String, String>,
@@ -174,7 +183,7 @@ pub struct ProgramInfo {
 impl ProgramInfo {
     /// The names every template gets from [`ProgramInfo::template_vars`]
     /// (each extra key too, but those depend on the caller).
-    pub const VARIABLES: [&'static str; 10] = [
+    pub const VARIABLES: [&'static str; 13] = [
         "program_name",
         "date",
         "machine",
@@ -185,6 +194,9 @@ impl ProgramInfo {
         "axes",
         "extra",
         "tcp",
+        "tool_loaded",
+        "length_register",
+        "tcp_output",
     ];
 
     /// The template variables: `program_name`, `date`, `machine`, `tool`,
@@ -208,6 +220,9 @@ impl ProgramInfo {
         put("cl_file", Value::from(self.cl_file.as_str()));
         put("dialect", Value::from(dialect));
         put("tcp", Value::from(false));
+        put("tool_loaded", Value::from(self.tool_loaded));
+        put("length_register", Value::from(self.length_register));
+        put("tcp_output", Value::from(self.tcp_output));
         put(
             "axes",
             Value::from(

@@ -192,6 +192,9 @@ pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<Strin
         tool: "SAMPLE TOOL".into(),
         tool_number: 1,
         cl_file: "sample.cls".into(),
+        tool_loaded: true,
+        length_register: 1,
+        tcp_output: false,
         extra: BTreeMap::new(),
     };
     let mut vars = info.template_vars(dialect, &axes);

@@ -497,8 +497,24 @@ impl<W: Write> NcWriter<W> {
     /// The name is cleaned for the dialect ([`CommentSyntax::clean`]); a
     /// tool number outside 1 ..= [`MAX_TOOL_NUMBER`] is an error.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
+        self.tool_change_with_register(number, name, number)
+    }
+
+    /// A tool change as [`NcWriter::tool_change`] with the new tool's
+    /// length offset register (template variable `length_register`, for
+    /// `G43 H…`; the CL's `ADJUST`).
+    pub fn tool_change_with_register(
+        &mut self,
+        number: u32,
+        name: &str,
+        register: u32,
+    ) -> Result<(), NcError> {
         check_tool_number(number, true)?;
+        check_tool_number(register, false)?;
         let name = self.comment.clean(name).into_owned();
+        self.vars
+            .insert("length_register".into(), Value::from(register));
+        self.vars.insert("tool_loaded".into(), Value::from(true));
         self.vars.insert("tool_number".into(), Value::from(number));
         self.vars.insert("tool".into(), Value::from(name.as_str()));
         self.vars.insert("tool_name".into(), Value::from(name));
@@ -616,9 +632,14 @@ impl<W: Write> NcWriter<W> {
     }
 
     /// Tool-centre-point control on or off (templates `tcp_on`, `tcp_off`).
+    /// A program that turns it on is tool-centre-point output (template
+    /// variable `tcp_output` true from then on, whatever the header said).
     pub fn tcp(&mut self, on: bool) -> Result<(), NcError> {
         self.tcp_on = on;
         self.vars.insert("tcp".into(), Value::from(on));
+        if on {
+            self.vars.insert("tcp_output".into(), Value::from(true));
+        }
         let kind = if on {
             TemplateKind::TcpOn
         } else {

@@ -10,8 +10,9 @@ use kinpost_nc::{NcError, Spindle};
 pub enum Command {
     /// A comment (`$$ text`, `PPRINT`, an operation's name).
     Comment(String),
-    /// A tool change: number and name.
-    ToolChange(u32, String),
+    /// A tool change: number, name and length offset register (the CL's
+    /// `ADJUST`, else the number).
+    ToolChange(u32, String, u32),
     /// Spindle on (speed and direction) or off.
     Spindle(Spindle),
     /// Coolant on in a mode (`FLOOD`, `MIST`, …), or off.

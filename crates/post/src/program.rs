@@ -10,7 +10,7 @@ use std::io::BufRead;
 use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Statement};
 use kinpost_diag::{Diagnostic, Located, Severity};
 use kinpost_machine::tolerance::REFERENCE_SKEW_DEG;
-use kinpost_machine::{Machine, Pose};
+use kinpost_machine::{Machine, OutputMode, Pose};
 use kinpost_nc::{AxisSpec, Dialect, ProgramInfo, Spindle};
 use kinpost_plan::PathPoint;
 use nalgebra::Vector3;
@@ -137,6 +137,8 @@ impl<'a> Program<'a> {
                 machine: machine.name.clone(),
                 tool: String::new(),
                 tool_number: 1,
+                length_register: 1,
+                tcp_output: config.output == OutputMode::Tcp,
                 cl_file: config.cl_file.clone(),
                 ..ProgramInfo::default()
             },
@@ -270,11 +272,11 @@ impl<'a> Program<'a> {
             ClEvent::Comment(text) => {
                 self.command(Command::Comment(text.trim().to_string()), reader, sink)?
             }
-            ClEvent::LoadTool { number, .. } => {
+            ClEvent::LoadTool { number, adjust } => {
                 if self.modal.is_some() {
                     self.end_cycle_at_tool_change(last, reader);
                 }
-                self.load_tool(number, reader, sink)?
+                self.load_tool(number, adjust, reader, sink)?
             }
             ClEvent::SelectTool { .. } => {}
             ClEvent::Spindle {
@@ -402,15 +404,23 @@ impl<'a> Program<'a> {
     fn load_tool<R: BufRead, S: ProgramSink>(
         &mut self,
         number: u32,
+        adjust: Option<u32>,
         reader: &ClReader<R>,
         sink: &mut S,
     ) -> Result<(), PostError> {
         sink.break_segment();
+        let register = adjust.unwrap_or(number);
         if !self.tool_loaded && self.six_axis.is_none() {
             self.info.tool_number = number;
-        } else if number != self.spindle_tool.unwrap_or(self.info.tool_number) {
+            self.info.tool_loaded = true;
+            self.info.length_register = register;
+        } else if Some(number)
+            != self
+                .spindle_tool
+                .or(self.info.tool_loaded.then_some(self.info.tool_number))
+        {
             let tool = self.info.tool.clone();
-            self.command(Command::ToolChange(number, tool), reader, sink)?;
+            self.command(Command::ToolChange(number, tool, register), reader, sink)?;
             self.spindle_tool = Some(number);
         }
         self.tool_loaded = true;
