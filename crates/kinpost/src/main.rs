@@ -196,6 +196,11 @@ struct PostArgs {
     /// inch or mm. An inch feed in a file without either is an error.
     #[arg(long, value_enum)]
     units: Option<UnitsArg>,
+    /// What a CL INSERT becomes: verbatim code (the APT meaning; a line
+    /// that moves an axis or changes a tool is warned about), a comment
+    /// (SOLIDWORKS CAM writes tool and stock notes as INSERT), or nothing.
+    #[arg(long, value_enum, default_value = "verbatim")]
+    insert: InsertArg,
     /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
     /// points before any PRESSURE statement. Without it and without
     /// PRESSURE, no pressure word is written and the wheel is where it is
@@ -222,6 +227,13 @@ enum FeedModeArg {
     Tip,
     InverseTime,
     Dpm,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum InsertArg {
+    Verbatim,
+    Comment,
+    Drop,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -704,6 +716,11 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        insert: match args.insert {
+            InsertArg::Verbatim => kinpost_post::InsertMode::Verbatim,
+            InsertArg::Comment => kinpost_post::InsertMode::Comment,
+            InsertArg::Drop => kinpost_post::InsertMode::Drop,
+        },
         units: args.units.map(|u| match u {
             UnitsArg::Inch => kinpost_post::cl::Units::Inch,
             UnitsArg::Mm => kinpost_post::cl::Units::Mm,

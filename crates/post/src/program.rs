@@ -308,7 +308,7 @@ impl<'a> Program<'a> {
             ClEvent::Coolant { on, mode } => {
                 self.command(Command::Coolant(on.then_some(mode)), reader, sink)?
             }
-            ClEvent::Insert(text) => self.command(Command::Insert(text), reader, sink)?,
+            ClEvent::Insert(text) => self.insert(text, reader, sink)?,
             ClEvent::EndOfPath => sink.break_segment(),
             ClEvent::Pressure { word, value } => self.pressure(word.as_deref(), value, reader)?,
             ClEvent::ToolData(data) => {

@@ -426,3 +426,31 @@ fn nurbs_become_points_on_the_curve() {
         assert!((bez(lo).1 - p[1]).abs() < 1e-9, "{p:?}");
     }
 }
+
+/// INSERT: verbatim with a warning when it moves an axis or changes a
+/// tool; a comment or nothing when asked.
+#[test]
+fn inserts_that_move_are_warned_about() {
+    let moving = [
+        "INSERT/Stock Size X293.7 Y100. Z9.",
+        "INSERT/G0 Z100",
+        "INSERT/X10Y20",
+        "INSERT/T5 M6",
+        "INSERT/X=12.5",
+    ];
+    let passive = [
+        "INSERT/M08",
+        "INSERT/[HOLDER=C40-32ERP412] 6MM CRB 2FL 19 LOC",
+        "INSERT/(MSG, CHECK THE CLAMPS)",
+        "INSERT/G17 G90",
+    ];
+    for line in moving {
+        let (out, warnings) = run_with(&format!("{line}\n"), 0.01).unwrap();
+        assert!(warnings.iter().any(|w| w.contains("INSERT")), "{line}");
+        assert!(matches!(commands(&out)[..], [Command::Insert(_)]));
+    }
+    for line in passive {
+        let (_, warnings) = run_with(&format!("{line}\n"), 0.01).unwrap();
+        assert!(warnings.is_empty(), "{line}: {warnings:?}");
+    }
+}

@@ -18,6 +18,7 @@ use kinpost_nc::Spindle;
 
 use super::{Program, ProgramSink, locate};
 use crate::command::Command;
+use crate::config::InsertMode;
 use crate::cycle::{CycleError, HoleCycle, HoleStep};
 use crate::error::{PostError, ProgramError};
 
@@ -58,6 +59,49 @@ fn blend_axis(a: Vec3, b: Vec3, t: f64) -> Vec3 {
     let v = [0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t);
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if n < 1e-9 { b } else { v.map(|x| x / n) }
+}
+
+/// The first address word of `text` that moves an axis or changes a tool
+/// (an axis letter X Y Z A B C U V W, `T` or `H`, with a number; `G0` to
+/// `G3`; `M6`), as written.
+fn moving_word(text: &str) -> Option<&str> {
+    let bytes = text.as_bytes();
+    let mut i = 0;
+    while i < bytes.len() {
+        let c = bytes[i].to_ascii_uppercase();
+        // G-code words follow one another, a blank or a comment: after the
+        // start, a blank, a digit (`X10Y20`) or `)`; a letter after `=` or
+        // inside a name (`HOLDER=C40-32ER`) starts none.
+        let starts_word =
+            i == 0 || matches!(bytes[i - 1], b' ' | b'\t' | b')') || bytes[i - 1].is_ascii_digit();
+        let mut j = i + 1;
+        if starts_word && c.is_ascii_alphabetic() {
+            if j < bytes.len() && (bytes[j] == b'=' || bytes[j] == b'-' || bytes[j] == b'+') {
+                j += 1;
+            }
+            let digits = j;
+            while j < bytes.len() && (bytes[j].is_ascii_digit() || bytes[j] == b'.') {
+                j += 1;
+            }
+            let ends_word = j == bytes.len()
+                || bytes[j].is_ascii_alphabetic()
+                || matches!(bytes[j], b' ' | b'\t' | b'(' | b';');
+            if j > digits && ends_word && bytes[digits..j].iter().any(u8::is_ascii_digit) {
+                let number: f64 = text[digits..j].parse().unwrap_or(f64::NAN);
+                let moves = match c {
+                    b'X' | b'Y' | b'Z' | b'A' | b'B' | b'C' | b'U' | b'V' | b'W' | b'T' => true,
+                    b'G' => (0.0..=3.0).contains(&number) && number.fract() == 0.0,
+                    b'M' => number == 6.0,
+                    _ => false,
+                };
+                if moves {
+                    return Some(&text[i..j]);
+                }
+            }
+        }
+        i = j.max(i + 1);
+    }
+    None
 }
 
 fn plane_name(plane: Plane) -> &'static str {
@@ -238,6 +282,33 @@ impl Program<'_> {
             ));
         }
         self.settle_modal();
+    }
+
+    /// `INSERT/text` as `--insert` says: verbatim (with a warning when the
+    /// text has an address word that moves an axis or changes a tool: a
+    /// note written as `INSERT` would become a motion block), as a
+    /// comment, or not at all.
+    pub(super) fn insert<R: BufRead, S: ProgramSink>(
+        &mut self,
+        text: String,
+        reader: &ClReader<R>,
+        sink: &mut S,
+    ) -> Result<(), PostError> {
+        match self.config.insert {
+            InsertMode::Verbatim => {
+                if let Some(word) = moving_word(&text) {
+                    self.report.warnings.push(reader.statement_diagnostic(
+                        Severity::Warning,
+                        format!(
+                            "INSERT is written as code, and its `{word}` moves an axis or changes a tool; if it is a note, give --insert comment"
+                        ),
+                    ));
+                }
+                self.command(Command::Insert(text), reader, sink)
+            }
+            InsertMode::Comment => self.command(Command::Comment(text), reader, sink),
+            InsertMode::Drop => Ok(()),
+        }
     }
 
     /// The spindle speed in rpm of a `SPINDL`: a surface speed turned
