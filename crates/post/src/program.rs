@@ -47,7 +47,8 @@ pub trait ProgramSink {
 /// What the program stage read, for the summary.
 #[derive(Debug, Clone, Default)]
 pub struct ProgramReport {
-    /// CL points (GOTOs) read.
+    /// CL points read: `GOTO`s (an arc's end, a hole), `NURBS`, `GOHOME`;
+    /// not the points an arc, a spline or a cycle is cut into.
     pub cl_points: u64,
     /// What the header and footer say.
     pub info: ProgramInfo,

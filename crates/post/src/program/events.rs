@@ -181,12 +181,16 @@ impl Program<'_> {
             .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
         let n = points.len();
         let mut m = *goto;
+        let counted = self.report.cl_points;
         for (k, p) in points.iter().take(n.saturating_sub(1)).enumerate() {
             m.point = *p;
             m.axis = blend_axis(pending.axis, goto.axis, (k + 1) as f64 / n as f64);
             self.goto(&m, reader, sink)?;
         }
-        self.goto(goto, reader, sink)
+        self.goto(goto, reader, sink)?;
+        // The summary counts the CL's points: the arc is its GOTO.
+        self.report.cl_points = counted + 1;
+        Ok(())
     }
 
     /// A `NURBS`: its points within the chord tolerance, at the feed, with
@@ -204,10 +208,12 @@ impl Program<'_> {
             .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
         last.line = line;
         last.motion = Motion::Feed;
+        let counted = self.report.cl_points;
         for p in points {
             last.point = p;
             self.goto(last, reader, sink)?;
         }
+        self.report.cl_points = counted + 1;
         Ok(())
     }
 
@@ -227,6 +233,7 @@ impl Program<'_> {
         let saved = std::mem::replace(&mut self.feed, feed);
         let mut m = *goto;
         let mut at = None;
+        let counted = self.report.cl_points;
         for step in steps {
             match step {
                 HoleStep::Rapid(p) | HoleStep::Feed(p) => {
@@ -255,6 +262,8 @@ impl Program<'_> {
             }
         }
         self.feed = saved;
+        // The summary counts the CL's points: the hole is its GOTO.
+        self.report.cl_points = counted + 1;
         if let Some(p) = at
             && let Some(c) = self.modal.as_mut().and_then(|m| m.cycle.as_mut())
         {
