@@ -11,9 +11,11 @@
 //! 1. **CL reader** ([`cl`]): the file as statements, one at a time.
 //! 2. **Program** ([`program::Program`] → [`program::ProgramSink`]): the
 //!    CL's modal state (units, feed, spindle, tool, pressure); every `GOTO`
-//!    becomes a tool pose in the part frame with its feed and pressure,
-//!    every other statement that speaks to the controller a
-//!    [`Command`].
+//!    becomes a tool pose in the part frame with its feed and pressure
+//!    (a `CIRCLE` arc or a `NURBS` the poses along it within the
+//!    linearization tolerance, a hole of a canned cycle the moves of
+//!    [`cycle`]), every other statement that speaks to the controller a
+//!    [`Command`] (stops, dwells, cutter compensation among them).
 //! 3. **Planner** ([`plan::Planner`] → [`plan::PlanSink`]): every
 //!    inverse-kinematics solution of every point, the configuration of each
 //!    decided over the whole path (branches, turns, singular runs, folds).
