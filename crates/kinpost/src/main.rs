@@ -192,6 +192,15 @@ struct PostArgs {
     /// Tool axis i,j,k for GOTOs before any axis is given (3-axis APT files).
     #[arg(long, allow_hyphen_values = true)]
     default_axis: Option<String>,
+    /// Length units of a CL file that declares none (NX writes no UNITS):
+    /// inch or mm. An inch feed in a file without either is an error.
+    #[arg(long, value_enum)]
+    units: Option<UnitsArg>,
+    /// What a CL INSERT becomes: verbatim code (the APT meaning; a line
+    /// that moves an axis or changes a tool is warned about), a comment
+    /// (SOLIDWORKS CAM writes tool and stock notes as INSERT), or nothing.
+    #[arg(long, value_enum, default_value = "verbatim")]
+    insert: InsertArg,
     /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
     /// points before any PRESSURE statement. Without it and without
     /// PRESSURE, no pressure word is written and the wheel is where it is
@@ -218,6 +227,19 @@ enum FeedModeArg {
     Tip,
     InverseTime,
     Dpm,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum InsertArg {
+    Verbatim,
+    Comment,
+    Drop,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum UnitsArg {
+    Inch,
+    Mm,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -694,6 +716,15 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        insert: match args.insert {
+            InsertArg::Verbatim => kinpost_post::InsertMode::Verbatim,
+            InsertArg::Comment => kinpost_post::InsertMode::Comment,
+            InsertArg::Drop => kinpost_post::InsertMode::Drop,
+        },
+        units: args.units.map(|u| match u {
+            UnitsArg::Inch => kinpost_post::cl::Units::Inch,
+            UnitsArg::Mm => kinpost_post::cl::Units::Mm,
+        }),
         pressure: args.pressure,
         no_pressure_compensation: args.no_pressure_compensation,
         axis_rounding_rad: args.axis_rounding,

@@ -160,6 +160,7 @@ fn no_crate_has_an_import_cycle_among_its_modules() {
 #[test]
 fn the_post_stages_import_only_upstream() {
     let order = [
+        "cycle",
         "error",
         "command",
         "config",

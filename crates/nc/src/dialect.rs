@@ -186,11 +186,23 @@ pub enum TemplateKind {
     InverseTimeOn,
     /// Feed per minute again (`G94`).
     InverseTimeOff,
+    /// Program stop (CL `STOP`: M00).
+    Stop,
+    /// Optional stop (CL `OPSTOP`: M01).
+    OptionalStop,
+    /// Dwell (CL `DELAY`, a cycle's dwell): `seconds` (a number) and
+    /// `milliseconds` (a whole number).
+    Dwell,
+    /// Cutter radius compensation on (CL `CUTCOM/LEFT|RIGHT`): `side`
+    /// (`left` or `right`) and `register` (the offset register).
+    CutcomOn,
+    /// Cutter radius compensation off (CL `CUTCOM/OFF`).
+    CutcomOff,
 }
 
 impl TemplateKind {
     /// All kinds, in file order.
-    pub const ALL: [TemplateKind; 12] = [
+    pub const ALL: [TemplateKind; 17] = [
         TemplateKind::Header,
         TemplateKind::Footer,
         TemplateKind::ToolChange,
@@ -203,6 +215,11 @@ impl TemplateKind {
         TemplateKind::TcpOff,
         TemplateKind::InverseTimeOn,
         TemplateKind::InverseTimeOff,
+        TemplateKind::Stop,
+        TemplateKind::OptionalStop,
+        TemplateKind::Dwell,
+        TemplateKind::CutcomOn,
+        TemplateKind::CutcomOff,
     ];
 
     /// The variables this template gets besides the program's
@@ -213,6 +230,8 @@ impl TemplateKind {
             TemplateKind::SpindleOn => &["speed", "clockwise", "direction"],
             TemplateKind::CoolantOn => &["mode"],
             TemplateKind::Pressure => &["pressure", "pressure_word"],
+            TemplateKind::Dwell => &["seconds", "milliseconds"],
+            TemplateKind::CutcomOn => &["side", "register"],
             _ => &[],
         }
     }
@@ -229,6 +248,11 @@ impl TemplateKind {
                 | TemplateKind::CoolantOn
                 | TemplateKind::CoolantOff
                 | TemplateKind::Pressure
+                | TemplateKind::Stop
+                | TemplateKind::OptionalStop
+                | TemplateKind::Dwell
+                | TemplateKind::CutcomOn
+                | TemplateKind::CutcomOff
         )
     }
 
@@ -247,6 +271,11 @@ impl TemplateKind {
             TemplateKind::TcpOff => "tcp_off",
             TemplateKind::InverseTimeOn => "inverse_time_on",
             TemplateKind::InverseTimeOff => "inverse_time_off",
+            TemplateKind::Stop => "stop",
+            TemplateKind::OptionalStop => "optional_stop",
+            TemplateKind::Dwell => "dwell",
+            TemplateKind::CutcomOn => "cutcom_on",
+            TemplateKind::CutcomOff => "cutcom_off",
         }
     }
 }
@@ -1477,6 +1506,11 @@ struct RawTemplates {
     tcp_off: Option<Spanned<String>>,
     inverse_time_on: Option<Spanned<String>>,
     inverse_time_off: Option<Spanned<String>>,
+    stop: Option<Spanned<String>>,
+    optional_stop: Option<Spanned<String>>,
+    dwell: Option<Spanned<String>>,
+    cutcom_on: Option<Spanned<String>>,
+    cutcom_off: Option<Spanned<String>>,
     outside_tcp: Option<Vec<Spanned<String>>>,
 }
 
@@ -1495,6 +1529,11 @@ impl RawTemplates {
             TemplateKind::InverseTimeOn => self.inverse_time_on.as_ref(),
             TemplateKind::InverseTimeOff => self.inverse_time_off.as_ref(),
             TemplateKind::Pressure => self.pressure.as_ref(),
+            TemplateKind::Stop => self.stop.as_ref(),
+            TemplateKind::OptionalStop => self.optional_stop.as_ref(),
+            TemplateKind::Dwell => self.dwell.as_ref(),
+            TemplateKind::CutcomOn => self.cutcom_on.as_ref(),
+            TemplateKind::CutcomOff => self.cutcom_off.as_ref(),
         }
     }
 }

@@ -46,7 +46,7 @@ pub use template::{
     MAX_TEMPLATE_OUTPUT_BYTES, TEMPLATE_FUEL, TEMPLATE_RECURSION_LIMIT, TemplateError,
     template_span_in_toml,
 };
-pub use writer::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
+pub use writer::{MAX_DWELL_SECONDS, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, NcWriter, Spindle};
 
 /// One machine axis as the writer and reader need it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -166,6 +166,15 @@ pub struct ProgramInfo {
     pub tool_number: u32,
     /// CL file the program was made from (`cl_file`).
     pub cl_file: String,
+    /// The CL loads the header's tool (`tool_loaded`): only then does the
+    /// header call it (`T… M06`).
+    pub tool_loaded: bool,
+    /// The tool length offset register of the header's tool
+    /// (`length_register`: the CL's `ADJUST`, else the tool number).
+    pub length_register: u32,
+    /// The program is tool-centre-point output (`tcp_output`): the
+    /// `tcp_on` template applies the tool length, not `G43`.
+    pub tcp_output: bool,
     /// Further variables: each is available by its own name (unless it
     /// collides with a built-in one) and in the map `extra`.
     pub extra: BTreeMap<String, String>,
@@ -174,7 +183,7 @@ pub struct ProgramInfo {
 impl ProgramInfo {
     /// The names every template gets from [`ProgramInfo::template_vars`]
     /// (each extra key too, but those depend on the caller).
-    pub const VARIABLES: [&'static str; 10] = [
+    pub const VARIABLES: [&'static str; 13] = [
         "program_name",
         "date",
         "machine",
@@ -185,6 +194,9 @@ impl ProgramInfo {
         "axes",
         "extra",
         "tcp",
+        "tool_loaded",
+        "length_register",
+        "tcp_output",
     ];
 
     /// The template variables: `program_name`, `date`, `machine`, `tool`,
@@ -208,6 +220,9 @@ impl ProgramInfo {
         put("cl_file", Value::from(self.cl_file.as_str()));
         put("dialect", Value::from(dialect));
         put("tcp", Value::from(false));
+        put("tool_loaded", Value::from(self.tool_loaded));
+        put("length_register", Value::from(self.length_register));
+        put("tcp_output", Value::from(self.tcp_output));
         put(
             "axes",
             Value::from(
@@ -269,6 +284,14 @@ pub enum NcError {
         /// The dialect's `max_line_length`.
         max: usize,
     },
+    /// The program asks for something the dialect has no template for (a
+    /// dwell, a stop, cutter compensation): never left out in silence.
+    MissingTemplate {
+        /// The template's key (`dwell`, `cutcom_on`, …).
+        template: &'static str,
+        /// The dialect's name.
+        dialect: String,
+    },
 }
 
 impl std::fmt::Display for NcError {
@@ -293,6 +316,10 @@ impl std::fmt::Display for NcError {
                 reason,
             } => write!(f, "cannot write the {what} {value}: {reason}"),
             NcError::Numbers(e) => e.fmt(f),
+            NcError::MissingTemplate { template, dialect } => write!(
+                f,
+                "dialect `{dialect}` has no `{template}` template: add one to its [templates] to post this statement"
+            ),
             NcError::LineTooLong {
                 source,
                 text,
@@ -318,7 +345,8 @@ impl std::error::Error for NcError {
             NcError::Template { .. }
             | NcError::Value { .. }
             | NcError::Numbers(_)
-            | NcError::LineTooLong { .. } => None,
+            | NcError::LineTooLong { .. }
+            | NcError::MissingTemplate { .. } => None,
         }
     }
 }

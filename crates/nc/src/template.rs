@@ -192,6 +192,9 @@ pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<Strin
         tool: "SAMPLE TOOL".into(),
         tool_number: 1,
         cl_file: "sample.cls".into(),
+        tool_loaded: true,
+        length_register: 1,
+        tcp_output: false,
         extra: BTreeMap::new(),
     };
     let mut vars = info.template_vars(dialect, &axes);
@@ -204,6 +207,10 @@ pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<Strin
             "mode" => Value::from("flood"),
             "pressure" => Value::from(3000.0),
             "pressure_word" => Value::from("H1"),
+            "seconds" => Value::from(1.5),
+            "milliseconds" => Value::from(1500),
+            "side" => Value::from("left"),
+            "register" => Value::from(1),
             _ => Value::from(""),
         };
         vars.insert((*name).to_string(), v);

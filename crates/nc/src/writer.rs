@@ -497,8 +497,24 @@ impl<W: Write> NcWriter<W> {
     /// The name is cleaned for the dialect ([`CommentSyntax::clean`]); a
     /// tool number outside 1 ..= [`MAX_TOOL_NUMBER`] is an error.
     pub fn tool_change(&mut self, number: u32, name: &str) -> Result<(), NcError> {
+        self.tool_change_with_register(number, name, number)
+    }
+
+    /// A tool change as [`NcWriter::tool_change`] with the new tool's
+    /// length offset register (template variable `length_register`, for
+    /// `G43 H…`; the CL's `ADJUST`).
+    pub fn tool_change_with_register(
+        &mut self,
+        number: u32,
+        name: &str,
+        register: u32,
+    ) -> Result<(), NcError> {
         check_tool_number(number, true)?;
+        check_tool_number(register, false)?;
         let name = self.comment.clean(name).into_owned();
+        self.vars
+            .insert("length_register".into(), Value::from(register));
+        self.vars.insert("tool_loaded".into(), Value::from(true));
         self.vars.insert("tool_number".into(), Value::from(number));
         self.vars.insert("tool".into(), Value::from(name.as_str()));
         self.vars.insert("tool_name".into(), Value::from(name));
@@ -548,10 +564,82 @@ impl<W: Write> NcWriter<W> {
         }
     }
 
+    /// A program stop (`stop`, CL `STOP`) or an optional stop
+    /// (`optional_stop`, CL `OPSTOP`). A dialect without the template is an
+    /// error ([`NcError::MissingTemplate`]); nothing for CSV.
+    pub fn stop(&mut self, optional: bool) -> Result<(), NcError> {
+        let kind = if optional {
+            TemplateKind::OptionalStop
+        } else {
+            TemplateKind::Stop
+        };
+        self.required_command(kind, Vec::new())
+    }
+
+    /// A dwell of `seconds` (template `dwell` with `seconds` and
+    /// `milliseconds`, rounded to a whole number). A dwell that is not
+    /// finite or not above zero, or longer than [`MAX_DWELL_SECONDS`], is an
+    /// error; so is a dialect without the template.
+    pub fn dwell(&mut self, seconds: f64) -> Result<(), NcError> {
+        if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_DWELL_SECONDS) {
+            return Err(NcError::Value {
+                what: "dwell",
+                value: format!("{seconds} s"),
+                reason: format!("a dwell is more than 0 and at most {MAX_DWELL_SECONDS} s"),
+            });
+        }
+        let ms = (seconds * 1000.0).round() as u64;
+        self.required_command(
+            TemplateKind::Dwell,
+            vec![
+                ("seconds", Value::from(seconds)),
+                ("milliseconds", Value::from(ms)),
+            ],
+        )
+    }
+
+    /// Cutter radius compensation on the `left` (`true`) or right side
+    /// with offset `register` (template `cutcom_on` with `side` = `left` /
+    /// `right` and `register`), or off (`None`, template `cutcom_off`). A
+    /// dialect without the template is an error.
+    pub fn cutter_compensation(&mut self, on: Option<(bool, u32)>) -> Result<(), NcError> {
+        match on {
+            None => self.required_command(TemplateKind::CutcomOff, Vec::new()),
+            Some((left, register)) => self.required_command(
+                TemplateKind::CutcomOn,
+                vec![
+                    ("side", Value::from(if left { "left" } else { "right" })),
+                    ("register", Value::from(register)),
+                ],
+            ),
+        }
+    }
+
+    /// A command the program asks for (a stop, a dwell): a dialect without
+    /// its template cannot write it, an error rather than a silent drop.
+    fn required_command(
+        &mut self,
+        kind: TemplateKind,
+        extra: Vec<(&str, Value)>,
+    ) -> Result<(), NcError> {
+        if self.kind != DialectKind::Csv && self.env.get_template(kind.key()).is_err() {
+            return Err(NcError::MissingTemplate {
+                template: kind.key(),
+                dialect: self.dialect_name.clone(),
+            });
+        }
+        self.command(kind, extra)
+    }
+
     /// Tool-centre-point control on or off (templates `tcp_on`, `tcp_off`).
+    /// A program that turns it on is tool-centre-point output (template
+    /// variable `tcp_output` true from then on, whatever the header said).
     pub fn tcp(&mut self, on: bool) -> Result<(), NcError> {
         self.tcp_on = on;
         self.vars.insert("tcp".into(), Value::from(on));
+        if on {
+            self.vars.insert("tcp_output".into(), Value::from(true));
+        }
         let kind = if on {
             TemplateKind::TcpOn
         } else {
@@ -1198,6 +1286,11 @@ impl<W: Write> NcWriter<W> {
 /// spindles run up to a few 100 000 rpm). A larger value is an error,
 /// not a word of hundreds of digits.
 pub const MAX_SPINDLE_RPM: f64 = 999_999.0;
+
+/// The longest dwell written, seconds: a day. Controls take a few digits
+/// of seconds (Fanuc `G04 P` in ms has 8 digits, about 27 hours); a longer
+/// one is a unit mistake (milliseconds read as seconds), refused.
+pub const MAX_DWELL_SECONDS: f64 = 86_400.0;
 
 /// The largest tool number a program may ask for: eight digits, the
 /// longest T word of the common controllers (Fanuc `T` with eight digits;

@@ -10,14 +10,26 @@ use kinpost_nc::{NcError, Spindle};
 pub enum Command {
     /// A comment (`$$ text`, `PPRINT`, an operation's name).
     Comment(String),
-    /// A tool change: number and name.
-    ToolChange(u32, String),
+    /// A tool change: number, name and length offset register (the CL's
+    /// `ADJUST`, else the number).
+    ToolChange(u32, String, u32),
     /// Spindle on (speed and direction) or off.
     Spindle(Spindle),
     /// Coolant on in a mode (`FLOOD`, `MIST`, …), or off.
     Coolant(Option<String>),
     /// Text for the controller, verbatim (`INSERT`).
     Insert(String),
+    /// A program stop (`STOP`, `END`) or an optional stop (`OPSTOP`:
+    /// `true`).
+    Stop {
+        /// Optional stop (M01).
+        optional: bool,
+    },
+    /// A dwell, seconds (`DELAY`, a cycle's dwell).
+    Dwell(f64),
+    /// Cutter radius compensation on (`Some((left, register))`) or off
+    /// (`CUTCOM`).
+    CutterCompensation(Option<(bool, u32)>),
 }
 
 /// A command with its CL statement: it is written after the reader has

@@ -30,6 +30,10 @@ pub struct PostOptions {
     pub tolerance_mm: Option<f64>,
     /// Tool axis for `GOTO/x,y,z` before any axis is given (3-axis APT).
     pub default_axis: Option<[f64; 3]>,
+    /// The CL file's length units when it does not say (`--units`).
+    pub units: Option<kinpost_cl::Units>,
+    /// What a CL `INSERT` becomes (`--insert`).
+    pub insert: InsertMode,
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
@@ -71,6 +75,20 @@ pub enum PlannerMode {
     Global,
     /// Point by point: least motion from the previous block.
     Nearest,
+}
+
+/// What the post writes for a CL `INSERT`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InsertMode {
+    /// The text as code, as the APT standard says (a line that would move
+    /// an axis or change a tool gives a warning naming its CL line).
+    #[default]
+    Verbatim,
+    /// The text as a comment (SOLIDWORKS CAM writes tool and stock notes as
+    /// `INSERT`).
+    Comment,
+    /// Nothing (the user's choice).
+    Drop,
 }
 
 /// What the feed word of a feed block means.
@@ -116,6 +134,10 @@ pub struct Config {
     pub tolerance_mm: Option<f64>,
     /// Tool axis of `GOTO/x,y,z` before any axis is given.
     pub default_axis: Option<[f64; 3]>,
+    /// The CL file's length units when it does not say.
+    pub units: Option<kinpost_cl::Units>,
+    /// What a CL `INSERT` becomes.
+    pub insert: InsertMode,
     /// Joint or tool-centre-point output.
     pub output: OutputMode,
     /// What the feed words mean.
@@ -203,6 +225,8 @@ impl Config {
             date: options.date.clone(),
             tolerance_mm: tolerance,
             default_axis: options.default_axis,
+            units: options.units,
+            insert: options.insert,
             output: options.output.or(machine.post.output).unwrap_or_default(),
             feed_mode: options
                 .feed_mode

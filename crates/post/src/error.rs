@@ -193,6 +193,49 @@ pub enum ProgramError {
         /// What the statement asks for.
         what: &'static str,
     },
+    /// A `CIRCLE` whose arc cannot be built from the current point to the
+    /// next `GOTO`.
+    #[error("CIRCLE: {0}")]
+    Arc(#[from] kinpost_cl::ArcError),
+    /// A curve that cannot be linearized within the tolerance.
+    #[error("the curve cannot be followed within the tolerance: {0}")]
+    Sample(#[from] kinpost_cl::SampleError),
+    /// A canned cycle that cannot be expanded.
+    #[error(transparent)]
+    Cycle(#[from] crate::cycle::CycleError),
+    /// A `CIRCLE` while a canned cycle is on: its `GOTO` is a hole.
+    #[error(
+        "CIRCLE while a CYCLE is on: the next GOTO is a hole, not the end of an arc; give CYCLE/OFF first"
+    )]
+    CircleInCycle,
+    /// `GOHOME` with no point to go to.
+    #[error(
+        "GOHOME with no home point: the CL gives no point and no FROM, and the machine file has no home; give GOHOME/x,y,z or a FROM before it"
+    )]
+    NoHome,
+    /// A surface speed with no tool diameter to turn it into rpm.
+    #[error(
+        "SPINDL in surface speed (SMM/SFM) needs the tool diameter to give rpm: give TLDATA or CUTTER with the diameter before it"
+    )]
+    SurfaceSpeedWithoutDiameter,
+    /// A dwell in spindle revolutions with the spindle off.
+    #[error(
+        "DELAY in spindle revolutions, but no spindle speed is in force: give SPINDL/rpm before it"
+    )]
+    DwellRevolutionsWithoutSpindle,
+    /// Cutter compensation in another plane than XY.
+    #[error(
+        "CUTCOM in the {0} plane: kinpost writes cutter compensation in the XY plane (G17) only"
+    )]
+    CutcomPlane(&'static str),
+    /// `ORIGIN` with an offset.
+    #[error(
+        "ORIGIN/{0:?} moves the program origin: kinpost posts every point in the machine file's part frame and does not shift it; set the work offset there, or remove the ORIGIN"
+    )]
+    OriginOffset([f64; 3]),
+    /// A dwell that cannot be written.
+    #[error("DELAY of {0} s: a dwell is a finite number of seconds, not below 0")]
+    Dwell(f64),
 }
 
 /// Why a pressure cannot be programmed.

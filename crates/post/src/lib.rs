@@ -11,9 +11,11 @@
 //! 1. **CL reader** ([`cl`]): the file as statements, one at a time.
 //! 2. **Program** ([`program::Program`] → [`program::ProgramSink`]): the
 //!    CL's modal state (units, feed, spindle, tool, pressure); every `GOTO`
-//!    becomes a tool pose in the part frame with its feed and pressure,
-//!    every other statement that speaks to the controller a
-//!    [`Command`].
+//!    becomes a tool pose in the part frame with its feed and pressure
+//!    (a `CIRCLE` arc or a `NURBS` the poses along it within the
+//!    linearization tolerance, a hole of a canned cycle the moves of
+//!    [`cycle`]), every other statement that speaks to the controller a
+//!    [`Command`] (stops, dwells, cutter compensation among them).
 //! 3. **Planner** ([`plan::Planner`] → [`plan::PlanSink`]): every
 //!    inverse-kinematics solution of every point, the configuration of each
 //!    decided over the whole path (branches, turns, singular runs, folds).
@@ -48,6 +50,7 @@
 pub mod check;
 mod command;
 pub mod config;
+pub mod cycle;
 mod error;
 mod machine_templates;
 pub mod motion;
@@ -67,7 +70,7 @@ use kinpost_machine::Machine;
 use kinpost_nc::{Dialect, NcWriter};
 
 pub use command::{Command, Pending};
-pub use config::{Config, FeedMode, PLANNER_LAG, PlannerMode, PostOptions};
+pub use config::{Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
 pub use error::{
     CheckError, ConfigError, LinearizationFailure, MotionError, MotionWarning, PointError,
     PostError, PressureError, PressureWarning, ProgramError, SetupError,
@@ -142,7 +145,7 @@ fn run<R: BufRead, P: ProgramWriter>(
     config: &Config,
 ) -> Result<(Summary, P::Finished), PostError> {
     let started = Instant::now();
-    let mut reader = ClReader::new(input, config.cl_file.clone());
+    let mut reader = ClReader::new(input, config.cl_file.clone()).with_units(config.units);
     if let Some(axis) = config.default_axis {
         reader = reader.with_default_axis(axis);
     }

@@ -7,13 +7,10 @@
 
 use std::io::BufRead;
 
-use kinpost_cl::{
-    ClEvent, ClReader, CutcomSide, FeedUnit, Motion, Move, Next, SpindleDir, SpindleSpeed,
-    Statement,
-};
+use kinpost_cl::{ClEvent, ClReader, FeedUnit, Motion, Move, Next, SpindleDir, Statement};
 use kinpost_diag::{Diagnostic, Located, Severity};
 use kinpost_machine::tolerance::REFERENCE_SKEW_DEG;
-use kinpost_machine::{Machine, Pose};
+use kinpost_machine::{Machine, OutputMode, Pose};
 use kinpost_nc::{AxisSpec, Dialect, ProgramInfo, Spindle};
 use kinpost_plan::PathPoint;
 use nalgebra::Vector3;
@@ -22,6 +19,10 @@ use crate::command::{Command, Pending};
 use crate::config::Config;
 use crate::error::{PointError, PostError, ProgramError};
 use crate::pressure::check_pressure;
+
+mod events;
+
+use events::Modal;
 
 /// Where the program stage's points and commands go.
 pub trait ProgramSink {
@@ -46,7 +47,8 @@ pub trait ProgramSink {
 /// What the program stage read, for the summary.
 #[derive(Debug, Clone, Default)]
 pub struct ProgramReport {
-    /// CL points (GOTOs) read.
+    /// CL points read: `GOTO`s (an arc's end, a hole), `NURBS`, `GOHOME`;
+    /// not the points an arc, a spline or a cycle is cut into.
     pub cl_points: u64,
     /// What the header and footer say.
     pub info: ProgramInfo,
@@ -84,6 +86,17 @@ pub struct Program<'a> {
     /// every point is posted in the machine file's part frame, so a later
     /// `MSYS` must not change it.
     msys: Option<([f64; 9], usize)>,
+    /// An arc waiting for its end point, a canned cycle on (`None`: the
+    /// `GOTO`s are plain moves, the fast path).
+    modal: Option<Box<Modal>>,
+    /// The spindle turns counter-clockwise (`SPINDL/…,CCLW`).
+    spindle_ccw: bool,
+    /// The diameter of the tool last described (`TLDATA`, `CUTTER`), mm.
+    tool_diameter_mm: Option<f64>,
+    /// Cutter radius compensation is on.
+    cutcom_on: bool,
+    /// A `CSYS` with a rotation or offset was remarked on.
+    csys_remarked: bool,
     remarked: Remarked,
     report: ProgramReport,
 }
@@ -125,6 +138,8 @@ impl<'a> Program<'a> {
                 machine: machine.name.clone(),
                 tool: String::new(),
                 tool_number: 1,
+                length_register: 1,
+                tcp_output: config.output == OutputMode::Tcp,
                 cl_file: config.cl_file.clone(),
                 ..ProgramInfo::default()
             },
@@ -138,6 +153,11 @@ impl<'a> Program<'a> {
             tool_loaded: false,
             spindle_tool: None,
             msys: None,
+            modal: None,
+            spindle_ccw: false,
+            tool_diameter_mm: None,
+            cutcom_on: false,
+            csys_remarked: false,
             remarked: Remarked::default(),
             report: ProgramReport {
                 warnings,
@@ -168,9 +188,15 @@ impl<'a> Program<'a> {
         let mut goto = Move::default();
         loop {
             match reader.next_move(&mut goto)? {
-                Next::Move => self.goto(&goto, reader, sink)?,
+                Next::Move => {
+                    if self.modal.is_none() {
+                        self.goto(&goto, reader, sink)?
+                    } else {
+                        self.modal_goto(&goto, reader, sink)?
+                    }
+                }
                 Next::Statement(s) => {
-                    if !self.statement(s, reader, sink)? {
+                    if !self.statement(s, &mut goto, reader, sink)? {
                         break;
                     }
                 }
@@ -199,10 +225,13 @@ impl<'a> Program<'a> {
     }
 
     /// A CL statement other than a plain `GOTO` line: `false` at `FINI`.
+    /// `last`: the last `GOTO` (the current point and axis), kept up to
+    /// date by every statement that moves the tool.
     #[inline(never)]
     fn statement<R: BufRead, S: ProgramSink>(
         &mut self,
         statement: Statement,
+        last: &mut Move,
         reader: &ClReader<R>,
         sink: &mut S,
     ) -> Result<bool, PostError> {
@@ -214,14 +243,18 @@ impl<'a> Program<'a> {
                 reference,
                 motion,
             } => {
-                let goto = Move {
+                *last = Move {
                     line,
                     point,
                     axis,
                     reference,
                     motion,
                 };
-                self.goto(&goto, reader, sink)?;
+                if self.modal.is_none() {
+                    self.goto(last, reader, sink)?;
+                } else {
+                    self.modal_goto(last, reader, sink)?;
+                }
             }
             ClEvent::Feedrate { value, unit } => self.feedrate(value, unit, reader)?,
             // The reader gives every length in mm.
@@ -240,14 +273,21 @@ impl<'a> Program<'a> {
             ClEvent::Comment(text) => {
                 self.command(Command::Comment(text.trim().to_string()), reader, sink)?
             }
-            ClEvent::LoadTool { number, .. } => self.load_tool(number, reader, sink)?,
+            ClEvent::LoadTool { number, adjust } => {
+                if self.modal.is_some() {
+                    self.end_cycle_at_tool_change(last, reader);
+                }
+                self.load_tool(number, adjust, reader, sink)?
+            }
             ClEvent::SelectTool { .. } => {}
             ClEvent::Spindle {
-                speed: SpindleSpeed::Rpm(rpm),
+                speed,
                 dir,
-                range: None,
-                max_rpm: None,
+                range,
+                max_rpm,
             } => {
+                let rpm = self.spindle_rpm(speed, range, max_rpm, reader)?;
+                self.spindle_ccw = dir == SpindleDir::CounterClockwise;
                 self.rpm = Some(rpm);
                 if let Some(per_rev) = self.feed_per_rev {
                     self.feed = Some(per_rev * rpm);
@@ -269,27 +309,26 @@ impl<'a> Program<'a> {
             ClEvent::Coolant { on, mode } => {
                 self.command(Command::Coolant(on.then_some(mode)), reader, sink)?
             }
-            ClEvent::Insert(text) => self.command(Command::Insert(text), reader, sink)?,
+            ClEvent::Insert(text) => self.insert(text, reader, sink)?,
             ClEvent::EndOfPath => sink.break_segment(),
             ClEvent::Pressure { word, value } => self.pressure(word.as_deref(), value, reader)?,
-            ClEvent::ToolData(_) | ClEvent::Multax(_) => {}
+            ClEvent::ToolData(data) => {
+                if data.diameter_mm.is_some() {
+                    self.tool_diameter_mm = data.diameter_mm;
+                }
+            }
+            ClEvent::Multax(_) => {}
             ClEvent::MachineSystem { origin, x, y, .. } => {
                 self.machine_system(origin, x, y, line, reader)?
             }
             ClEvent::CoordinateSystem(frame) if frame.is_identity(1e-9) => {}
-            ClEvent::CutterCompensation {
-                side: CutcomSide::Off,
-                ..
-            } => {}
-            // Informational: the CAM system's post name, names, setups, marks,
-            // and FROM (a position, no motion).
+            // Informational: the CAM system's post name, names, setups, marks.
             ClEvent::Machine { .. }
             | ClEvent::OperationName(_)
             | ClEvent::Setup { .. }
-            | ClEvent::TapeMark
-            | ClEvent::From { .. } => {}
+            | ClEvent::TapeMark => {}
             ClEvent::Fini => return Ok(false),
-            other => return Err(not_posted(reader, &other)),
+            other => self.event(other, last, reader, sink)?,
         }
         Ok(true)
     }
@@ -366,15 +405,23 @@ impl<'a> Program<'a> {
     fn load_tool<R: BufRead, S: ProgramSink>(
         &mut self,
         number: u32,
+        adjust: Option<u32>,
         reader: &ClReader<R>,
         sink: &mut S,
     ) -> Result<(), PostError> {
         sink.break_segment();
+        let register = adjust.unwrap_or(number);
         if !self.tool_loaded && self.six_axis.is_none() {
             self.info.tool_number = number;
-        } else if number != self.spindle_tool.unwrap_or(self.info.tool_number) {
+            self.info.tool_loaded = true;
+            self.info.length_register = register;
+        } else if Some(number)
+            != self
+                .spindle_tool
+                .or(self.info.tool_loaded.then_some(self.info.tool_number))
+        {
             let tool = self.info.tool.clone();
-            self.command(Command::ToolChange(number, tool), reader, sink)?;
+            self.command(Command::ToolChange(number, tool, register), reader, sink)?;
             self.spindle_tool = Some(number);
         }
         self.tool_loaded = true;
@@ -530,31 +577,4 @@ fn reference_remark(
                 off.abs().to_degrees()
             )
         })
-}
-
-/// The error for a CL statement the post does not act on yet (the reader
-/// gives it as an event).
-#[cold]
-fn not_posted<R: BufRead>(reader: &ClReader<R>, event: &ClEvent) -> PostError {
-    let what = match event {
-        ClEvent::Spindle { .. } => {
-            "a spindle speed in surface units, a gear range or a speed limit"
-        }
-        ClEvent::CoordinateSystem(_) => "CSYS with a rotation or an offset",
-        ClEvent::Circle(_) => "CIRCLE (an arc)",
-        ClEvent::Nurbs(_) => "NURBS (a spline)",
-        ClEvent::Cycle(_) | ClEvent::CycleOff => "CYCLE (a canned cycle)",
-        ClEvent::GoHome { .. } => "GOHOME",
-        ClEvent::CutterCompensation { .. } => {
-            "CUTCOM (cutter radius compensation: the GOTOs are the part contour, not tool positions)"
-        }
-        ClEvent::Dwell(_) => "DELAY (a dwell)",
-        ClEvent::Stop | ClEvent::OptionalStop | ClEvent::End => {
-            "STOP, OPSTOP or END (a program stop)"
-        }
-        ClEvent::Clamp { .. } => "CLAMP",
-        ClEvent::Origin(_) => "ORIGIN",
-        _ => "this statement",
-    };
-    locate(reader, ProgramError::NotPosted { what }).into()
 }

@@ -24,10 +24,15 @@ impl<W: Write> BlockSink for NcWriter<W> {
     fn command(&mut self, p: Pending) -> Result<(), PostError> {
         let written = match &p.command {
             Command::Comment(text) => self.comment(text),
-            Command::ToolChange(number, name) => self.tool_change(*number, name),
+            Command::ToolChange(number, name, register) => {
+                self.tool_change_with_register(*number, name, *register)
+            }
             Command::Spindle(state) => self.spindle(*state),
             Command::Coolant(mode) => self.coolant(mode.as_deref()),
             Command::Insert(text) => self.insert(text),
+            Command::Stop { optional } => self.stop(*optional),
+            Command::Dwell(seconds) => self.dwell(*seconds),
+            Command::CutterCompensation(on) => self.cutter_compensation(*on),
         };
         written.map_err(|e| p.locate(e).into())
     }

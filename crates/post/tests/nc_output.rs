@@ -45,18 +45,19 @@ fn post_error(dialect: &Dialect, cl: &str) -> kinpost_post::nc::Diagnostic {
 fn template_error_names_the_cl_line() {
     let dialect = dialect_with(
         "linuxcnc",
-        "tool_change =",
-        "tool_change = \"T{{ tool_number }} M6 P{{ extra.slot }}\"",
+        "spindle_on =",
+        "spindle_on = \"S{{ speed | num(0) }} M3 P{{ extra.slot }}\"",
     );
-    let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,100\nGOTO/0,0,40\nLOAD/TOOL,2\nGOTO/0,0,60\n";
+    let cl =
+        "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,100\nGOTO/0,0,40\nSPINDL/1000,RPM\nGOTO/0,0,60\n";
     let d = post_error(&dialect, cl);
     assert_eq!(
         (d.file.as_str(), d.line, d.column),
         ("job.cls", 5, 1),
         "{d}"
     );
-    assert_eq!(d.source_line, "LOAD/TOOL,2");
-    assert!(d.message.contains("template `tool_change`"), "{d}");
+    assert_eq!(d.source_line, "SPINDL/1000,RPM");
+    assert!(d.message.contains("template `spindle_on`"), "{d}");
 }
 
 /// An INSERT longer than the dialect's `max_line_length` (LinuxCNC's 253

@@ -906,22 +906,24 @@ fn a_block_that_turns_while_the_tool_point_barely_moves_takes_the_turning_time()
 fn inverse_time_starts_where_the_start_is_known() {
     // The first feed move and the first after a tool change start where the
     // machine happens to be: no block time, so they are written at the CL
-    // feed rate per minute (G94), inverse time (G93) in between.
+    // feed rate per minute (G94), inverse time (G93) in between. (The CL
+    // loads no tool before its first point: the header calls none.)
     let cl = "FEDRAT/MMPM,100\nGOTO/0,0,50,0,0,1\nGOTO/0,0,10\nLOAD/TOOL,2\nGOTO/10,0,10\nGOTO/20,0,10\n";
     let nc = post_trunnion(cl, "fanuc", kinpost_post::FeedMode::InverseTime).unwrap();
     let body: Vec<&str> = nc
         .lines()
-        .skip_while(|l| !l.starts_with("T1"))
+        .skip_while(|l| !l.starts_with("G54"))
+        .skip(1)
         .take_while(|l| !l.starts_with("M05"))
         .collect();
     assert_eq!(
         body,
         [
-            "T1 M06",
             "G01 X0.000 Y0.000 Z50.000 A0.000 C0.000 F100.",
             "G93",
             "Z10.000 F2.5",
             "T2 M06",
+            "G43 H2",
             "G94",
             "G01 X10.000 Y0.000 Z10.000 A0.000 C0.000 F100.",
             "G93",

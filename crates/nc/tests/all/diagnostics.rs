@@ -69,7 +69,7 @@ fn outside_tcp_names_command_templates_only() {
     assert_eq!(
         d.message,
         "`templates.outside_tcp`: `header` is not a command template (one of tool_change, \
-         spindle_on, spindle_off, coolant_on, coolant_off, pressure)"
+         spindle_on, spindle_off, coolant_on, coolant_off, pressure, stop, optional_stop, dwell, cutcom_on, cutcom_off)"
     );
     let d = err("name = \"x\"\nextension = \"nc\"\n[templates]\noutside_tcp = \"spindle_on\"\n");
     assert_eq!(d.line, 4, "{d}");
@@ -110,7 +110,7 @@ fn every_unknown_key_and_value_at_once() {
             ),
             (
                 12,
-                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`, `outside_tcp`"
+                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`, `stop`, `optional_stop`, `dwell`, `cutcom_on`, `cutcom_off`, `outside_tcp`"
             ),
         ]
     );

@@ -69,6 +69,9 @@ fn info() -> ProgramInfo {
         tool: "WHEEL".into(),
         tool_number: 1,
         cl_file: "demo.cls".into(),
+        tool_loaded: true,
+        length_register: 1,
+        tcp_output: false,
         extra: BTreeMap::new(),
     }
 }
@@ -241,14 +244,14 @@ fn fanuc_numbering_can_be_turned_on() {
     let text = String::from_utf8(w.finish().unwrap()).unwrap();
     assert!(
         text.ends_with(
-            "G54\nT1 M06\nN10 T3 M06\nN20 G01 X0.000 Y1.000 F100.\nN30 X1.000\nN40 X2.000\n"
+            "G54\nT1 M06\nG43 H1\nN10 T3 M06\nN20 G43 H3\nN30 G01 X0.000 Y1.000 F100.\nN40 X1.000\nN50 X2.000\n"
         ),
         "{text}"
     );
     let read = read_program(&dialect, &axes, "n", &text).unwrap();
     assert_eq!(
         read.iter().map(|b| b.number).collect::<Vec<_>>(),
-        [Some(20), Some(30), Some(40)]
+        [Some(30), Some(40), Some(50)]
     );
 }
 
@@ -286,11 +289,13 @@ O0001 (DEMO [1])
 (CL FILE: demo.cls)
 (DATE: 2025-01-31)
 (POSTED BY KINPOST, DIALECT fanuc)
-G90 G17 G21 G40 G49 G80 G94
+G90 G17 G21 G40 G80 G94
 G54
 T1 M06
+G43 H1
 (TOOL PATH: ROUGH [A], FINISH)
 T2 M06
+G43 H2
 S3000 M03
 M08
 G00 X459.000 Y8.807 Z361.368 A0.000 B0.000
@@ -302,6 +307,7 @@ M09
 M05
 M05
 M09
+G49
 M30
 %
 ";
@@ -338,11 +344,13 @@ const LINUXCNC: &str = "\
 (CL FILE: demo.cls)
 (DATE: 2025-01-31)
 (POSTED BY KINPOST; DIALECT linuxcnc)
-G21 G90 G40 G49 G64 P0.01
+G21 G90 G40 G64 P0.01
 G17 G54 G94
 T1 M6
+G43 H1
 (TOOL PATH: ROUGH [A]; FINISH)
 T2 M6
+G43 H2
 S3000 M3
 M8
 G0 X459.0000 Y8.8069 Z361.3684 A0.0000 B0.0000
@@ -354,6 +362,7 @@ M9
 M5
 M5
 M9
+G49
 M2
 %
 ";

@@ -154,6 +154,9 @@ fn header_footer_templates_and_overrides() {
         tool: "BELT".into(),
         tool_number: 1,
         cl_file: "figure28a.cls".into(),
+        tool_loaded: true,
+        length_register: 1,
+        tcp_output: false,
         extra: BTreeMap::new(),
     };
     info.extra.insert("pressure".into(), "3000".into());
@@ -859,7 +862,9 @@ fn a_tool_change_under_tcp_control_renews_it_for_the_new_tool() {
     w.tool_change(3, "T3").unwrap();
     assert_eq!(
         text(w),
-        "T1 M06\nG43.4 H1\nG49\nT2 M06\nG43.4 H2\nG49\nT3 M06\n"
+        // G43 for the first tool: the writer was not told (by a header)
+        // that the program is tool-centre-point output before G43.4.
+        "T1 M06\nG43 H1\nG43.4 H1\nG49\nT2 M06\nG43.4 H2\nG49\nT3 M06\n"
     );
 }
 
@@ -884,7 +889,7 @@ fn outside_tcp_lists_the_commands_written_with_tcp_off() {
     w.coolant(Some("flood")).unwrap();
     assert_eq!(
         text(w),
-        "T1 M06\nG43.4 H1\nG49\nM08\nG43.4 H1\nT2 M06\nM09\nG49\nM08\n"
+        "T1 M06\nG43 H1\nG43.4 H1\nG49\nM08\nG43.4 H1\nT2 M06\nM09\nG49\nM08\n"
     );
 }
 
@@ -910,9 +915,10 @@ fn after_a_tool_change_the_motion_word_and_every_axis_are_written_again() {
     w.tool_change(2, "T2").unwrap();
     z_block(&mut w, Motion::Rapid, 400.0);
     let out = text(w);
+    // (The tool change applies the new tool's length: `G43 H2`.)
     assert_eq!(
         out,
-        "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nG00 X459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
+        "G00 X459.000 Y8.500 Z380.000 A-90.000 B10.250\nZ400.000\nT2 M06\nG43 H2\nG00 X459.000 Y8.500 Z400.000 A-90.000 B10.250\n"
     );
 }
 
@@ -1022,6 +1028,11 @@ fn every_template_gets_the_variables_the_loader_accepts() {
     w.tcp(false).unwrap();
     w.inverse_time(true).unwrap();
     w.inverse_time(false).unwrap();
+    w.stop(false).unwrap();
+    w.stop(true).unwrap();
+    w.dwell(1.0).unwrap();
+    w.cutter_compensation(Some((true, 1))).unwrap();
+    w.cutter_compensation(None).unwrap();
     pressure_block(&mut w, 1.0, 3000.0);
     w.footer(&info, None).unwrap();
     let out = text(w);

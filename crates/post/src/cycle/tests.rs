@@ -1,0 +1,141 @@
+//! The hole expansions written out by hand from the G-code definitions of
+//! each cycle (LinuxCNC G-code reference: G73, G83, G84, G85).
+
+use super::*;
+
+const Z: [f64; 3] = [0.0, 0.0, 1.0];
+
+fn cycle(motion: HoleMotion, dwell_s: f64) -> HoleCycle {
+    HoleCycle {
+        motion,
+        depth_mm: 4.0,
+        feed_start_mm: 1.0,
+        retract_mm: 5.0,
+        feed_mm_min: 100.0,
+        dwell_s,
+    }
+}
+
+fn z(h: f64) -> [f64; 3] {
+    [0.0, 0.0, h]
+}
+
+/// G73: feed a peck, back off, feed on (from where it backed off to);
+/// out of the hole after every second peck, then rapid down to the
+/// clearance above the bottom.
+#[test]
+fn chip_breaking() {
+    let c = cycle(
+        HoleMotion::ChipBreak {
+            first_mm: 1.5,
+            next_mm: 1.5,
+            back_off_mm: 0.5,
+            full_retract_every: Some(2),
+        },
+        0.0,
+    );
+    use HoleStep::{Feed, Rapid};
+    assert_eq!(
+        c.expand([0.0; 3], Z, z(10.0)),
+        [
+            Rapid(z(1.0)),
+            Feed(z(-0.5)),
+            Rapid(z(0.0)),
+            Feed(z(-2.0)),
+            Rapid(z(1.0)),
+            Rapid(z(-2.0 + PECK_CLEARANCE_MM)),
+            Feed(z(-3.5)),
+            Rapid(z(-3.0)),
+            Feed(z(-4.0)),
+            Rapid(z(5.0)),
+        ]
+    );
+}
+
+/// G85/G89: feed in, dwell, feed out to R, then up to the retract height.
+#[test]
+fn boring_feeds_out() {
+    let c = cycle(HoleMotion::Bore, 0.5);
+    use HoleStep::{Dwell, Feed, Rapid};
+    assert_eq!(
+        c.expand([0.0; 3], Z, z(10.0)),
+        [
+            Rapid(z(1.0)),
+            Feed(z(-4.0)),
+            Dwell(0.5),
+            Feed(z(1.0)),
+            Rapid(z(5.0)),
+        ]
+    );
+}
+
+/// A tool below the feed start goes up along its own axis first, then
+/// across.
+#[test]
+fn a_tool_below_the_feed_start_goes_up_first() {
+    let c = cycle(HoleMotion::Drill, 0.0);
+    use HoleStep::{Feed, Rapid};
+    assert_eq!(
+        c.expand([0.0; 3], Z, [7.0, 0.0, -2.0]),
+        [
+            Rapid([7.0, 0.0, 1.0]),
+            Rapid(z(1.0)),
+            Feed(z(-4.0)),
+            Rapid(z(5.0)),
+        ]
+    );
+}
+
+fn raw(kind: CycleKind) -> Cycle {
+    Cycle {
+        kind,
+        depth_mm: Some(4.0),
+        feed_start_mm: Some(1.0),
+        retract_mm: None,
+        peck_mm: None,
+        next_peck_mm: None,
+        dwell: None,
+        feed: None,
+        pitch_mm: None,
+        back_off_mm: None,
+        full_retract_every: None,
+    }
+}
+
+/// What cannot be expanded is an error naming what is missing.
+#[test]
+fn resolve_errors() {
+    assert_eq!(
+        HoleCycle::resolve(&raw(CycleKind::Deep), Some(100.0), None),
+        Err(CycleError::NoPeck("DEEP"))
+    );
+    assert_eq!(
+        HoleCycle::resolve(&raw(CycleKind::Drill), None, None),
+        Err(CycleError::NoFeed)
+    );
+    let mut c = raw(CycleKind::Deep);
+    c.peck_mm = Some(1e-6);
+    assert!(matches!(
+        HoleCycle::resolve(&c, Some(100.0), None),
+        Err(CycleError::TooManyPecks { .. })
+    ));
+    assert_eq!(
+        HoleCycle::resolve(&raw(CycleKind::Other("FOO".into())), Some(1.0), None),
+        Err(CycleError::Kind("FOO".into()))
+    );
+    let mut c = raw(CycleKind::Drill);
+    c.depth_mm = None;
+    assert_eq!(
+        HoleCycle::resolve(&c, Some(100.0), None),
+        Err(CycleError::NoDepth)
+    );
+    // A dwell in revolutions at 600 rpm: 60 / 600 s each.
+    let mut c = raw(CycleKind::Drill);
+    c.dwell = Some(Dwell::Revolutions(5.0));
+    assert_eq!(
+        HoleCycle::resolve(&c, Some(100.0), Some(600.0))
+            .unwrap()
+            .dwell_s,
+        0.5
+    );
+}
