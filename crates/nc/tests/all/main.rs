@@ -11,5 +11,6 @@ mod interp_roundtrip;
 mod interp_rs274;
 mod interp_sinumerik;
 mod never_panics;
+mod program_commands;
 mod props;
 mod writer;
