@@ -945,6 +945,7 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         free_with_reference: false,
         prefer: None,
         max_velocity: None,
+        machine_offset: offset,
     };
     let mut axis = axis;
     if let Some(w) = &a.wrap {

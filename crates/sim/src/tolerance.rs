@@ -1,0 +1,36 @@
+//! The replay's tolerances and assumptions, in one place with their reasons.
+
+/// How far beyond its travel an axis may go unreported, mm or degrees: the
+/// slack of `Axis::accepts` for values computed exactly at a limit. A value
+/// a program writes past its limit by the smallest output unit (0.001) is
+/// reported.
+pub const TRAVEL_MM_OR_DEG: f64 = 1e-9;
+
+/// Rapid rate assumed for a linear axis whose machine file gives no
+/// `max_velocity`, mm/min: a common rapid traverse of machining centres
+/// (10 m/min). Said in the report's `assumed` when used.
+pub const ASSUMED_RAPID_MM_PER_MIN: f64 = 10_000.0;
+
+/// Rapid rate assumed for a rotary axis without `max_velocity`,
+/// degrees/min: 10 revolutions per minute, a common rotary-table rapid.
+pub const ASSUMED_RAPID_DEG_PER_MIN: f64 = 3_600.0;
+
+/// Below this X Y Z travel a feed block is a rotary-only move whose feed
+/// applies to degrees, mm.
+pub const STANDSTILL_MM: f64 = 1e-9;
+
+/// Longest step of the tool point between two points compared with the
+/// CL inside a feed block, mm. The largest deviation along a block is found
+/// to within the sagitta of such a step on the replayed path (micrometres
+/// for any lever of a real machine with the rotary step below).
+pub const SAMPLE_STEP_MM: f64 = 1.0;
+
+/// Largest step of a rotary axis between two compared points, degrees.
+pub const SAMPLE_STEP_DEG: f64 = 0.25;
+
+/// Chord error of the samples of an arc, mm.
+pub const SAMPLE_CHORD_MM: f64 = 1e-3;
+
+/// Most points compared inside one block (a block of several metres or
+/// full turns is still sampled every few millimetres or less).
+pub const MAX_SAMPLES_PER_BLOCK: usize = 100_000;
