@@ -2,7 +2,6 @@
 
 use kinpost_machine::{Kinematics, KinematicsAtPressure, Machine};
 use kinpost_nc::interp::{Event, FeedMode, MAX_AXES, MotionKind, Move, Step};
-use nalgebra::Vector3;
 
 use crate::cl::ClPath;
 use crate::collide::Worlds;
@@ -35,9 +34,15 @@ pub struct Replay {
     kin: KinematicsAtPressure,
     q: Joints,
     offset: Joints,
-    started: bool,
+    /// Axes whose position is known (bit i): locked axes, and axes a block
+    /// has programmed. The others stand where the program found them,
+    /// which a program excerpt does not say.
+    known: u32,
+    /// All of the machine's axes (bit i for i < n).
+    all: u32,
+    /// Line of the first block after which every axis is known.
+    complete_at: Option<usize>,
     pressure: f64,
-    pose: Option<(Vector3<f64>, Vector3<f64>)>,
     report: SimReport,
     cl: Option<(ClPath, ClComparison)>,
     worlds: Option<Worlds>,
@@ -106,14 +111,12 @@ impl Replay {
         let mut q = [0.0; MAX_AXES];
         let start = start_joints(machine, options);
         q[..n].copy_from_slice(&start[..n]);
-        report.assumed.push(format!(
-            "the machine starts at {} (the start itself is not checked: the first block is checked at its end)",
-            axes.iter()
-                .zip(&q)
-                .map(|(a, v)| format!("{}{v}", a.name))
-                .collect::<Vec<_>>()
-                .join(" ")
-        ));
+        let known = sim
+            .axes
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| a.fixed.is_some())
+            .fold(0u32, |k, (i, _)| k | 1 << i);
         let worlds = if options.collisions && !sim.solids.is_empty() {
             Some(Worlds::new(&sim, options.pressure_offset)?)
         } else {
@@ -133,9 +136,10 @@ impl Replay {
             kin,
             q,
             offset: [0.0; MAX_AXES],
-            started: false,
+            known,
+            all: if n == 32 { u32::MAX } else { (1u32 << n) - 1 },
+            complete_at: None,
             pressure: f64::NAN,
-            pose: None,
             report,
             cl,
             worlds,
@@ -171,6 +175,12 @@ impl Replay {
         let mut assumed = interp.assumed.clone();
         assumed.append(&mut r.assumed);
         r.assumed = assumed;
+        r.assumed.push(match self.complete_at {
+            Some(line) => format!(
+                "an axis is where the program puts it from its first word on: before that its position is unknown and not checked; collisions and the CL comparison start once every axis is known (line {line})"
+            ),
+            None => "an axis is where the program puts it from its first word on; not every axis was ever programmed, so no pose was checked for collisions or against the CL".to_string(),
+        });
         if self.untimed_blocks > 0 {
             r.assumed.push(format!(
                 "{} feed blocks without a feed rate (F0, or G95 without a spindle speed) take the time their axes' velocity limits give (0 without limits)",
@@ -210,22 +220,26 @@ impl Replay {
                 return;
             }
         };
-        self.check_travel(&path, &at);
+        let known_before = self.known;
+        self.known |= m.programmed & self.all;
+        self.check_travel(&path, &at, known_before);
         self.report.duration_s += self.block_time_s(m, &path);
         let rapid = m.kind == MotionKind::Rapid;
-        if self.cl.is_some() {
-            self.compare(&path, &at, rapid);
-        }
-        if let Some(w) = &mut self.worlds {
-            let started = self.started;
-            if let Err(e) = w.check(&path, &at, rapid, started, self.pressure) {
+        let started = known_before == self.all;
+        if self.known == self.all {
+            self.complete_at.get_or_insert(step.line);
+            if self.cl.is_some() && !rapid {
+                self.compare(&path, &at, started);
+            }
+            if let Some(w) = &mut self.worlds
+                && let Err(e) = w.check(&path, &at, rapid, started, self.pressure)
+            {
                 self.error = Some(e);
                 return;
             }
         }
         self.q = path.to;
         self.offset[..self.n].copy_from_slice(&m.state.offset.as_slice()[..self.n]);
-        self.started = true;
     }
 
     /// The joints the block ends at and how it gets there.
@@ -280,16 +294,21 @@ impl Replay {
         })
     }
 
-    /// Every axis against its travel along the block. A block is charged
-    /// with an excess only where it goes beyond where it started: a block
-    /// that starts outside (the previous block took it there) and comes
-    /// back is not.
-    fn check_travel(&mut self, path: &BlockPath, at: &At) {
+    /// Every axis against its travel along the block (an axis whose start
+    /// is not known, bit clear in `known_before`: at its end only, once
+    /// programmed). A block is charged with an excess only where it goes
+    /// beyond where it started: a block that starts outside (the previous
+    /// block took it there) and comes back is not.
+    fn check_travel(&mut self, path: &BlockPath, at: &At, known_before: u32) {
         for i in 0..self.n {
             let Some([lo, hi]) = self.axes[i].travel else {
                 continue;
             };
-            let [min, max] = if self.started {
+            let started = known_before & (1 << i) != 0;
+            if !started && self.known & (1 << i) == 0 {
+                continue;
+            }
+            let [min, max] = if started {
                 path.range(i, &mut self.scratch)
             } else {
                 [path.to[i], path.to[i]]
@@ -300,7 +319,7 @@ impl Replay {
                 continue;
             }
             let from = path.from[i];
-            let start_excess = if self.started {
+            let start_excess = if started {
                 (lo - from).max(from - hi).max(0.0)
             } else {
                 0.0
@@ -384,13 +403,15 @@ impl Replay {
             .sqrt()
     }
 
-    /// The replayed tool point and axis against the CL: at the block's end,
-    /// and for a feed block at points inside it.
-    fn compare(&mut self, path: &BlockPath, at: &At, rapid: bool) {
+    /// The replayed tool point and axis of a feed block against the CL: at
+    /// the block's end, and inside it when its start is known (`started`).
+    fn compare(&mut self, path: &BlockPath, at: &At, started: bool) {
         let end = self.kin.fk(&path.to[..self.n]);
-        let pieces = match (&self.pose, rapid || !self.started) {
-            (Some((p0, _)), false) => self.pieces(path, &(end.point - p0).norm()),
-            _ => 1,
+        let pieces = if started {
+            let start = self.kin.fk(&path.from[..self.n]);
+            self.pieces(path, &(end.point - start.point).norm())
+        } else {
+            1
         };
         let mut q = [0.0; MAX_AXES];
         let Some((cl, cmp)) = &mut self.cl else {
@@ -417,7 +438,6 @@ impl Replay {
                 raise(&mut cmp.axis_at_block_ends, m.axis_rad, &dev);
             }
         }
-        self.pose = Some((end.point, end.axis));
     }
 
     /// How many pieces a feed block is sampled in for the CL comparison:
