@@ -111,7 +111,8 @@ impl Replay {
         let mut q = [0.0; MAX_AXES];
         let start = start_joints(machine, options);
         q[..n].copy_from_slice(&start[..n]);
-        let known = sim
+        // (The machine file's locked axes: a program need not write them.)
+        let known = machine
             .axes
             .iter()
             .enumerate()
