@@ -314,21 +314,23 @@ impl Replay {
             } else {
                 [path.to[i], path.to[i]]
             };
-            let (below, above) = (lo - min, max - hi);
-            let excess = below.max(above);
-            if excess <= tolerance::TRAVEL_MM_OR_DEG {
-                continue;
-            }
+            // Each side on its own, less what the start already exceeded
+            // it by (0 for a start not known).
             let from = path.from[i];
-            let start_excess = if started {
-                (lo - from).max(from - hi).max(0.0)
+            let (start_below, start_above) = if started {
+                ((lo - from).max(0.0), (from - hi).max(0.0))
             } else {
-                0.0
+                (0.0, 0.0)
             };
-            if excess <= start_excess + tolerance::TRAVEL_MM_OR_DEG {
-                continue;
-            }
-            let value = if below >= above { min } else { max };
+            let t = tolerance::TRAVEL_MM_OR_DEG;
+            let below = (lo - min > t && lo - min > start_below + t).then_some(lo - min);
+            let above = (max - hi > t && max - hi > start_above + t).then_some(max - hi);
+            let (value, excess) = match (below, above) {
+                (None, None) => continue,
+                (Some(b), Some(a)) if b >= a => (min, b),
+                (Some(b), None) => (min, b),
+                (_, Some(a)) => (max, a),
+            };
             let a = &self.axes[i];
             self.report.overtravel.push(Overtravel {
                 at: at.clone(),
