@@ -92,6 +92,18 @@ impl Worlds {
                         found.push((c.contact, ta + c.fraction * (tb - ta)));
                     }
                 }
+                // The sweep stops at the first pose within the clearance:
+                // the block's end may be nearer (a move that stops short).
+                if !found.is_empty() {
+                    for end in world.check_pose(&path.to[..n], motion) {
+                        if let Some((c, _)) = found.iter_mut().find(|(c, _)| c.indices == end.indices)
+                            && end.distance_mm < c.distance_mm
+                        {
+                            c.distance_mm = end.distance_mm;
+                            c.penetration_mm = deeper(c.penetration_mm, end.penetration_mm);
+                        }
+                    }
+                }
             } else {
                 for c in world.check_pose(&path.to[..n], motion) {
                     found.push((c, 1.0));
@@ -120,10 +132,7 @@ impl Worlds {
             if e.last_block + 1 >= at.block {
                 e.last_block = at.block;
                 e.distance_mm = e.distance_mm.min(c.distance_mm);
-                e.penetration_mm = match (e.penetration_mm, c.penetration_mm) {
-                    (Some(a), Some(b)) => Some(a.max(b)),
-                    (a, b) => a.or(b),
-                };
+                e.penetration_mm = deeper(e.penetration_mm, c.penetration_mm);
                 return;
             }
         }
@@ -147,5 +156,13 @@ impl Worlds {
     /// The collisions (errors) and near misses (warnings) found.
     pub fn into_contacts(self) -> (Vec<Contact>, Vec<Contact>) {
         (self.collisions, self.near)
+    }
+}
+
+/// The deeper of two overlaps, where computed.
+fn deeper(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
     }
 }
