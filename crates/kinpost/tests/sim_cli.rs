@@ -97,7 +97,10 @@ fn clean_program_exits_0_and_errors_keep_their_codes() {
     assert_exit(&o, 1);
     assert!(stderr(&o).contains("bad.ngc:3"), "{}", stderr(&o));
     // A bad option value is 2.
-    let o = run_in(&dir, &["sim", "ok.ngc", "-m", "trunnion-ac", "--input", "X"]);
+    let o = run_in(
+        &dir,
+        &["sim", "ok.ngc", "-m", "trunnion-ac", "--input", "X"],
+    );
     assert_exit(&o, 2);
     // An extension that names no language: the machine's dialect reads it.
     std::fs::write(dir.join("ok.txt"), "G0 X0\n").unwrap();
@@ -132,7 +135,14 @@ fn outputs_are_all_or_nothing() {
     let o = run_in(
         &dir,
         &[
-            "sim", "bad.ngc", "-m", "trunnion-ac", "--json", "r.json", "--blocks", "b.csv",
+            "sim",
+            "bad.ngc",
+            "-m",
+            "trunnion-ac",
+            "--json",
+            "r.json",
+            "--blocks",
+            "b.csv",
         ],
     );
     assert_exit(&o, 1);

@@ -40,8 +40,10 @@ fn bench(c: &mut Criterion) {
         collisions: false,
         ..SimOptions::default()
     };
-    let mut interp = Options::default();
-    interp.start = Some(m.home_joints());
+    let interp = Options {
+        start: Some(m.home_joints()),
+        ..Options::default()
+    };
     let (steps, report) = read_all(&text, Family::LinuxCnc, &axes, &interp, "bench.ngc").unwrap();
     let moves = report.moves;
     let mut g = c.benchmark_group("replay");
@@ -58,8 +60,16 @@ fn bench(c: &mut Criterion) {
     g.bench_function("simulate_with_interpreter", |b| {
         b.iter(|| {
             black_box(
-                simulate(&text, Family::LinuxCnc, "bench.ngc", &m, &options, None, &mut |_| {})
-                    .unwrap(),
+                simulate(
+                    &text,
+                    Family::LinuxCnc,
+                    "bench.ngc",
+                    &m,
+                    &options,
+                    None,
+                    &mut |_| {},
+                )
+                .unwrap(),
             )
         })
     });

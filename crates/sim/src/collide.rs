@@ -96,7 +96,8 @@ impl Worlds {
                 // the block's end may be nearer (a move that stops short).
                 if !found.is_empty() {
                     for end in world.check_pose(&path.to[..n], motion) {
-                        if let Some((c, _)) = found.iter_mut().find(|(c, _)| c.indices == end.indices)
+                        if let Some((c, _)) =
+                            found.iter_mut().find(|(c, _)| c.indices == end.indices)
                             && end.distance_mm < c.distance_mm
                         {
                             c.distance_mm = end.distance_mm;

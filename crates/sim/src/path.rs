@@ -146,29 +146,29 @@ impl BlockPath {
             return;
         }
         match &self.shape {
-            Shape::Joint => {
-                for i in 0..self.n {
-                    q[i] = self.from[i] + t * (self.to[i] - self.from[i]);
-                }
-            }
+            Shape::Joint => self.lerp(t, q),
             Shape::Rapid { reach } => {
-                for i in 0..self.n {
-                    let f = if reach[i] <= 0.0 {
-                        1.0
-                    } else {
-                        (t / reach[i]).min(1.0)
-                    };
-                    q[i] = self.from[i] + f * (self.to[i] - self.from[i]);
+                let ends = self.from.iter().zip(&self.to).zip(reach);
+                for (q, ((a, b), r)) in q[..self.n].iter_mut().zip(ends) {
+                    let f = if *r <= 0.0 { 1.0 } else { (t / r).min(1.0) };
+                    *q = a + f * (b - a);
                 }
             }
             Shape::Arc(arc) => {
-                for i in 0..self.n {
-                    q[i] = self.from[i] + t * (self.to[i] - self.from[i]);
-                }
+                self.lerp(t, q);
                 let [u, v] = arc.at(t);
                 q[arc.axes[0]] = u;
                 q[arc.axes[1]] = v;
             }
+        }
+    }
+
+    /// Every axis linear from `from` to `to`, at `t`.
+    #[inline]
+    fn lerp(&self, t: f64, q: &mut [f64]) {
+        let ends = self.from.iter().zip(&self.to);
+        for (q, (a, b)) in q[..self.n].iter_mut().zip(ends) {
+            *q = a + t * (b - a);
         }
     }
 

@@ -247,7 +247,11 @@ impl Replay {
     fn block_path(&self, m: &Move, line: usize) -> Result<BlockPath, SimError> {
         let n = self.n;
         let mut to = self.q;
-        let (end, travel, off) = (m.end.as_slice(), m.travel.as_slice(), m.state.offset.as_slice());
+        let (end, travel, off) = (
+            m.end.as_slice(),
+            m.travel.as_slice(),
+            m.state.offset.as_slice(),
+        );
         for i in 0..n {
             to[i] = if self.axes[i].endless {
                 self.q[i] + travel[i] + (off[i] - self.offset[i])
@@ -422,7 +426,7 @@ impl Replay {
         };
         for k in 1..=pieces {
             let pose = if k == pieces {
-                end.clone()
+                end
             } else {
                 path.at(k as f64 / pieces as f64, &mut q);
                 self.kin.fk(&q[..self.n])

@@ -18,8 +18,16 @@ fn run(text: &str, m: &Machine) -> SimReport {
         collisions: false,
         ..SimOptions::default()
     };
-    simulate(text, Family::LinuxCnc, "t.ngc", m, &options, None, &mut |_| {})
-        .unwrap_or_else(|e| panic!("{e}"))
+    simulate(
+        text,
+        Family::LinuxCnc,
+        "t.ngc",
+        m,
+        &options,
+        None,
+        &mut |_| {},
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// trunnion-ac: Y travel ±250, A −30..120 (its machine file).
@@ -139,7 +147,11 @@ M2
     // Dwell 1.5 s. Half circle of radius 20 (62.83 mm) at 1000 mm/min:
     // 3.7699 s. A 90° alone at 900 degrees/min: 6 s.
     let want = 0.6 + 5.0 + 30.0 + 0.6 + 1.5 + 20.0 * std::f64::consts::PI / 1000.0 * 60.0 + 6.0;
-    assert!((r.duration_s - want).abs() < 1e-9, "{} {want}", r.duration_s);
+    assert!(
+        (r.duration_s - want).abs() < 1e-9,
+        "{} {want}",
+        r.duration_s
+    );
     assert!(r.assumed.iter().any(|a| a.contains("10000 mm/min")));
     assert!(r.overtravel.is_empty(), "{:?}", r.overtravel);
 }

@@ -52,8 +52,18 @@ fn a_rapid_through_the_fixture_is_a_collision_at_its_block() {
     // Every collision starts in line 3, the rapid that goes in; the one
     // back out (line 4) is the same contact, not a new one.
     assert!(!r.collisions.is_empty());
-    assert!(r.collisions.iter().all(|c| c.at.line == 3 && c.last_block == 3), "{:?}", r.collisions);
-    assert!(r.collisions.iter().any(|c| names(c) == ["wheel", "right-upper-jaw"] && c.kind == "collision"));
+    assert!(
+        r.collisions
+            .iter()
+            .all(|c| c.at.line == 3 && c.last_block == 3),
+        "{:?}",
+        r.collisions
+    );
+    assert!(
+        r.collisions
+            .iter()
+            .any(|c| names(c) == ["wheel", "right-upper-jaw"] && c.kind == "collision")
+    );
     assert!(r.violated());
 }
 
@@ -61,8 +71,11 @@ fn a_rapid_through_the_fixture_is_a_collision_at_its_block() {
 fn tilting_the_wheel_into_the_jaw_is_a_collision_inside_the_block() {
     let r = run(&format!("{START}G1 B10\nG1 B0\nM2\n"));
     assert!(r.overtravel.is_empty());
-    let found: Vec<(usize, [&str; 2], &str)> =
-        r.collisions.iter().map(|c| (c.at.line, names(c), c.kind)).collect();
+    let found: Vec<(usize, [&str; 2], &str)> = r
+        .collisions
+        .iter()
+        .map(|c| (c.at.line, names(c), c.kind))
+        .collect();
     assert_eq!(found, [(3, ["wheel", "left-upper-jaw"], "collision")]);
     let c = &r.collisions[0];
     // It touches between B 0 and B 4.52 (single poses), well before the
@@ -90,8 +103,11 @@ fn stopping_short_inside_the_warning_clearance_is_a_near_miss() {
     // inside the 2 mm warning clearance, outside the 0 mm error clearance.
     let r = run(&format!("{START}G1 B{:.6}\nM2\n", clear - 0.02));
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
-    let found: Vec<(usize, [&str; 2], &str)> =
-        r.near_misses.iter().map(|c| (c.at.line, names(c), c.kind)).collect();
+    let found: Vec<(usize, [&str; 2], &str)> = r
+        .near_misses
+        .iter()
+        .map(|c| (c.at.line, names(c), c.kind))
+        .collect();
     assert_eq!(found, [(3, ["wheel", "left-upper-jaw"], "near_miss")]);
     let d = r.near_misses[0].distance_mm;
     assert!(d > 0.0 && d <= 0.2, "{d}");

@@ -114,7 +114,10 @@ fn posted_programs_replay_onto_their_cl() {
                 "{name}/{dn}: {along} mm along the path\n{:?}",
                 r.cl
             );
-            assert!(r.cl.unwrap().samples > r.blocks, "{name}/{dn}: sampled inside blocks");
+            assert!(
+                r.cl.unwrap().samples > r.blocks,
+                "{name}/{dn}: sampled inside blocks"
+            );
         }
     }
 }
@@ -173,8 +176,7 @@ fn an_axis_word_past_its_limit_is_reported_at_its_line_only() {
             let (text, _) = posted(&m, &d, &cl, DEFAULT_LINTOL_MM);
             let family = Family::of_dialect(&d).unwrap();
             let axes = kinpost_post::axis_specs(&m);
-            let (steps, _) =
-                read_all(&text, family, &axes, &Default::default(), "job").unwrap();
+            let (steps, _) = read_all(&text, family, &axes, &Default::default(), "job").unwrap();
             let lines: Vec<usize> = steps
                 .iter()
                 .filter(|s| matches!(s.event, Event::Move(_)))
@@ -188,7 +190,12 @@ fn an_axis_word_past_its_limit_is_reported_at_its_line_only() {
             rows[target - 1] = if family == Family::Csv {
                 push_column(&rows[0], &rows[target - 1], &axis, pushed)
             } else {
-                push_word(&rows[target - 1], &axis, pushed, family == Family::Heidenhain)
+                push_word(
+                    &rows[target - 1],
+                    &axis,
+                    pushed,
+                    family == Family::Heidenhain,
+                )
             };
             let text = rows.join("\n") + "\n";
             let options = SimOptions {

@@ -46,7 +46,11 @@ fn held_at_the_reference_pressure_the_program_is_on_the_cl() {
     assert!(r.max_axis_error_rad.unwrap() < 1e-9);
     // The inputs are off by default, and the run says so.
     for input in ["$A_IN[5] = 0", "$A_IN[6] = 0"] {
-        assert!(r.assumed.iter().any(|a| a.contains(input)), "{:?}", r.assumed);
+        assert!(
+            r.assumed.iter().any(|a| a.contains(input)),
+            "{:?}",
+            r.assumed
+        );
     }
 }
 
@@ -63,7 +67,10 @@ fn the_pressure_word_moves_the_wheel_off_the_cl() {
     // Every ground point is moved by the offset; its distance from the CL
     // polyline is at most that, and the path does not double back onto
     // itself within a percent of it.
-    assert!(dev <= offset + 0.001 && dev >= 0.99 * offset, "{dev} vs {offset}");
+    assert!(
+        dev <= offset + 0.001 && dev >= 0.99 * offset,
+        "{dev} vs {offset}"
+    );
 }
 
 #[test]
@@ -101,7 +108,11 @@ fn travel_and_run_time_of_the_figure() {
         .map(|w| (w[1].0 - w[0].0).hypot(w[1].1 - w[0].1))
         .sum();
     let want = 640.0 / 15000.0 * 60.0 + 3.0 + (first + along) / 4980.0 * 60.0;
-    assert!((r.duration_s - want).abs() < 1e-9, "{} {want}", r.duration_s);
+    assert!(
+        (r.duration_s - want).abs() < 1e-9,
+        "{} {want}",
+        r.duration_s
+    );
     // Poses before every axis is programmed (X and Y first at line 18) are
     // not known and not checked; from there the wheel grinds clear.
     assert!(r.collisions.is_empty(), "{:?}", r.collisions);
