@@ -140,7 +140,7 @@ impl SimReport {
     pub fn summary(&self) -> String {
         use std::fmt::Write as _;
         let mut s = String::new();
-        for o in &self.overtravel {
+        for o in self.overtravel.iter().take(SUMMARY_LINES) {
             let _ = writeln!(
                 s,
                 "error: line {}{}: {} reaches {} outside its travel [{}, {}] by {:.6}{}",
@@ -158,11 +158,12 @@ impl SimReport {
                 }
             );
         }
-        for (c, what) in self
-            .collisions
-            .iter()
+        more(&mut s, self.overtravel.len(), "overtravel findings");
+        let collisions = self.collisions.iter().take(SUMMARY_LINES);
+        let near = self.near_misses.iter().take(SUMMARY_LINES);
+        for (c, what) in collisions
             .map(|c| (c, "error"))
-            .chain(self.near_misses.iter().map(|c| (c, "warning")))
+            .chain(near.map(|c| (c, "warning")))
         {
             let depth = c
                 .penetration_mm
@@ -185,6 +186,8 @@ impl SimReport {
                 }
             );
         }
+        more(&mut s, self.collisions.len(), "collisions");
+        more(&mut s, self.near_misses.len(), "near misses");
         for a in &self.assumed {
             let _ = writeln!(s, "note: assumed {a}");
         }
@@ -214,6 +217,22 @@ impl SimReport {
             }
         }
         s
+    }
+}
+
+/// Findings of one kind the summary lists line by line; the rest are
+/// counted (the JSON report has them all).
+const SUMMARY_LINES: usize = 20;
+
+/// "… and N more" when `count` findings exceed the summary's lines.
+fn more(s: &mut String, count: usize, what: &str) {
+    use std::fmt::Write as _;
+    if count > SUMMARY_LINES {
+        let _ = writeln!(
+            s,
+            "  … and {} more {what} (--json lists them all)",
+            count - SUMMARY_LINES
+        );
     }
 }
 
