@@ -109,6 +109,8 @@ pub fn sim(args: &SimArgs) -> Result<()> {
             (Some(_), Some(sink)) => Some(BlockTable::new(&names, machine.axes.len(), sink)?),
             _ => None,
         };
+        let bar = progress_bar(args.quiet, &text);
+        let mut count = 0u32;
         let result = simulate(
             &text,
             family,
@@ -120,8 +122,17 @@ pub fn sim(args: &SimArgs) -> Result<()> {
                 if let Some(t) = &mut table {
                     t.step(s);
                 }
+                count = count.wrapping_add(1);
+                if count % 65_536 == 0
+                    && let Some(b) = &bar
+                {
+                    b.set_position(s.line as u64);
+                }
             },
         );
+        if let Some(b) = &bar {
+            b.finish_and_clear();
+        }
         if let Some(e) = table.and_then(|t| t.error) {
             return Err(anyhow::Error::new(e).context("cannot write the block table"));
         }
@@ -143,6 +154,21 @@ pub fn sim(args: &SimArgs) -> Result<()> {
         return Err(anyhow::Error::new(Violated));
     }
     Ok(())
+}
+
+/// A progress bar over the program's lines (the line being run; loops go
+/// back), on a terminal only, never with `--quiet`, for programs large
+/// enough to take a while (8 MiB, as `post`).
+fn progress_bar(quiet: bool, text: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if quiet || !io::stderr().is_terminal() || text.len() < 8 << 20 {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(text.lines().count() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("replaying {wide_bar} line {pos}/{len}").ok()?,
+    );
+    Some(bar)
 }
 
 /// A replay error: a located diagnostic is printed as it is.
