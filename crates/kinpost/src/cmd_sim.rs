@@ -123,7 +123,7 @@ pub fn sim(args: &SimArgs) -> Result<()> {
                     t.step(s);
                 }
                 count = count.wrapping_add(1);
-                if count % 65_536 == 0
+                if count.is_multiple_of(65_536)
                     && let Some(b) = &bar
                 {
                     b.set_position(s.line as u64);
