@@ -78,7 +78,9 @@ pub struct Deviation {
 pub struct ClComparison {
     /// `GOTO`s read from the CL.
     pub cl_points: usize,
-    /// Tool points compared (block ends and points inside feed blocks).
+    /// Tool points compared: the ends of feed blocks and points inside them
+    /// (rapids do not cut and are not compared; their collisions are
+    /// checked).
     pub samples: u64,
     /// Largest distance of a replayed tool point from the CL polyline, mm.
     pub position: Option<Deviation>,
