@@ -3,7 +3,7 @@
 
 use std::io::BufRead;
 
-use kinpost_cl::{ClReader, Move, Next};
+use kinpost_cl::{Circle, ClEvent, ClReader, Move, Next};
 use nalgebra::Vector3;
 
 use crate::SimError;
@@ -13,6 +13,15 @@ use crate::SimError;
 /// forward by about one segment per block; a window keeps a path that comes
 /// back near itself (a zigzag) from matching an earlier or later pass.
 const WINDOW: usize = 64;
+
+/// Chord tolerance of the CL's arcs in the polyline, mm: far below any
+/// output rounding.
+pub const ARC_CHORD_MM: f64 = 1e-5;
+
+/// A CL motion the polyline cannot hold.
+fn not_compared(line: usize, what: &'static str) -> SimError {
+    SimError::ClNotCompared { line, what }
+}
 
 /// One `GOTO`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,30 +53,60 @@ pub struct Measured {
 }
 
 impl ClPath {
-    /// The `GOTO`s of a CL file (other statements are passed over: they do
-    /// not move the tool; a CL without any `GOTO` is an error).
+    /// The path of a CL file: its `GOTO`s, and the arcs of its `CIRCLE`s
+    /// as chords within [`ARC_CHORD_MM`] (the tool axis interpolated
+    /// linearly along them). Other statements do not move the tool; a CL
+    /// without any `GOTO` is an error, and so are the motions the polyline
+    /// cannot hold (`NURBS`, canned cycles): they are not compared.
     pub fn read<R: BufRead>(input: R, file: &str) -> Result<ClPath, SimError> {
         let mut reader = ClReader::new(input, file);
-        let mut points = Vec::new();
+        let mut points: Vec<ClPoint> = Vec::new();
+        let mut circle: Option<(Box<Circle>, usize)> = None;
         let mut m = Move::default();
         loop {
-            match reader.next_move(&mut m).map_err(SimError::Cl)? {
-                Next::Move => points.push(ClPoint {
-                    point: Vector3::from(m.point),
-                    axis: Vector3::from(m.axis),
-                    line: m.line,
-                }),
-                Next::Statement(s) => {
-                    if let kinpost_cl::ClEvent::Goto { point, axis, .. } = s.event {
-                        points.push(ClPoint {
-                            point: Vector3::from(point),
-                            axis: Vector3::from(axis),
-                            line: s.line,
-                        });
+            let (point, axis, line) = match reader.next_move(&mut m).map_err(SimError::Cl)? {
+                Next::Move => (m.point, m.axis, m.line),
+                Next::Statement(s) => match s.event {
+                    ClEvent::Goto { point, axis, .. } => (point, axis, s.line),
+                    ClEvent::Circle(c) => {
+                        circle = Some((c, s.line));
+                        continue;
                     }
-                }
+                    ClEvent::Nurbs(_) => return Err(not_compared(s.line, "a NURBS curve")),
+                    ClEvent::Cycle(_) => return Err(not_compared(s.line, "a canned cycle")),
+                    _ => continue,
+                },
                 Next::End => break,
+            };
+            let goto = ClPoint {
+                point: Vector3::from(point),
+                axis: Vector3::from(axis),
+                line,
+            };
+            if let (Some((c, circle_line)), Some(prev)) = (circle.take(), points.last().copied()) {
+                let arc = c
+                    .arc(prev.point.into(), point)
+                    .map_err(|source| SimError::ClArc {
+                        line: circle_line,
+                        source,
+                    })?;
+                let samples =
+                    arc.sample(ARC_CHORD_MM)
+                        .map_err(|source| SimError::ClArcSampling {
+                            line: circle_line,
+                            source,
+                        })?;
+                let n = samples.len();
+                for (k, p) in samples.iter().enumerate().take(n.saturating_sub(1)) {
+                    let t = (k + 1) as f64 / n as f64;
+                    points.push(ClPoint {
+                        point: Vector3::from(*p),
+                        axis: prev.axis + t * (goto.axis - prev.axis),
+                        line: circle_line,
+                    });
+                }
             }
+            points.push(goto);
         }
         ClPath::new(points).ok_or_else(|| SimError::EmptyCl(file.to_string()))
     }

@@ -63,6 +63,34 @@ pub enum SimError {
     /// The CL file cannot be read.
     #[error("{0}")]
     Cl(Diagnostic),
+    /// A `CIRCLE` of the CL that makes no arc from the point before it to
+    /// the `GOTO` after it.
+    #[error("CL line {line}: {source}")]
+    ClArc {
+        /// CL line of the `CIRCLE`.
+        line: usize,
+        /// Why.
+        source: kinpost_cl::ArcError,
+    },
+    /// A `CIRCLE` of the CL too large to sample at the comparison's chord.
+    #[error("CL line {line}: {source}")]
+    ClArcSampling {
+        /// CL line of the `CIRCLE`.
+        line: usize,
+        /// Why.
+        source: kinpost_cl::SampleError,
+    },
+    /// A CL motion the comparison cannot follow (it would compare the
+    /// program with a wrong path).
+    #[error(
+        "CL line {line}: {what}: the comparison with the CL follows GOTOs and CIRCLEs only (run without --cl to check travel and collisions)"
+    )]
+    ClNotCompared {
+        /// CL line.
+        line: usize,
+        /// What the statement is.
+        what: &'static str,
+    },
     /// The CL file has no `GOTO`.
     #[error("the CL file {0} has no GOTO to compare the program with")]
     EmptyCl(String),

@@ -172,3 +172,59 @@ fn a_locked_axis_moved_by_the_program_is_past_its_travel() {
         .collect();
     assert_eq!(found, [(3, "A", [0.0, 0.0])]);
 }
+
+/// The CL's arcs are arcs in the comparison: a program that cuts the
+/// quarter circle with G3 lies on it; one that cuts its chord with G1 is
+/// off it by the sagitta r (1 − cos 45°) at the middle.
+#[test]
+fn cl_arcs_are_compared_as_arcs() {
+    use kinpost_machine::Kinematics;
+    use kinpost_sim::ClPath;
+    let m = trunnion();
+    let kin = Kinematics::new(&m);
+    // At A0 C0 the part frame is the machine's moved by b: X Y Z move the
+    // tool point by themselves (checked).
+    let b = kin.fk(&[0.0; 5]).point;
+    let x1 = kin.fk(&[1.0, 0.0, 0.0, 0.0, 0.0]).point - b;
+    let y1 = kin.fk(&[0.0, 1.0, 0.0, 0.0, 0.0]).point - b;
+    assert!(
+        (x1 - nalgebra::Vector3::x()).norm() < 1e-12
+            && (y1 - nalgebra::Vector3::y()).norm() < 1e-12
+    );
+    let cl = format!(
+        "GOTO/{:.6},{:.6},{:.6},0,0,1\nCIRCLE/{:.6},{:.6},{:.6},0,0,1,10\nGOTO/{:.6},{:.6},{:.6},0,0,1\n",
+        b.x + 10.0,
+        b.y,
+        b.z,
+        b.x,
+        b.y,
+        b.z,
+        b.x,
+        b.y + 10.0,
+        b.z
+    );
+    let options = SimOptions {
+        collisions: false,
+        ..SimOptions::default()
+    };
+    let dev = |program: &str| {
+        let path = ClPath::read(cl.as_bytes(), "arc.cls").unwrap();
+        simulate(
+            program,
+            Family::LinuxCnc,
+            "a.ngc",
+            &m,
+            &options,
+            Some(path),
+            &mut |_| {},
+        )
+        .unwrap()
+        .max_position_error_mm
+        .unwrap()
+    };
+    let on_arc = dev("G21 G90 G17\nG0 X10 Y0 Z0 A0 C0\nG3 X0 Y10 I-10 J0 F500\nM2\n");
+    assert!(on_arc < 1e-4, "{on_arc}");
+    let chord = dev("G21 G90 G17\nG0 X10 Y0 Z0 A0 C0\nG1 X0 Y10 F500\nM2\n");
+    let sagitta = 10.0 * (1.0 - std::f64::consts::FRAC_1_SQRT_2);
+    assert!((chord - sagitta).abs() < 1e-4, "{chord} vs {sagitta}");
+}
