@@ -1,7 +1,8 @@
 //! kinpost's virtual machine: an NC program, read by the interpreter of its
 //! controller family (`kinpost_nc::interp`), replayed through the machine
-//! file's kinematics as a controller without tool-centre-point control
-//! moves it, and checked as Qiao et al. 2022 (§4), Qi (thesis, §4.1) and
+//! file's kinematics as the controller moves it (joint-linear without
+//! tool-centre-point control; under it the tool point along the programmed
+//! line or arc, the linear axes solved at every sample), and checked as Qiao et al. 2022 (§4), Qi (thesis, §4.1) and
 //! Zhang et al. (impeller) check their programs in VERICUT before they reach
 //! the machine:
 //!
@@ -97,13 +98,21 @@ pub enum SimError {
     /// The machine's solids cannot be built.
     #[error("the machine's solids: {0}")]
     Solids(#[from] kinpost_collide::BuildError),
-    /// A block under tool-centre-point control: its axis words are a tool
-    /// point, which the replay would have to solve with the inverse
-    /// kinematics; it replays joint programs only.
+    /// A block under tool-centre-point control on a machine without
+    /// linear X, Y and Z axes to move the tool point.
     #[error(
-        "line {line}: tool-centre-point control is on (TRAORI, G43.4, M128, …): the replay takes joint programs (axis values) only; post with joint output to replay"
+        "line {line}: tool-centre-point control is on (TRAORI, G43.4, M128, …), but the machine has no free linear X, Y and Z axes to move the tool point"
     )]
-    Tcp {
+    TcpAxes {
+        /// NC line.
+        line: usize,
+    },
+    /// A tool point under tool-centre-point control that the linear axes
+    /// cannot reach at the block's rotary values (they do not span space).
+    #[error(
+        "line {line}: under tool-centre-point control the linear axes cannot put the tool point where the block asks at its rotary values"
+    )]
+    TcpUnsolvable {
         /// NC line.
         line: usize,
     },
@@ -127,6 +136,10 @@ impl SimError {
         }
     }
 }
+
+/// The M-codes that switch tool-centre-point control on and off in a
+/// LinuxCNC program when the options give none (`Options::tcp_mcodes`).
+pub const LINUXCNC_TCP_MCODES: (u32, u32) = (428, 429);
 
 /// Options of a replay.
 #[derive(Debug, Clone, PartialEq)]
@@ -173,6 +186,14 @@ pub fn simulate(
         start.resize(axes.len(), 0.0);
         options.interp.start = Some(start);
     }
+    // LinuxCNC has no TCP G-code of its own: its 5-axis sample
+    // configurations remap M428/M429, and kinpost's linuxcnc dialect writes
+    // them.
+    let remapped_tcp = family == Family::LinuxCnc && options.interp.tcp_mcodes.is_none();
+    if remapped_tcp {
+        options.interp.tcp_mcodes = Some(LINUXCNC_TCP_MCODES);
+    }
+    let mut tcp_seen = false;
     let mut replay = Replay::new(machine, &options, cl)?;
     let report = interp::run(
         text,
@@ -181,10 +202,17 @@ pub fn simulate(
         &options.interp,
         file,
         &mut |s: &Step| {
+            tcp_seen |= s.event == interp::Event::Tcp(true);
             on_step(s);
             replay.step(s);
         },
     )
     .map_err(SimError::Program)?;
-    replay.finish(&report)
+    let mut report = replay.finish(&report)?;
+    if remapped_tcp && tcp_seen {
+        report.assumed.push(
+            "M428 switches tool-centre-point control on and M429 off (the remap of LinuxCNC's 5-axis sample configurations, which kinpost's linuxcnc dialect writes)".to_string(),
+        );
+    }
+    Ok(report)
 }

@@ -9,6 +9,8 @@ use crate::path::{ArcPath, BlockPath, Joints, Shape, plane_axes};
 use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport};
 use crate::{SimError, SimOptions, tolerance};
 
+mod tcp;
+
 /// What the replay knows of one axis.
 #[derive(Debug, Clone)]
 struct AxisInfo {
@@ -211,10 +213,13 @@ impl Replay {
             number: step.number,
         };
         if m.state.tcp {
-            self.error = Some(SimError::Tcp { line: step.line });
+            if let Err(e) = self.tcp_motion(step, m, &at) {
+                self.error = Some(e);
+            }
             return;
         }
-        let path = match self.block_path(m, step.line) {
+        let from = self.q;
+        let path = match self.block_path(m, step.line, &from) {
             Ok(p) => p,
             Err(e) => {
                 self.error = Some(e);
@@ -224,7 +229,7 @@ impl Replay {
         let known_before = self.known;
         self.known |= m.programmed & self.all;
         self.check_travel(&path, &at, known_before);
-        self.report.duration_s += self.block_time_s(m, &path);
+        self.report.duration_s += self.block_time_s(m, &path, &path);
         let rapid = m.kind == MotionKind::Rapid;
         let started = known_before == self.all;
         if self.known == self.all {
@@ -243,10 +248,11 @@ impl Replay {
         self.offset[..self.n].copy_from_slice(&m.state.offset.as_slice()[..self.n]);
     }
 
-    /// The joints the block ends at and how it gets there.
-    fn block_path(&self, m: &Move, line: usize) -> Result<BlockPath, SimError> {
+    /// The values the block ends at and how it gets there from `from` (the
+    /// joints; under TCP the tool point in place of X Y Z).
+    fn block_path(&self, m: &Move, line: usize, from: &Joints) -> Result<BlockPath, SimError> {
         let n = self.n;
-        let mut to = self.q;
+        let mut to = *from;
         let (end, travel, off) = (
             m.end.as_slice(),
             m.travel.as_slice(),
@@ -254,7 +260,7 @@ impl Replay {
         );
         for i in 0..n {
             to[i] = if self.axes[i].endless {
-                self.q[i] + travel[i] + (off[i] - self.offset[i])
+                from[i] + travel[i] + (off[i] - self.offset[i])
             } else {
                 end[i] + off[i]
             };
@@ -265,7 +271,7 @@ impl Replay {
                 let mut reach = [0.0; MAX_AXES];
                 let mut longest: f64 = 0.0;
                 for i in 0..n {
-                    reach[i] = (to[i] - self.q[i]).abs() / self.axes[i].rapid_per_min;
+                    reach[i] = (to[i] - from[i]).abs() / self.axes[i].rapid_per_min;
                     longest = longest.max(reach[i]);
                 }
                 if longest > 0.0 {
@@ -284,7 +290,7 @@ impl Replay {
                 Shape::Arc(ArcPath::new(
                     axes,
                     centre,
-                    &self.q,
+                    from,
                     &to,
                     a.sweep_deg,
                     a.clockwise,
@@ -293,7 +299,7 @@ impl Replay {
         };
         Ok(BlockPath {
             n,
-            from: self.q,
+            from: *from,
             to,
             shape,
         })
@@ -306,21 +312,37 @@ impl Replay {
     /// block took it there) and comes back is not.
     fn check_travel(&mut self, path: &BlockPath, at: &At, known_before: u32) {
         for i in 0..self.n {
-            let Some([lo, hi]) = self.axes[i].travel else {
-                continue;
-            };
-            let started = known_before & (1 << i) != 0;
-            if !started && self.known & (1 << i) == 0 {
-                continue;
-            }
-            let [min, max] = if started {
+            let range = if known_before & (1 << i) != 0 {
                 path.range(i, &mut self.scratch)
             } else {
                 [path.to[i], path.to[i]]
             };
+            self.charge_travel(i, range, [path.from[i], path.to[i]], at, known_before);
+        }
+    }
+
+    /// Axis `i`, which takes the values `range` in a block from `ends[0]`
+    /// to `ends[1]`, against its travel (see [`Replay::check_travel`]).
+    fn charge_travel(
+        &mut self,
+        i: usize,
+        range: [f64; 2],
+        ends: [f64; 2],
+        at: &At,
+        known_before: u32,
+    ) {
+        {
+            let Some([lo, hi]) = self.axes[i].travel else {
+                return;
+            };
+            let started = known_before & (1 << i) != 0;
+            if !started && self.known & (1 << i) == 0 {
+                return;
+            }
+            let [min, max] = range;
             // Each side on its own, less what the start already exceeded
             // it by (0 for a start not known).
-            let from = path.from[i];
+            let from = ends[0];
             let (start_below, start_above) = if started {
                 ((lo - from).max(0.0), (from - hi).max(0.0))
             } else {
@@ -330,7 +352,7 @@ impl Replay {
             let below = (lo - min > t && lo - min > start_below + t).then_some(lo - min);
             let above = (max - hi > t && max - hi > start_above + t).then_some(max - hi);
             let (value, excess) = match (below, above) {
-                (None, None) => continue,
+                (None, None) => return,
                 (Some(b), Some(a)) if b >= a => (min, b),
                 (Some(b), None) => (min, b),
                 (_, Some(a)) => (max, a),
@@ -342,17 +364,19 @@ impl Replay {
                 value: value + a.machine_offset,
                 limits: [lo + a.machine_offset, hi + a.machine_offset],
                 excess,
-                between_ends: (value - path.to[i]).abs() > tolerance::TRAVEL_MM_OR_DEG,
+                between_ends: (value - ends[1]).abs() > tolerance::TRAVEL_MM_OR_DEG,
             });
         }
     }
 
-    /// The block's time, seconds: the feed's, or each axis at its rapid
-    /// rate, and never faster than an axis' `max_velocity`.
-    fn block_time_s(&mut self, m: &Move, path: &BlockPath) -> f64 {
+    /// The block's time, seconds: the feed's along `programmed` (the
+    /// tool point's path under TCP), or each axis at its rapid rate, and
+    /// never faster than an axis' `max_velocity` allows for the joints'
+    /// change in `joints`.
+    fn block_time_s(&mut self, m: &Move, programmed: &BlockPath, joints: &BlockPath) -> f64 {
         let mut slowest_min: f64 = 0.0;
         for i in 0..self.n {
-            let d = (path.to[i] - path.from[i]).abs();
+            let d = (joints.to[i] - joints.from[i]).abs();
             let rate = match m.kind {
                 MotionKind::Rapid => Some(self.axes[i].rapid_per_min),
                 _ => self.axes[i].max_velocity,
@@ -364,7 +388,7 @@ impl Replay {
         if m.kind == MotionKind::Rapid {
             return slowest_min * 60.0;
         }
-        let length = self.feed_length(m, path);
+        let length = self.feed_length(m, programmed);
         let feed_min = match m.feed_mode {
             FeedMode::PerMinute => (m.feed > 0.0).then(|| length / m.feed),
             FeedMode::InverseTime => (m.feed > 0.0).then(|| 1.0 / m.feed),
@@ -421,9 +445,6 @@ impl Replay {
             1
         };
         let mut q = [0.0; MAX_AXES];
-        let Some((cl, cmp)) = &mut self.cl else {
-            return;
-        };
         for k in 1..=pieces {
             let pose = if k == pieces {
                 end
@@ -431,19 +452,27 @@ impl Replay {
                 path.at(k as f64 / pieces as f64, &mut q);
                 self.kin.fk(&q[..self.n])
             };
-            let m = cl.measure(&pose.point, &pose.axis);
-            cmp.samples += 1;
-            let dev = |value: f64| Deviation {
-                at: at.clone(),
-                cl_line: m.cl_line,
-                value,
-            };
-            raise(&mut cmp.position, m.position_mm, &dev);
-            raise(&mut cmp.axis, m.axis_rad, &dev);
-            if k == pieces {
-                raise(&mut cmp.position_at_block_ends, m.position_mm, &dev);
-                raise(&mut cmp.axis_at_block_ends, m.axis_rad, &dev);
-            }
+            self.measure(&pose, at, k == pieces);
+        }
+    }
+
+    /// One replayed pose against the CL (`end`: a block's end).
+    fn measure(&mut self, pose: &kinpost_machine::Pose, at: &At, end: bool) {
+        let Some((cl, cmp)) = &mut self.cl else {
+            return;
+        };
+        let m = cl.measure(&pose.point, &pose.axis);
+        cmp.samples += 1;
+        let dev = |value: f64| Deviation {
+            at: at.clone(),
+            cl_line: m.cl_line,
+            value,
+        };
+        raise(&mut cmp.position, m.position_mm, &dev);
+        raise(&mut cmp.axis, m.axis_rad, &dev);
+        if end {
+            raise(&mut cmp.position_at_block_ends, m.position_mm, &dev);
+            raise(&mut cmp.axis_at_block_ends, m.axis_rad, &dev);
         }
     }
 

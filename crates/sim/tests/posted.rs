@@ -216,3 +216,49 @@ fn an_axis_word_past_its_limit_is_reported_at_its_line_only() {
         }
     }
 }
+
+/// Tool-centre-point output (X Y Z the tool point; the controller solves
+/// the linear axes): replayed by solving them the same way, the program
+/// lies on its CL within the output rounding, at the block ends and
+/// between them (the tool point moves straight, as the CL's). The csv
+/// table has no TCP switch and is left out.
+#[test]
+fn tcp_programs_replay_onto_their_cl() {
+    for name in builtin::names() {
+        let m = builtin::load(name).unwrap().unwrap();
+        let cl = job(&m);
+        for dn in Dialect::builtin_names().iter().filter(|d| **d != "csv") {
+            let d = Dialect::builtin(dn).unwrap();
+            let mut out = Vec::new();
+            let options = PostOptions {
+                output: Some(kinpost_machine::OutputMode::Tcp),
+                ..PostOptions::default()
+            };
+            let summary = post(cl.as_bytes(), &m, &d, &mut out, &options)
+                .unwrap_or_else(|e| panic!("{name}/{dn}: {e}"));
+            let text = String::from_utf8(out).unwrap();
+            let family = Family::of_dialect(&d).unwrap();
+            let path = ClPath::read(cl.as_bytes(), "job.cls").unwrap();
+            let sim = SimOptions {
+                collisions: false,
+                ..SimOptions::default()
+            };
+            let r = simulate(&text, family, "job", &m, &sim, Some(path), &mut |_| {})
+                .unwrap_or_else(|e| panic!("{name}/{dn}: {e}\n{text}"));
+            let cmp = r.cl.as_ref().unwrap();
+            let ends = cmp.position_at_block_ends.as_ref().unwrap().value;
+            let along = cmp.position.as_ref().unwrap().value;
+            let axis = cmp.axis_at_block_ends.as_ref().unwrap().value;
+            // X Y Z are written with the output's decimals: half a unit in
+            // each, on top of the closed-loop tolerance.
+            let rounding = summary.tolerance_mm + 1e-3;
+            assert!(ends <= rounding, "{name}/{dn}: {ends} mm\n{cmp:?}\n{text}");
+            assert!(along <= rounding, "{name}/{dn}: {along} mm along\n{cmp:?}");
+            assert!(
+                axis <= summary.tolerance_rad + 1e-8,
+                "{name}/{dn}: {axis} rad"
+            );
+            assert!(r.overtravel.is_empty(), "{name}/{dn}: {:?}", r.overtravel);
+        }
+    }
+}
