@@ -19,7 +19,7 @@ fn word() -> impl Strategy<Value = String> {
     ]);
     let code = prop::sample::select(vec![
         "G0", "G1", "G2", "G3", "G17", "G18", "G19", "G90", "G91", "G93", "G94", "G95", "G4 P0.5",
-        "M3", "M5", "G20", "G21",
+        "M3", "M5", "G20", "G21", "TRAORI", "TRAFOOF", "M428", "M429",
     ]);
     prop_oneof![
         (letter, value).prop_map(|(l, v)| format!("{l}{v:.4}")),
