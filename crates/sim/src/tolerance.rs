@@ -36,3 +36,13 @@ pub const SAMPLE_CHORD_MM: f64 = 1e-3;
 /// Most points compared inside one block (a block of several metres or
 /// full turns is still sampled every few millimetres or less).
 pub const MAX_SAMPLES_PER_BLOCK: usize = 100_000;
+
+/// Largest change of a rotary axis over one chord of a block under
+/// tool-centre-point control in the collision check, degrees: the
+/// joint-linear chord leaves the controller's path by about L·θ²/8, under
+/// 0.02 mm for a lever L of half a metre.
+pub const TCP_CHORD_DEG: f64 = 1.0;
+
+/// Largest travel of a linear axis over one chord of a block under
+/// tool-centre-point control in the collision check, mm.
+pub const TCP_CHORD_MM: f64 = 10.0;

@@ -12,9 +12,9 @@ use kinpost_nc::interp::{MAX_AXES, MotionKind, Move, Step};
 use nalgebra::{Matrix3, Vector3};
 
 use super::Replay;
-use crate::SimError;
 use crate::path::{BlockPath, Joints, Shape};
 use crate::report::At;
+use crate::{SimError, tolerance};
 
 impl Replay {
     /// A block under tool-centre-point control.
@@ -101,6 +101,7 @@ impl Replay {
                 self.measure(&pose, at, k == pieces);
             }
         }
+        let rotary = self.axes_rotary();
         if let Some(w) = &mut self.worlds {
             let sub = |a: usize, b: usize| BlockPath {
                 n: self.n,
@@ -109,14 +110,26 @@ impl Replay {
                 shape: Shape::Joint,
             };
             if started {
-                for k in 1..=pieces {
-                    w.check(&sub(k - 1, k), at, rapid, true, self.pressure)?;
+                // Chords of the TCP path, each within the collision step.
+                let chords = collision_chords(joints, &rotary);
+                let mut a = 0;
+                for j in 1..=chords {
+                    let b = (j * pieces).div_ceil(chords);
+                    if b > a {
+                        w.check(&sub(a, b), at, rapid, true, self.pressure)?;
+                        a = b;
+                    }
                 }
             } else {
                 w.check(&sub(0, pieces), at, rapid, false, self.pressure)?;
             }
         }
         Ok(())
+    }
+
+    /// Which axes are rotary.
+    fn axes_rotary(&self) -> Vec<bool> {
+        self.axes.iter().map(|a| a.rotary).collect()
     }
 
     /// The machine's X, Y and Z axes (linear, not locked): what the TCP
@@ -158,4 +171,32 @@ impl Replay {
         }
         Some(q)
     }
+}
+
+/// How many joint-linear chords a TCP block sampled at `joints` is checked
+/// for collisions in: each spans at most [`tolerance::TCP_CHORD_DEG`] of any
+/// rotary axis and [`tolerance::TCP_CHORD_MM`] of any linear one.
+fn collision_chords(joints: &[Joints], rotary: &[bool]) -> usize {
+    let (first, last) = (&joints[0], &joints[joints.len() - 1]);
+    let mut k: f64 = 1.0;
+    for (i, &r) in rotary.iter().enumerate() {
+        // (The linear axes curve under TCP: their largest excursion from
+        // the start bounds their travel.)
+        let span = if r {
+            (last[i] - first[i]).abs()
+        } else {
+            joints
+                .iter()
+                .map(|q| (q[i] - first[i]).abs())
+                .fold(0.0, f64::max)
+                * 2.0
+        };
+        let step = if r {
+            tolerance::TCP_CHORD_DEG
+        } else {
+            tolerance::TCP_CHORD_MM
+        };
+        k = k.max((span / step).ceil());
+    }
+    (k as usize).clamp(1, joints.len() - 1)
 }
