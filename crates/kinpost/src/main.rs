@@ -1,6 +1,7 @@
 //! The `kinpost` command: a thin layer over the library.
 //!
-//! Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error.
+//! Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error,
+//! 3 `sim` found overtravel or a collision.
 
 use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
@@ -25,6 +26,7 @@ macro_rules! note {
     }};
 }
 
+mod cmd_sim;
 mod cmd_surface;
 mod cmd_wheel;
 mod output;
@@ -37,7 +39,7 @@ use sinks::{Sink, deliver, open_outputs};
     name = "kinpost",
     version,
     about = "Multi-axis CNC post-processor: CL data to NC code through a machine's kinematic chain, checked in closed loop",
-    after_help = "Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error."
+    after_help = "Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error, 3 `sim` found overtravel or a collision."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -104,6 +106,10 @@ enum Command {
     /// Grinding-pressure axis: input-link angle, wheel offset and axis
     /// correction per pressure, and the wheel-centre trajectory as SVG.
     Wheel(WheelArgs),
+    /// The virtual machine: replay an NC program on a machine, checking
+    /// travel, collisions and (with --cl) the deviation from its CL; exit
+    /// code 3 when anything is violated.
+    Sim(Box<cmd_sim::SimArgs>),
 }
 
 #[derive(clap::Args)]
@@ -322,6 +328,9 @@ fn main() -> ExitCode {
         // quietly, as Unix tools do.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
+            if e.downcast_ref::<cmd_sim::Violated>().is_some() {
+                return ExitCode::from(3);
+            }
             if e.downcast_ref::<Reported>().is_none() {
                 note!("error: {e:#}");
             }
@@ -400,6 +409,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Wheel(args) => wheel(&args),
         Command::Surface(c) => cmd_surface::surface(c),
         Command::Path(a) => cmd_surface::path(*a),
+        Command::Sim(a) => cmd_sim::sim(&a),
     }
 }
 

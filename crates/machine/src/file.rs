@@ -922,6 +922,7 @@ fn check_axis(c: &mut Checker, a: &RawAxis, all: &[RawAxis]) -> (Axis, bool) {
         free_with_reference: false,
         prefer: None,
         max_velocity: None,
+        machine_offset: offset,
     };
     check_axis_options(c, a, &mut axis);
     (axis, direction_ok)

@@ -57,6 +57,7 @@ fn axis(name: &str, kind: AxisKind, side: Side, direction: Vector3<f64>) -> Axis
         wrap: crate::model::Wrap::None,
         prefer: None,
         max_velocity: None,
+        machine_offset: 0.0,
     }
 }
 

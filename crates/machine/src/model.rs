@@ -54,6 +54,9 @@ pub struct Axis {
     /// Largest speed of the axis, mm/min or degrees/min; feed moves that
     /// would need more are slowed down.
     pub max_velocity: Option<f64>,
+    /// The machine file's `machine_offset`: machine coordinate = NC value +
+    /// this (0 when the file gives none; [`Axis::limits`] are NC values).
+    pub machine_offset: f64,
 }
 
 /// How a rotary axis counts its turns.

@@ -59,6 +59,7 @@ fn axis(name: &str, kind: AxisKind, side: Side, direction: Vector3<f64>) -> Axis
         wrap: Wrap::None,
         prefer: None,
         max_velocity: None,
+        machine_offset: 0.0,
     }
 }
 

@@ -1,0 +1,169 @@
+//! Collisions along the replayed path, through `kinpost-collide`: every
+//! block swept (conservative advancement between its ends, in pieces along
+//! which every axis moves one way), the wheel where the program's pressure
+//! puts it.
+
+use std::collections::HashMap;
+
+use kinpost_collide::{ContactKind, Motion, World};
+use kinpost_machine::Machine;
+
+use crate::SimError;
+use crate::path::BlockPath;
+use crate::report::{At, Contact};
+
+/// Worlds at most kept for other pressures (the oldest is dropped beyond).
+const PRESSURE_WORLDS: usize = 8;
+
+/// The machine's worlds: at the reference pressure and at the pressures
+/// the program wrote; the contacts found so far.
+pub(crate) struct Worlds {
+    machine: Machine,
+    reference: World,
+    at_pressure: Vec<(u64, World)>,
+    compensate: bool,
+    collisions: Vec<Contact>,
+    near: Vec<Contact>,
+    /// The last contact of each pair (solid indices, error or not): index
+    /// into `collisions` or `near`.
+    last: HashMap<([usize; 2], bool), usize>,
+    breaks: Vec<f64>,
+}
+
+impl Worlds {
+    /// The worlds of `machine`; `compensate`: the pressure moves the wheel.
+    pub fn new(machine: &Machine, compensate: bool) -> Result<Worlds, SimError> {
+        Ok(Worlds {
+            machine: machine.clone(),
+            reference: World::new(machine)?,
+            at_pressure: Vec::new(),
+            compensate,
+            collisions: Vec::new(),
+            near: Vec::new(),
+            last: HashMap::new(),
+            breaks: Vec::new(),
+        })
+    }
+
+    fn world(&mut self, pressure: f64) -> Result<&World, SimError> {
+        if !self.compensate || pressure.is_nan() || self.machine.pressure.is_none() {
+            return Ok(&self.reference);
+        }
+        let key = pressure.to_bits();
+        let i = match self.at_pressure.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                if self.at_pressure.len() >= PRESSURE_WORLDS {
+                    self.at_pressure.remove(0);
+                }
+                let w = World::new(&self.machine.at_pressure(pressure))?;
+                self.at_pressure.push((key, w));
+                self.at_pressure.len() - 1
+            }
+        };
+        Ok(&self.at_pressure[i].1)
+    }
+
+    /// Checks one block (`started`: it has a known start; else only its
+    /// end pose is checked).
+    pub fn check(
+        &mut self,
+        path: &BlockPath,
+        at: &At,
+        rapid: bool,
+        started: bool,
+        pressure: f64,
+    ) -> Result<(), SimError> {
+        let motion = if rapid { Motion::Rapid } else { Motion::Feed };
+        let n = path.n;
+        let mut found = Vec::new();
+        let mut breaks = std::mem::take(&mut self.breaks);
+        {
+            let world = self.world(pressure)?;
+            if started {
+                path.monotonic_breaks(&mut breaks);
+                for w in breaks.windows(2) {
+                    let (ta, tb) = (w[0], w[1]);
+                    let piece = |t: f64, q: &mut Vec<f64>| {
+                        q.resize(n, 0.0);
+                        path.at(ta + t * (tb - ta), q);
+                    };
+                    for c in world.check_path(&piece, motion) {
+                        found.push((c.contact, ta + c.fraction * (tb - ta)));
+                    }
+                }
+                // The sweep stops at the first pose within the clearance:
+                // the block's end may be nearer (a move that stops short).
+                if !found.is_empty() {
+                    for end in world.check_pose(&path.to[..n], motion) {
+                        if let Some((c, _)) =
+                            found.iter_mut().find(|(c, _)| c.indices == end.indices)
+                            && end.distance_mm < c.distance_mm
+                        {
+                            c.distance_mm = end.distance_mm;
+                            c.penetration_mm = deeper(c.penetration_mm, end.penetration_mm);
+                        }
+                    }
+                }
+            } else {
+                for c in world.check_pose(&path.to[..n], motion) {
+                    found.push((c, 1.0));
+                }
+            }
+        }
+        self.breaks = breaks;
+        for (c, fraction) in found {
+            self.record(c, fraction, at);
+        }
+        Ok(())
+    }
+
+    /// A contact: extends the pair's contact of the previous block, or a
+    /// new one.
+    fn record(&mut self, c: kinpost_collide::Contact, fraction: f64, at: &At) {
+        let error = c.kind.is_error();
+        let list = if error {
+            &mut self.collisions
+        } else {
+            &mut self.near
+        };
+        let key = (c.indices, error);
+        if let Some(&i) = self.last.get(&key) {
+            let e = &mut list[i];
+            if e.last_block + 1 >= at.block {
+                e.last_block = at.block;
+                e.distance_mm = e.distance_mm.min(c.distance_mm);
+                e.penetration_mm = deeper(e.penetration_mm, c.penetration_mm);
+                return;
+            }
+        }
+        self.last.insert(key, list.len());
+        list.push(Contact {
+            at: at.clone(),
+            last_block: at.block,
+            solids: [c.solids[0].to_string(), c.solids[1].to_string()],
+            kind: match c.kind {
+                ContactKind::Collision => "collision",
+                ContactKind::RapidIntoStock => "rapid_into_stock",
+                ContactKind::NearMiss => "near_miss",
+            },
+            distance_mm: c.distance_mm,
+            penetration_mm: c.penetration_mm,
+            fraction,
+            clearances_mm: [c.clearances_mm.0, c.clearances_mm.1],
+        });
+    }
+
+    /// The collisions (errors) and near misses (warnings) found.
+    pub fn into_contacts(self) -> (Vec<Contact>, Vec<Contact>) {
+        (self.collisions, self.near)
+    }
+}
+
+/// The deeper of two overlaps, where computed.
+fn deeper(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    }
+}

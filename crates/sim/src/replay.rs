@@ -1,0 +1,509 @@
+//! The replay: every step of the interpreter through the machine.
+
+use kinpost_machine::{Kinematics, KinematicsAtPressure, Machine};
+use kinpost_nc::interp::{Event, FeedMode, MAX_AXES, MotionKind, Move, Step};
+
+use crate::cl::ClPath;
+use crate::collide::Worlds;
+use crate::path::{ArcPath, BlockPath, Joints, Shape, plane_axes};
+use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport};
+use crate::{SimError, SimOptions, tolerance};
+
+mod tcp;
+
+/// What the replay knows of one axis.
+#[derive(Debug, Clone)]
+struct AxisInfo {
+    name: String,
+    /// Travel in joint values (NC values with the work offset): the
+    /// limits, or the fixed value of a locked axis; `None`: unlimited.
+    travel: Option<[f64; 2]>,
+    machine_offset: f64,
+    /// Turns without end: its value follows the interpreter's travel.
+    endless: bool,
+    rotary: bool,
+    /// Rapid rate, mm/min or degrees/min.
+    rapid_per_min: f64,
+    max_velocity: Option<f64>,
+}
+
+/// A program's replay on a machine, one [`Step`] at a time
+/// ([`Replay::step`]), then [`Replay::finish`].
+pub struct Replay {
+    axes: Vec<AxisInfo>,
+    n: usize,
+    xyz: [Option<usize>; 3],
+    kin: KinematicsAtPressure,
+    q: Joints,
+    offset: Joints,
+    /// Axes whose position is known (bit i): locked axes, and axes a block
+    /// has programmed. The others stand where the program found them,
+    /// which a program excerpt does not say.
+    known: u32,
+    /// All of the machine's axes (bit i for i < n).
+    all: u32,
+    /// Line of the first block after which every axis is known.
+    complete_at: Option<usize>,
+    pressure: f64,
+    report: SimReport,
+    cl: Option<(ClPath, ClComparison)>,
+    worlds: Option<Worlds>,
+    scratch: Vec<f64>,
+    untimed_blocks: u64,
+    error: Option<SimError>,
+}
+
+/// The machine the replay moves: axes locked only without a reference
+/// direction are free (a program may turn them, as 6-axis output does).
+pub(crate) fn sim_machine(machine: &Machine) -> Machine {
+    if machine.unlocks_with_reference() {
+        machine.with_reference_axes_free()
+    } else {
+        machine.clone()
+    }
+}
+
+impl Replay {
+    /// A replay on `machine` (validated), compared with `cl` when given.
+    pub fn new(
+        machine: &Machine,
+        options: &SimOptions,
+        cl: Option<ClPath>,
+    ) -> Result<Replay, SimError> {
+        let sim = sim_machine(machine);
+        let n = sim.axes.len();
+        if n > MAX_AXES {
+            return Err(SimError::TooManyAxes(n));
+        }
+        let mut report = SimReport::default();
+        let mut assumed_rapid = Vec::new();
+        let axes: Vec<AxisInfo> = sim
+            .axes
+            .iter()
+            .map(|a| {
+                let rapid_per_min = a.max_velocity.unwrap_or_else(|| {
+                    assumed_rapid.push(a.name.clone());
+                    if a.is_rotary() {
+                        tolerance::ASSUMED_RAPID_DEG_PER_MIN
+                    } else {
+                        tolerance::ASSUMED_RAPID_MM_PER_MIN
+                    }
+                });
+                AxisInfo {
+                    name: a.name.clone(),
+                    travel: a.fixed.map(|f| [f, f]).or(a.travel()),
+                    machine_offset: a.machine_offset,
+                    endless: a.is_endless(),
+                    rotary: a.is_rotary(),
+                    rapid_per_min,
+                    max_velocity: a.max_velocity,
+                }
+            })
+            .collect();
+        if !assumed_rapid.is_empty() {
+            report.assumed.push(format!(
+                "rapid rates of {} mm/min (linear) and {} degrees/min (rotary) for axes without `max_velocity` in the machine file ({}); rapids move each axis at its own rate; no acceleration is modelled, so the run time is a lower bound",
+                tolerance::ASSUMED_RAPID_MM_PER_MIN,
+                tolerance::ASSUMED_RAPID_DEG_PER_MIN,
+                assumed_rapid.join(" ")
+            ));
+        }
+        let xyz = ["X", "Y", "Z"].map(|l| sim.axis_index(l).filter(|&i| !axes[i].rotary));
+        let kin = KinematicsAtPressure::new(&sim, Kinematics::new(&sim), options.pressure_offset);
+        let mut q = [0.0; MAX_AXES];
+        let start = start_joints(machine, options);
+        q[..n].copy_from_slice(&start[..n]);
+        // (The machine file's locked axes: a program need not write them.)
+        let known = machine
+            .axes
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| a.fixed.is_some())
+            .fold(0u32, |k, (i, _)| k | 1 << i);
+        let worlds = if options.collisions && !sim.solids.is_empty() {
+            Some(Worlds::new(&sim, options.pressure_offset)?)
+        } else {
+            None
+        };
+        let cl = cl.map(|c| {
+            let cmp = ClComparison {
+                cl_points: c.len(),
+                ..ClComparison::default()
+            };
+            (c, cmp)
+        });
+        Ok(Replay {
+            axes,
+            n,
+            xyz,
+            kin,
+            q,
+            offset: [0.0; MAX_AXES],
+            known,
+            all: if n == 32 { u32::MAX } else { (1u32 << n) - 1 },
+            complete_at: None,
+            pressure: f64::NAN,
+            report,
+            cl,
+            worlds,
+            scratch: Vec::new(),
+            untimed_blocks: 0,
+            error: None,
+        })
+    }
+
+    /// One step of the interpreter.
+    pub fn step(&mut self, step: &Step) {
+        if self.error.is_some() {
+            return;
+        }
+        match &step.event {
+            Event::Move(m) => self.motion(step, m),
+            Event::Pressure { value, .. } => {
+                self.pressure = *value;
+                self.kin.select(*value);
+            }
+            Event::Dwell { seconds } => self.report.duration_s += seconds,
+            _ => {}
+        }
+    }
+
+    /// The report, with what the interpreter reported (`interp`).
+    pub fn finish(mut self, interp: &kinpost_nc::interp::Report) -> Result<SimReport, SimError> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let r = &mut self.report;
+        r.executed_blocks = interp.executed_blocks;
+        let mut assumed = interp.assumed.clone();
+        assumed.append(&mut r.assumed);
+        r.assumed = assumed;
+        r.assumed.push(match self.complete_at {
+            Some(line) => format!(
+                "an axis is where the program puts it from its first word on: before that its position is unknown and not checked; collisions and the CL comparison start once every axis is known (line {line})"
+            ),
+            None => "an axis is where the program puts it from its first word on; not every axis was ever programmed, so no pose was checked for collisions or against the CL".to_string(),
+        });
+        if self.untimed_blocks > 0 {
+            r.assumed.push(format!(
+                "{} feed blocks without a feed rate (F0, or G95 without a spindle speed) take the time their axes' velocity limits give (0 without limits)",
+                self.untimed_blocks
+            ));
+        }
+        r.warnings = interp.warnings.iter().map(|w| w.to_string()).collect();
+        if let Some((_, cmp)) = self.cl.take() {
+            r.max_position_error_mm = cmp.position.as_ref().map(|d| d.value);
+            r.max_axis_error_rad = cmp.axis.as_ref().map(|d| d.value);
+            r.cl = Some(cmp);
+        }
+        if let Some(w) = self.worlds.take() {
+            let (collisions, near) = w.into_contacts();
+            r.collisions = collisions;
+            r.near_misses = near;
+        }
+        Ok(self.report)
+    }
+
+    /// A motion block.
+    fn motion(&mut self, step: &Step, m: &Move) {
+        self.report.blocks += 1;
+        let at = At {
+            block: self.report.blocks,
+            line: step.line,
+            number: step.number,
+        };
+        if m.state.tcp {
+            if let Err(e) = self.tcp_motion(step, m, &at) {
+                self.error = Some(e);
+            }
+            return;
+        }
+        let from = self.q;
+        let path = match self.block_path(m, step.line, &from) {
+            Ok(p) => p,
+            Err(e) => {
+                self.error = Some(e);
+                return;
+            }
+        };
+        let known_before = self.known;
+        self.known |= m.programmed & self.all;
+        self.check_travel(&path, &at, known_before);
+        self.report.duration_s += self.block_time_s(m, &path, &path);
+        let rapid = m.kind == MotionKind::Rapid;
+        let started = known_before == self.all;
+        if self.known == self.all {
+            self.complete_at.get_or_insert(step.line);
+            if self.cl.is_some() && !rapid {
+                self.compare(&path, &at, started);
+            }
+            if let Some(w) = &mut self.worlds
+                && let Err(e) = w.check(&path, &at, rapid, started, self.pressure)
+            {
+                self.error = Some(e);
+                return;
+            }
+        }
+        self.q = path.to;
+        self.offset[..self.n].copy_from_slice(&m.state.offset.as_slice()[..self.n]);
+    }
+
+    /// The values the block ends at and how it gets there from `from` (the
+    /// joints; under TCP the tool point in place of X Y Z).
+    fn block_path(&self, m: &Move, line: usize, from: &Joints) -> Result<BlockPath, SimError> {
+        let n = self.n;
+        let mut to = *from;
+        let (end, travel, off) = (
+            m.end.as_slice(),
+            m.travel.as_slice(),
+            m.state.offset.as_slice(),
+        );
+        for i in 0..n {
+            to[i] = if self.axes[i].endless {
+                from[i] + travel[i] + (off[i] - self.offset[i])
+            } else {
+                end[i] + off[i]
+            };
+        }
+        let shape = match &m.kind {
+            MotionKind::Linear => Shape::Joint,
+            MotionKind::Rapid => {
+                let mut reach = [0.0; MAX_AXES];
+                let mut longest: f64 = 0.0;
+                for i in 0..n {
+                    reach[i] = (to[i] - from[i]).abs() / self.axes[i].rapid_per_min;
+                    longest = longest.max(reach[i]);
+                }
+                if longest > 0.0 {
+                    reach.iter_mut().for_each(|r| *r /= longest);
+                }
+                Shape::Rapid { reach }
+            }
+            MotionKind::Arc(a) => {
+                let axes = plane_axes(a.plane, self.xyz).ok_or(SimError::ArcPlane { line })?;
+                // The centre's plane coordinates, in joint values.
+                let xyz_of = |axis: usize| {
+                    let k = self.xyz.iter().position(|x| *x == Some(axis)).unwrap_or(0);
+                    a.centre_mm[k] + off[axis]
+                };
+                let centre = [xyz_of(axes[0]), xyz_of(axes[1])];
+                Shape::Arc(ArcPath::new(
+                    axes,
+                    centre,
+                    from,
+                    &to,
+                    a.sweep_deg,
+                    a.clockwise,
+                ))
+            }
+        };
+        Ok(BlockPath {
+            n,
+            from: *from,
+            to,
+            shape,
+        })
+    }
+
+    /// Every axis against its travel along the block (an axis whose start
+    /// is not known, bit clear in `known_before`: at its end only, once
+    /// programmed). A block is charged with an excess only where it goes
+    /// beyond where it started: a block that starts outside (the previous
+    /// block took it there) and comes back is not.
+    fn check_travel(&mut self, path: &BlockPath, at: &At, known_before: u32) {
+        for i in 0..self.n {
+            let range = if known_before & (1 << i) != 0 {
+                path.range(i, &mut self.scratch)
+            } else {
+                [path.to[i], path.to[i]]
+            };
+            self.charge_travel(i, range, [path.from[i], path.to[i]], at, known_before);
+        }
+    }
+
+    /// Axis `i`, which takes the values `range` in a block from `ends[0]`
+    /// to `ends[1]`, against its travel (see [`Replay::check_travel`]).
+    fn charge_travel(
+        &mut self,
+        i: usize,
+        range: [f64; 2],
+        ends: [f64; 2],
+        at: &At,
+        known_before: u32,
+    ) {
+        {
+            let Some([lo, hi]) = self.axes[i].travel else {
+                return;
+            };
+            let started = known_before & (1 << i) != 0;
+            if !started && self.known & (1 << i) == 0 {
+                return;
+            }
+            let [min, max] = range;
+            // Each side on its own, less what the start already exceeded
+            // it by (0 for a start not known).
+            let from = ends[0];
+            let (start_below, start_above) = if started {
+                ((lo - from).max(0.0), (from - hi).max(0.0))
+            } else {
+                (0.0, 0.0)
+            };
+            let t = tolerance::TRAVEL_MM_OR_DEG;
+            let below = (lo - min > t && lo - min > start_below + t).then_some(lo - min);
+            let above = (max - hi > t && max - hi > start_above + t).then_some(max - hi);
+            let (value, excess) = match (below, above) {
+                (None, None) => return,
+                (Some(b), Some(a)) if b >= a => (min, b),
+                (Some(b), None) => (min, b),
+                (_, Some(a)) => (max, a),
+            };
+            let a = &self.axes[i];
+            self.report.overtravel.push(Overtravel {
+                at: at.clone(),
+                axis: a.name.clone(),
+                value: value + a.machine_offset,
+                limits: [lo + a.machine_offset, hi + a.machine_offset],
+                excess,
+                between_ends: (value - ends[1]).abs() > tolerance::TRAVEL_MM_OR_DEG,
+            });
+        }
+    }
+
+    /// The block's time, seconds: the feed's along `programmed` (the
+    /// tool point's path under TCP), or each axis at its rapid rate, and
+    /// never faster than an axis' `max_velocity` allows for the joints'
+    /// change in `joints`.
+    fn block_time_s(&mut self, m: &Move, programmed: &BlockPath, joints: &BlockPath) -> f64 {
+        let mut slowest_min: f64 = 0.0;
+        for i in 0..self.n {
+            let d = (joints.to[i] - joints.from[i]).abs();
+            let rate = match m.kind {
+                MotionKind::Rapid => Some(self.axes[i].rapid_per_min),
+                _ => self.axes[i].max_velocity,
+            };
+            if let Some(v) = rate {
+                slowest_min = slowest_min.max(d / v);
+            }
+        }
+        if m.kind == MotionKind::Rapid {
+            return slowest_min * 60.0;
+        }
+        let length = self.feed_length(m, programmed);
+        let feed_min = match m.feed_mode {
+            FeedMode::PerMinute => (m.feed > 0.0).then(|| length / m.feed),
+            FeedMode::InverseTime => (m.feed > 0.0).then(|| 1.0 / m.feed),
+            FeedMode::PerRevolution => {
+                let v = m.feed * m.state.spindle_speed;
+                (v > 0.0).then(|| length / v)
+            }
+        };
+        let feed_min = feed_min.unwrap_or_else(|| {
+            if length > 0.0 {
+                self.untimed_blocks += 1;
+            }
+            0.0
+        });
+        feed_min.max(slowest_min) * 60.0
+    }
+
+    /// The length the feed applies to: the X Y Z path (the arc's, helix
+    /// included), or where those stand still, the rotary axes' degrees (as
+    /// rs274 and the Sinumerik take it).
+    fn feed_length(&self, m: &Move, path: &BlockPath) -> f64 {
+        let d = |i: usize| path.to[i] - path.from[i];
+        let linear: f64 = match (&m.kind, &path.shape) {
+            (MotionKind::Arc(a), Shape::Arc(arc)) => {
+                let r = 0.5 * (arc.radius[0] + arc.radius[1]);
+                (r * arc.sweep_rad).hypot(a.helix_mm)
+            }
+            _ => self
+                .xyz
+                .iter()
+                .flatten()
+                .map(|&i| d(i) * d(i))
+                .sum::<f64>()
+                .sqrt(),
+        };
+        if linear > tolerance::STANDSTILL_MM {
+            return linear;
+        }
+        (0..self.n)
+            .filter(|&i| self.axes[i].rotary)
+            .map(|i| d(i) * d(i))
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    /// The replayed tool point and axis of a feed block against the CL: at
+    /// the block's end, and inside it when its start is known (`started`).
+    fn compare(&mut self, path: &BlockPath, at: &At, started: bool) {
+        let end = self.kin.fk(&path.to[..self.n]);
+        let pieces = if started {
+            let start = self.kin.fk(&path.from[..self.n]);
+            self.pieces(path, &(end.point - start.point).norm())
+        } else {
+            1
+        };
+        let mut q = [0.0; MAX_AXES];
+        for k in 1..=pieces {
+            let pose = if k == pieces {
+                end
+            } else {
+                path.at(k as f64 / pieces as f64, &mut q);
+                self.kin.fk(&q[..self.n])
+            };
+            self.measure(&pose, at, k == pieces);
+        }
+    }
+
+    /// One replayed pose against the CL (`end`: a block's end).
+    fn measure(&mut self, pose: &kinpost_machine::Pose, at: &At, end: bool) {
+        let Some((cl, cmp)) = &mut self.cl else {
+            return;
+        };
+        let m = cl.measure(&pose.point, &pose.axis);
+        cmp.samples += 1;
+        let dev = |value: f64| Deviation {
+            at: at.clone(),
+            cl_line: m.cl_line,
+            value,
+        };
+        raise(&mut cmp.position, m.position_mm, &dev);
+        raise(&mut cmp.axis, m.axis_rad, &dev);
+        if end {
+            raise(&mut cmp.position_at_block_ends, m.position_mm, &dev);
+            raise(&mut cmp.axis_at_block_ends, m.axis_rad, &dev);
+        }
+    }
+
+    /// How many pieces a feed block is sampled in for the CL comparison:
+    /// steps of at most [`tolerance::SAMPLE_STEP_MM`] of the tool point
+    /// and [`tolerance::SAMPLE_STEP_DEG`] of any rotary axis, and arcs to a
+    /// chord error of [`tolerance::SAMPLE_CHORD_MM`].
+    fn pieces(&self, path: &BlockPath, tool_travel_mm: &f64) -> usize {
+        let mut k = (tool_travel_mm / tolerance::SAMPLE_STEP_MM).ceil();
+        for i in (0..self.n).filter(|&i| self.axes[i].rotary) {
+            k = k.max(((path.to[i] - path.from[i]).abs() / tolerance::SAMPLE_STEP_DEG).ceil());
+        }
+        if let Shape::Arc(arc) = &path.shape {
+            k = k.max(arc.pieces(tolerance::SAMPLE_CHORD_MM) as f64);
+        }
+        (k as usize).clamp(1, tolerance::MAX_SAMPLES_PER_BLOCK)
+    }
+}
+
+/// `slot` raised to `value` when that is larger.
+fn raise(slot: &mut Option<Deviation>, value: f64, dev: &impl Fn(f64) -> Deviation) {
+    if slot.as_ref().is_none_or(|d| value > d.value) {
+        *slot = Some(dev(value));
+    }
+}
+
+/// Where the machine starts: the interpreter's start (`Options::start`)
+/// or the machine's home (locked axes at their value, the others at 0).
+pub(crate) fn start_joints(machine: &Machine, options: &SimOptions) -> Vec<f64> {
+    match &options.interp.start {
+        Some(s) => s.clone(),
+        None => machine.home_joints(),
+    }
+}

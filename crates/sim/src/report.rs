@@ -1,0 +1,255 @@
+//! What a replay found: the report `kinpost sim` prints and writes as JSON.
+
+use serde::Serialize;
+
+/// Where in the program something happened.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct At {
+    /// 1-based motion block of the run (loops count every pass).
+    pub block: u64,
+    /// 1-based line of the NC program.
+    pub line: usize,
+    /// The block number of that line (`N120`), if it has one.
+    pub number: Option<u64>,
+}
+
+/// An axis beyond its travel in one block.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Overtravel {
+    /// Where.
+    #[serde(flatten)]
+    pub at: At,
+    /// The axis name.
+    pub axis: String,
+    /// The farthest value the axis reaches in the block, machine
+    /// coordinates (the machine file's `machine_offset` applied), mm or
+    /// degrees.
+    pub value: f64,
+    /// The travel in machine coordinates `[min, max]` (a locked axis: its
+    /// fixed value twice).
+    pub limits: [f64; 2],
+    /// How far beyond the limit it goes, mm or degrees (positive).
+    pub excess: f64,
+    /// Whether the largest excess lies inside the block, not at its end
+    /// (an arc that bulges out, a rotary axis passing its limit).
+    pub between_ends: bool,
+}
+
+/// Two solids too close along a stretch of blocks.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Contact {
+    /// The first block where they touch (or come within the clearance).
+    #[serde(flatten)]
+    pub at: At,
+    /// The last block of the stretch (consecutive blocks with the same
+    /// pair are one contact).
+    pub last_block: u64,
+    /// The two solids' names.
+    pub solids: [String; 2],
+    /// `collision`, `rapid_into_stock` or `near_miss`.
+    pub kind: &'static str,
+    /// Their smallest distance found, mm (0 touching or overlapping): at
+    /// the first pose of each block within the clearance and at the block's
+    /// end.
+    pub distance_mm: f64,
+    /// The deepest overlap found, mm, where it is computed.
+    pub penetration_mm: Option<f64>,
+    /// Where in the first block (0 start, 1 end).
+    pub fraction: f64,
+    /// The pair's clearances, mm: warning, error.
+    pub clearances_mm: [f64; 2],
+}
+
+/// The largest deviation from the CL.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Deviation {
+    /// Where in the program.
+    #[serde(flatten)]
+    pub at: At,
+    /// The CL line of the `GOTO` that starts the CL segment it was measured
+    /// against.
+    pub cl_line: usize,
+    /// The deviation: mm for a position, radians for a tool axis.
+    pub value: f64,
+}
+
+/// The comparison of the replayed path with the CL it was posted from.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct ClComparison {
+    /// `GOTO`s read from the CL.
+    pub cl_points: usize,
+    /// Tool points compared: the ends of feed blocks and points inside them
+    /// (rapids do not cut and are not compared; their collisions are
+    /// checked).
+    pub samples: u64,
+    /// Largest distance of a replayed tool point from the CL polyline, mm.
+    pub position: Option<Deviation>,
+    /// Largest angle between a replayed tool axis and the CL's (linearly
+    /// interpolated between its `GOTO`s), radians.
+    pub axis: Option<Deviation>,
+    /// The same, at block ends only (what the output rounding bounds).
+    pub position_at_block_ends: Option<Deviation>,
+    /// The same, at block ends only.
+    pub axis_at_block_ends: Option<Deviation>,
+}
+
+/// What a replay found.
+#[derive(Debug, Clone, PartialEq, Serialize, Default)]
+pub struct SimReport {
+    /// Motion blocks replayed.
+    pub blocks: u64,
+    /// Blocks executed (lines interpreted; loops count every pass).
+    pub executed_blocks: u64,
+    /// Run time, seconds, from the feeds, rapid rates and velocity limits
+    /// (no acceleration: a lower bound of the real time).
+    pub duration_s: f64,
+    /// Axes beyond their travel, block by block.
+    pub overtravel: Vec<Overtravel>,
+    /// Collisions and rapids into stock (errors).
+    pub collisions: Vec<Contact>,
+    /// Pairs within their warning clearance (warnings).
+    pub near_misses: Vec<Contact>,
+    /// Largest position deviation from the CL along the path, mm (with
+    /// `--cl`).
+    pub max_position_error_mm: Option<f64>,
+    /// Largest tool-axis deviation from the CL along the path, radians
+    /// (with `--cl`).
+    pub max_axis_error_rad: Option<f64>,
+    /// The CL comparison in full (with `--cl`).
+    pub cl: Option<ClComparison>,
+    /// What the run assumed, one sentence each (inputs read as 0, rapid
+    /// rates, the start position).
+    pub assumed: Vec<String>,
+    /// Warnings with their place (`file:line:column: message`).
+    pub warnings: Vec<String>,
+}
+
+impl SimReport {
+    /// Whether anything was violated (overtravel, a collision, a rapid into
+    /// stock): `kinpost sim` exits with 3.
+    pub fn violated(&self) -> bool {
+        !self.overtravel.is_empty() || !self.collisions.is_empty()
+    }
+
+    /// The report as pretty JSON, with a final newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+
+    /// One line per finding and a closing summary, for standard error.
+    pub fn summary(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        for o in self.overtravel.iter().take(SUMMARY_LINES) {
+            let _ = writeln!(
+                s,
+                "error: line {}{}: {} reaches {} outside its travel [{}, {}] by {:.6}{}",
+                o.at.line,
+                number(o.at.number),
+                o.axis,
+                o.value,
+                o.limits[0],
+                o.limits[1],
+                o.excess,
+                if o.between_ends {
+                    " (between the block's ends)"
+                } else {
+                    ""
+                }
+            );
+        }
+        more(&mut s, self.overtravel.len(), "overtravel findings");
+        let collisions = self.collisions.iter().take(SUMMARY_LINES);
+        let near = self.near_misses.iter().take(SUMMARY_LINES);
+        for (c, what) in collisions
+            .map(|c| (c, "error"))
+            .chain(near.map(|c| (c, "warning")))
+        {
+            let depth = c
+                .penetration_mm
+                .map_or(String::new(), |p| format!(", {p:.3} mm deep"));
+            let _ = writeln!(
+                s,
+                "{what}: line {}{}: {} between `{}` and `{}` (distance {:.3} mm{depth}; clearances {} / {} mm){}",
+                c.at.line,
+                number(c.at.number),
+                c.kind.replace('_', " "),
+                c.solids[0],
+                c.solids[1],
+                c.distance_mm,
+                c.clearances_mm[0],
+                c.clearances_mm[1],
+                if c.last_block > c.at.block {
+                    format!(" through block {}", c.last_block)
+                } else {
+                    String::new()
+                }
+            );
+        }
+        more(&mut s, self.collisions.len(), "collisions");
+        more(&mut s, self.near_misses.len(), "near misses");
+        for a in &self.assumed {
+            let _ = writeln!(s, "note: assumed {a}");
+        }
+        let _ = write!(
+            s,
+            "{} blocks, {}, {} overtravel, {} collisions, {} near misses",
+            self.blocks,
+            duration(self.duration_s),
+            self.overtravel.len(),
+            self.collisions.len(),
+            self.near_misses.len()
+        );
+        if let Some(cl) = &self.cl {
+            if let Some(p) = &cl.position {
+                let _ = write!(
+                    s,
+                    "; CL deviation {:.6} mm (line {}, CL line {})",
+                    p.value, p.at.line, p.cl_line
+                );
+            }
+            if let Some(a) = &cl.axis {
+                let _ = write!(
+                    s,
+                    ", tool axis {:.3e} rad (line {}, CL line {})",
+                    a.value, a.at.line, a.cl_line
+                );
+            }
+        }
+        s
+    }
+}
+
+/// Findings of one kind the summary lists line by line; the rest are
+/// counted (the JSON report has them all).
+const SUMMARY_LINES: usize = 20;
+
+/// "… and N more" when `count` findings exceed the summary's lines.
+fn more(s: &mut String, count: usize, what: &str) {
+    use std::fmt::Write as _;
+    if count > SUMMARY_LINES {
+        let _ = writeln!(
+            s,
+            "  … and {} more {what} (--json lists them all)",
+            count - SUMMARY_LINES
+        );
+    }
+}
+
+fn number(n: Option<u64>) -> String {
+    n.map_or(String::new(), |n| format!(" (N{n})"))
+}
+
+/// A duration as h:mm:ss.s.
+fn duration(s: f64) -> String {
+    let h = (s / 3600.0).floor();
+    let m = ((s - h * 3600.0) / 60.0).floor();
+    format!(
+        "run time {}:{:02}:{:04.1}",
+        h as u64,
+        m as u64,
+        s - h * 3600.0 - m * 60.0
+    )
+}
