@@ -281,7 +281,9 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
             *v = rng.range(20.0, 60.0).copysign(*v);
         }
     }
-    let default = (rng.next() < 0.5).then(|| half(&mut rng, lo - 100.0, hi + 100.0));
+    // (A pressure below 0 is refused as an option, as `PRESSURE/` values
+    // below 0 are clamped above: both are the machine's pressure range.)
+    let default = (rng.next() < 0.5).then(|| half(&mut rng, lo - 100.0, hi + 100.0).max(0.0));
     let mut pressure = default;
     let mut cl = String::from("FEDRAT/MMPM,500\n");
     // Per CL line: the pose and the pressure in force.
