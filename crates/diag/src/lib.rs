@@ -177,6 +177,32 @@ pub const MESSAGE_CHARS: usize = 400;
 /// ([`excerpt`]).
 pub const EXCERPT_CHARS: usize = 60;
 
+/// The error for a settings file (`kind`: "machine", "dialect") of more
+/// than `max_bytes`, or `None`: such files are a few kilobytes, so a larger
+/// one is refused before it is parsed (it is not one, and parsing it would
+/// only cost time). Shown at line 1 with the file's first line.
+pub fn oversized_file(
+    file: &str,
+    source: &str,
+    kind: &str,
+    max_bytes: usize,
+) -> Option<Diagnostic> {
+    (source.len() > max_bytes).then(|| {
+        Diagnostic::error(
+            file,
+            1,
+            1,
+            1,
+            source.lines().next().unwrap_or(""),
+            format!(
+                "the {kind} file has {} bytes, more than {max_bytes}: a {kind} file is a few \
+                 kilobytes (is this a {kind} file?)",
+                source.len()
+            ),
+        )
+    })
+}
+
 /// `text` to quote in a message: whole when it has at most
 /// [`EXCERPT_CHARS`] characters, else its start, `…` and how long it is.
 /// The one place that decides how much of an input a message echoes.
@@ -343,6 +369,22 @@ impl From<Diagnostic> for Diagnostics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_oversized_settings_file_is_refused_at_line_1() {
+        assert!(oversized_file("m.toml", "abc", "machine", 3).is_none());
+        let d = oversized_file("m.toml", "first line\nsecond", "machine", 3).unwrap();
+        assert!(d.is_error());
+        assert_eq!(
+            (d.line, d.column, d.source_line.as_str()),
+            (1, 1, "first line")
+        );
+        assert_eq!(
+            d.message,
+            "the machine file has 17 bytes, more than 3: a machine file is a few kilobytes \
+             (is this a machine file?)"
+        );
+    }
 
     #[test]
     fn control_characters_are_not_echoed() {

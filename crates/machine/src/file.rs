@@ -450,20 +450,8 @@ fn parse_raw_machine(
     source: &str,
     file: &str,
 ) -> Result<(RawMachine, Vec<Diagnostic>), Diagnostics> {
-    if source.len() > MAX_MACHINE_FILE_BYTES {
-        return Err(Diagnostic::error(
-            file,
-            1,
-            1,
-            1,
-            source.lines().next().unwrap_or(""),
-            format!(
-                "the machine file has {} bytes, more than {MAX_MACHINE_FILE_BYTES}: a machine \
-                 file is a few kilobytes (is this a machine file?)",
-                source.len()
-            ),
-        )
-        .into());
+    if let Some(e) = kinpost_diag::oversized_file(file, source, "machine", MAX_MACHINE_FILE_BYTES) {
+        return Err(e.into());
     }
     // Syntax first, then the keys and types of the machine file.
     if let Err(e) = source.parse::<toml::Table>() {

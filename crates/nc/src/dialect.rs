@@ -681,22 +681,10 @@ fn parse_raw_dialect(
 /// A file over [`MAX_DIALECT_FILE_BYTES`] is refused before it is parsed:
 /// it is not a dialect file, and parsing it would only cost time.
 fn refuse_oversized(source: &str, file_name: &str) -> Result<(), Diagnostics> {
-    if source.len() > MAX_DIALECT_FILE_BYTES {
-        return Err(Diagnostic::error(
-            file_name,
-            1,
-            1,
-            1,
-            source.lines().next().unwrap_or(""),
-            format!(
-                "the dialect file has {} bytes, more than {MAX_DIALECT_FILE_BYTES}: a dialect \
-                 file is a few kilobytes (is this a dialect file?)",
-                source.len()
-            ),
-        )
-        .into());
+    match kinpost_diag::oversized_file(file_name, source, "dialect", MAX_DIALECT_FILE_BYTES) {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The dialect names itself (`name` not blank) and its programs' bare
