@@ -54,6 +54,7 @@ pub mod cycle;
 mod error;
 mod machine_templates;
 pub mod motion;
+pub mod native_arc;
 mod pressure;
 pub mod program;
 mod readback;
@@ -70,7 +71,7 @@ use kinpost_machine::Machine;
 use kinpost_nc::{Dialect, NcWriter};
 
 pub use command::{Command, Pending};
-pub use config::{Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
+pub use config::{ArcMode, Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
 pub use error::{
     CheckError, ConfigError, LinearizationFailure, MotionError, MotionWarning, PointError,
     PostError, PressureError, PressureWarning, ProgramError, SetupError,
