@@ -1073,7 +1073,7 @@ impl<W: Write> NcWriter<W> {
     /// Fails for a wrong number of axis values, a value that is not finite
     /// or too large to write, a line longer than the dialect allows, or the
     /// output.
-    #[inline]
+    #[inline(always)]
     pub fn block(&mut self, block: &Block) -> Result<(), BlockError> {
         if block.axes.len() != self.formats.len() {
             return Err(BlockError::AxisCount {

@@ -384,6 +384,25 @@ impl<S: BlockSink> Check<S> {
         true
     }
 
+    /// Holds block `b` (its values handed over in `row`, as written in
+    /// `self.written`) back among the blocks of the arc being gathered.
+    #[cold]
+    #[inline(never)]
+    fn hold(&mut self, kin: &Kinematics, b: &MotionBlock<'_>, row: &[f64; MAX_AXES + 1]) {
+        if let Some(g) = &mut self.arc {
+            if g.kin.is_none() {
+                g.kin = Some(kin.clone());
+            }
+            g.blocks.push(HeldBlock {
+                row: *row,
+                written: self.written,
+                motion: b.motion,
+                cl_line: b.cl_line,
+                feed: b.feed,
+            });
+        }
+    }
+
     /// The end of a gathered arc: one circular block when the machine can
     /// write it and it passes the check (see [`crate::native_arc`]),
     /// otherwise its blocks as they are (each passed the check already).
@@ -540,17 +559,8 @@ impl<S: BlockSink> MotionSink for Check<S> {
         row[..MAX_AXES].copy_from_slice(b.values);
         row[n] = b.pressure;
         self.started = true;
-        if let Some(g) = &mut self.arc {
-            if g.kin.is_none() {
-                g.kin = Some(kin.clone());
-            }
-            g.blocks.push(HeldBlock {
-                row,
-                written: self.written,
-                motion: b.motion,
-                cl_line: b.cl_line,
-                feed: b.feed,
-            });
+        if self.arc.is_some() {
+            self.hold(kin, b, &row);
             return Ok(lever);
         }
         self.sink
