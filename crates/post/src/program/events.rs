@@ -184,18 +184,23 @@ impl Program<'_> {
             .map_err(|e| PostError::from(locate(reader, ProgramError::Arc(e))))?;
         let counted = self.report.cl_points;
         if let Some(pieces) = self.native_arc_pieces(&arc, &pending, goto, reader)? {
+            // The points of the whole arc, as --arcs linear has them (their
+            // number rounded up to a multiple of the pieces), so that an
+            // arc the check writes as lines is mostly written as there.
+            let segments = arc
+                .segments(self.chord_tolerance_mm())
+                .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
+            let per_piece = segments.div_ceil(pieces.len());
+            let total = (per_piece * pieces.len()) as f64;
             let mut m = *goto;
-            for piece in pieces {
-                let points = piece
-                    .sample(self.chord_tolerance_mm())
-                    .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
+            for (j, piece) in pieces.into_iter().enumerate() {
                 let begin = Command::ArcBegin {
                     arc: Box::new(piece),
                     xy_only: self.cutcom_on,
                 };
                 self.command(begin, reader, sink)?;
-                for p in points {
-                    m.point = p;
+                for k in j * per_piece + 1..=(j + 1) * per_piece {
+                    m.point = arc.point_at(k as f64 / total);
                     self.goto(&m, reader, sink)?;
                 }
                 self.command(Command::ArcEnd, reader, sink)?;
