@@ -457,10 +457,15 @@ impl<S: BlockSink> Check<S> {
 
     /// The circular block of a gathered arc and its largest distance from
     /// the CL arc, if it can be written: every block a feed block at one
-    /// feed and pressure, every free axis but X, Y, Z as at the start, the
+    /// feed, no pressure axis, every free axis but X, Y, Z as at the start, the
     /// arc in a program plane there, and the block as written within the
     /// tolerance of the CL arc at its sampled points.
     fn native_block(&self, g: &Gathered) -> Option<(NativeArc, f64)> {
+        // (A machine with a pressure word writes it on a line of its own
+        // before the block that changes it: its arcs stay lines.)
+        if self.has_pressure {
+            return None;
+        }
         let axes = self.program_axes.as_ref()?;
         let kin = g.kin.as_ref()?;
         let last = g.blocks.last()?;
