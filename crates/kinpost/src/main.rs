@@ -207,6 +207,12 @@ struct PostArgs {
     /// (SOLIDWORKS CAM writes tool and stock notes as INSERT), or nothing.
     #[arg(long, value_enum, default_value = "verbatim")]
     insert: InsertArg,
+    /// How CL CIRCLE arcs are written: native G2/G3 (Heidenhain: lines)
+    /// where the arc lies in a plane of the machine at constant rotary axes
+    /// in joint output, lines within --lintol elsewhere; or lines
+    /// everywhere.
+    #[arg(long, value_enum, default_value = "native")]
+    arcs: ArcsArg,
     /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
     /// points before any PRESSURE statement. Without it and without
     /// PRESSURE, no pressure word is written and the wheel is where it is
@@ -233,6 +239,12 @@ enum FeedModeArg {
     Tip,
     InverseTime,
     Dpm,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ArcsArg {
+    Native,
+    Linear,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -726,6 +738,10 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        arcs: match args.arcs {
+            ArcsArg::Native => kinpost_post::ArcMode::Native,
+            ArcsArg::Linear => kinpost_post::ArcMode::Linear,
+        },
         insert: match args.insert {
             InsertArg::Verbatim => kinpost_post::InsertMode::Verbatim,
             InsertArg::Comment => kinpost_post::InsertMode::Comment,

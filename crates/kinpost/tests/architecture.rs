@@ -162,6 +162,7 @@ fn the_post_stages_import_only_upstream() {
     let order = [
         "cycle",
         "error",
+        "native_arc",
         "command",
         "config",
         "pressure",

@@ -128,3 +128,27 @@ pub const REFERENCE_NORMAL_MIN: f64 = 1e-12;
 /// A CL reference direction off perpendicular to the tool axis by more than
 /// this is remarked on (its part along the axis is left out), degrees.
 pub const REFERENCE_SKEW_DEG: f64 = 0.1;
+
+/// How far the linear axes of a machine may be from a rigid map of the
+/// part frame (|MᵀM − I| of the tool point's motion per mm of X, Y, Z at
+/// fixed rotary values) for its arcs to be written as circular blocks:
+/// arithmetic only; every kinematic chain of rigid axes is exact to it.
+pub const NATIVE_ARC_RIGID: f64 = 1e-9;
+
+/// How far an arc's normal, mapped into the program's X, Y, Z, may be
+/// from a coordinate axis (1 − |cos|) for the arc to lie in G17, G18 or
+/// G19: arithmetic only (a CL arc axis is written with 6 or more
+/// decimals; 1e-9 of the cosine is 4.5e-5 rad, far below them, so an
+/// arc in a tilted plane is never taken for one in a machine plane).
+pub const NATIVE_ARC_PLANE_COS: f64 = 1e-9;
+
+/// Largest difference of the radii to the start and the end of a written
+/// circular block, mm: controllers refuse an arc whose end is off its
+/// circle by more (LinuxCNC's default for G2/G3 with I J K is 0.0005 inch
+/// absolute with 0.1 % relative; this stays below it).
+pub const NATIVE_ARC_RADIUS_MISMATCH_MM: f64 = 0.002;
+
+/// Points of a written circular block compared with the CL arc by the
+/// closed-loop check, at least, besides one between every two of its
+/// linearized points.
+pub const NATIVE_ARC_MIN_SAMPLES: usize = 16;

@@ -98,6 +98,23 @@ pub struct MotionWords {
     pub feed_aliases: Vec<String>,
 }
 
+/// The circular interpolation words of a dialect (`[arc]`): a dialect
+/// without them gets every arc as lines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcWords {
+    /// Clockwise arc (`G2`), looking against the plane's normal.
+    pub clockwise: String,
+    /// Counter-clockwise arc (`G3`).
+    pub counter_clockwise: String,
+    /// The plane selection words, XY, ZX, YZ (`G17`, `G18`, `G19`),
+    /// written when the plane changes.
+    pub planes: [String; 3],
+    /// The prefixes of the centre words on X, Y, Z (`I`, `J`, `K`):
+    /// the centre relative to the arc's start point, in the linear axes'
+    /// number format.
+    pub centre: [String; 3],
+}
+
 /// Layout of a block (a line).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BlockFormat {
@@ -301,6 +318,7 @@ pub struct Dialect {
     pressure: Option<PartialWord>,
     pub(crate) feed: FeedFormat,
     pub(crate) motion: MotionWords,
+    pub(crate) arc: Option<ArcWords>,
     pub(crate) numbering: Numbering,
     pub(crate) comment: CommentSyntax,
     templates: BTreeMap<TemplateKind, String>,
@@ -413,6 +431,12 @@ impl Dialect {
                 mode: raw.feed.mode.map(Spanned::into_inner),
             },
             motion,
+            arc: raw.arc.map(|a| ArcWords {
+                clockwise: a.clockwise,
+                counter_clockwise: a.counter_clockwise,
+                planes: a.planes,
+                centre: a.centre,
+            }),
             numbering,
             comment: CommentSyntax {
                 enabled: raw.comment.enabled,
@@ -466,6 +490,12 @@ impl Dialect {
     /// Motion words.
     pub fn motion_words(&self) -> &MotionWords {
         &self.motion
+    }
+
+    /// The circular interpolation words (`[arc]`), if the dialect writes
+    /// arcs.
+    pub fn arc_words(&self) -> Option<&ArcWords> {
+        self.arc.as_ref()
     }
 
     /// Block numbering.
@@ -1240,6 +1270,7 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
             names::<RawMotion>(),
             &[("initial", names::<RawInitial>())],
         ),
+        ("arc", names::<RawArc>(), &[]),
         ("numbering", names::<RawNumbering>(), &[]),
         ("comment", names::<RawComment>(), &[]),
         ("templates", names::<RawTemplates>(), &[]),
@@ -1274,6 +1305,7 @@ struct RawDialect {
     feed: RawFeed,
     #[serde(default)]
     motion: RawMotion,
+    arc: Option<RawArc>,
     #[serde(default)]
     numbering: RawNumbering,
     #[serde(default)]
@@ -1362,6 +1394,14 @@ enum RawInitial {
     None,
     Rapid,
     Feed,
+}
+
+#[derive(Deserialize)]
+struct RawArc {
+    clockwise: String,
+    counter_clockwise: String,
+    planes: [String; 3],
+    centre: [String; 3],
 }
 
 #[derive(Deserialize)]

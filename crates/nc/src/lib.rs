@@ -35,7 +35,7 @@ mod template;
 mod writer;
 
 pub use dialect::{
-    BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
+    ArcWords, BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
     MotionWords, Numbering, TemplateKind, WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
@@ -147,6 +147,58 @@ pub struct Block<'a> {
     pub axes: &'a [f64],
     /// Feed rate of a feed block (mm/min, or inverse time for a dialect with
     /// `inverse_time`); ignored on rapid blocks. `None` keeps the last one.
+    pub feed: Option<f64>,
+}
+
+/// The plane of a circular block, in the program's X, Y, Z words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ArcPlane {
+    /// XY (`G17`), normal +Z.
+    Xy,
+    /// ZX (`G18`), normal +Y.
+    Zx,
+    /// YZ (`G19`), normal +X.
+    Yz,
+}
+
+impl ArcPlane {
+    /// 0, 1, 2 for XY, ZX, YZ (the order of [`ArcWords::planes`]).
+    pub fn index(self) -> usize {
+        match self {
+            ArcPlane::Xy => 0,
+            ArcPlane::Zx => 1,
+            ArcPlane::Yz => 2,
+        }
+    }
+
+    /// The program axes (0 = X, 1 = Y, 2 = Z) of the plane, in the order
+    /// that makes the normal positive (X Y for XY, Z X for ZX, Y Z for
+    /// YZ), then the normal's.
+    pub fn axes(self) -> [usize; 3] {
+        match self {
+            ArcPlane::Xy => [0, 1, 2],
+            ArcPlane::Zx => [2, 0, 1],
+            ArcPlane::Yz => [1, 2, 0],
+        }
+    }
+}
+
+/// One circular (or helical) block to write: the end point as in a
+/// [`Block`], the centre relative to the start point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcBlock<'a> {
+    /// 1-based line of the CL record whose arc this block ends.
+    pub cl_line: Option<usize>,
+    /// The plane.
+    pub plane: ArcPlane,
+    /// Clockwise looking against the plane's normal (`G2`), else `G3`.
+    pub clockwise: bool,
+    /// NC values of the end point in machine order (as in [`Block::axes`]).
+    pub axes: &'a [f64],
+    /// The centre minus the start point on the program's X, Y, Z (mm);
+    /// the two of the plane are written.
+    pub centre_offset: [f64; 3],
+    /// Feed rate (as in [`Block::feed`]).
     pub feed: Option<f64>,
 }
 
@@ -406,6 +458,11 @@ pub enum BlockError {
     },
     /// Block numbers ran out.
     Numbers(NumbersRunOut),
+    /// An arc block for a dialect without `[arc]` words.
+    NoArcWords {
+        /// The dialect.
+        dialect: String,
+    },
     /// Writing failed.
     Io(std::io::Error),
 }
@@ -481,6 +538,10 @@ impl std::fmt::Display for BlockError {
                 "dialect `{dialect}` cannot write the pressure word `{word}`: it has no [pressure] table"
             ),
             BlockError::Template(e) => e.fmt(f),
+            BlockError::NoArcWords { dialect } => write!(
+                f,
+                "dialect `{dialect}` has no [arc] words: its arcs are written as lines"
+            ),
             BlockError::PressureRoundsToZero { word, value } => write!(
                 f,
                 "cannot write {word} = {value}: it would be written as 0 with the dialect's decimals"

@@ -261,6 +261,19 @@ pub struct NcWriter<W: Write> {
     /// The templates written with tool-centre-point control off
     /// ([`Dialect`]'s `templates.outside_tcp`).
     outside_tcp: Vec<TemplateKind>,
+    /// The arc words, when the dialect writes arcs.
+    arc: Option<Box<ArcWords>>,
+}
+
+/// The arc words of a writer: motion and plane words, the centre words in
+/// the linear axes' number format, and the plane in force.
+struct ArcWords {
+    clockwise: Text,
+    counter_clockwise: Text,
+    planes: [Text; 3],
+    centre: [Word; 3],
+    /// The plane last selected (`None`: as the header left it, unknown).
+    plane: Option<crate::ArcPlane>,
 }
 
 /// The pressure word: its format and state (modal), and whether the
@@ -342,6 +355,9 @@ impl<W: Write> NcWriter<W> {
             // (and a CSV `feed_mode` field)
             + sep.len()
             + 16
+            + 64
+            // (and an arc block's plane, arc and centre words)
+            + 2 * WORD_ROOM
             + 64;
         let vars = ProgramInfo::default().template_vars(&dialect.name, axes);
         NcWriter {
@@ -385,7 +401,148 @@ impl<W: Write> NcWriter<W> {
             inverse_time_on: false,
             tcp_on: false,
             outside_tcp: dialect.outside_tcp.clone(),
+            arc: dialect.arc.as_ref().filter(|_| words_kind).map(|a| {
+                let linear = dialect.word_format(&AxisSpec::linear("X"));
+                let centre = |k: usize| {
+                    let wf = crate::WordFormat {
+                        prefix: a.centre[k].clone(),
+                        suffix: String::new(),
+                        ..linear.clone()
+                    };
+                    Word::new(usize::MAX, sep, &wf, false)
+                };
+                Box::new(ArcWords {
+                    clockwise: Text::new(&a.clockwise),
+                    counter_clockwise: Text::new(&a.counter_clockwise),
+                    planes: [0, 1, 2].map(|k| Text::new(&a.planes[k])),
+                    centre: [0, 1, 2].map(centre),
+                    plane: None,
+                })
+            }),
         }
+    }
+
+    /// The centre offset `value` on program axis `k` (0 = X, 1 = Y, 2 =
+    /// Z) exactly as an arc block writes it (the value itself for a
+    /// dialect without arc words).
+    pub fn quantized_centre(&self, k: usize, value: f64) -> f64 {
+        match &self.arc {
+            Some(a) if k < 3 => a.centre[k].fmt.quantize(value),
+            _ => value,
+        }
+    }
+
+    /// Whether the dialect writes arc blocks ([`NcWriter::arc`]).
+    pub fn writes_arcs(&self) -> bool {
+        self.arc.is_some()
+    }
+
+    /// Writes one circular block: the plane word when the plane changes,
+    /// the arc word, the axis words of the end point that change (as
+    /// [`NcWriter::block`] does), the two centre words of the plane
+    /// (relative to the start point) and the feed word. The next linear
+    /// block writes its motion word. Fails for a dialect without `[arc]`
+    /// words and as [`NcWriter::block`] does.
+    pub fn arc(&mut self, block: &crate::ArcBlock) -> Result<(), BlockError> {
+        if block.axes.len() != self.formats.len() {
+            return Err(BlockError::AxisCount {
+                got: block.axes.len(),
+                want: self.formats.len(),
+            });
+        }
+        let Some(mut arc) = self.arc.take() else {
+            return Err(BlockError::NoArcWords {
+                dialect: self.dialect_name.clone(),
+            });
+        };
+        let done = self.arc_line(&mut arc, block);
+        self.arc = Some(arc);
+        done
+    }
+
+    fn arc_line(&mut self, arc: &mut ArcWords, block: &crate::ArcBlock) -> Result<(), BlockError> {
+        for (k, w) in self.words.iter().enumerate() {
+            let v = block.axes[w.index];
+            self.units[k] = w.units(v).map_err(|e| self.bad_value(w.index, v, e))?;
+        }
+        // The centre words in the order I, J, K.
+        let [a, b, _] = block.plane.axes();
+        let (a, b) = (a.min(b), a.max(b));
+        let mut centre = [0i64; 2];
+        for (c, axis) in centre.iter_mut().zip([a, b]) {
+            let v = block.centre_offset[axis];
+            *c = arc.centre[axis]
+                .fmt
+                .units(v)
+                .map_err(|e| BlockError::Value {
+                    word: arc.centre[axis].first[..arc.centre[axis].first_len]
+                        .iter()
+                        .map(|&c| c as char)
+                        .collect(),
+                    value: v,
+                    error: e,
+                })?;
+        }
+        let mut feed_units = None;
+        if let Some(f) = block.feed {
+            let n = self
+                .feed_units(f)
+                .map_err(|e| self.bad_value(usize::MAX, f, e))?;
+            if !(self.feed.modal && self.last_feed == Some(n)) {
+                feed_units = Some(n);
+            }
+        }
+        self.start_line()?;
+        let line = &mut self.line;
+        let mut first = true;
+        let put = |line: &mut Line, t: &Text, first: &mut bool| {
+            if !*first {
+                line.put(&self.sep);
+            }
+            line.put(t);
+            *first = false;
+        };
+        if arc.plane != Some(block.plane) && !arc.planes[block.plane.index()].is_empty() {
+            put(line, &arc.planes[block.plane.index()], &mut first);
+        }
+        arc.plane = Some(block.plane);
+        let word = if block.clockwise {
+            &arc.clockwise
+        } else {
+            &arc.counter_clockwise
+        };
+        put(line, word, &mut first);
+        for (k, w) in self.words.iter_mut().enumerate() {
+            let n = self.units[k];
+            if w.modal && w.known && w.last == n {
+                continue;
+            }
+            w.last = n;
+            w.known = true;
+            line.put_word(w, n, first);
+            first = false;
+        }
+        for (c, axis) in centre.into_iter().zip([a, b]) {
+            line.put_word(&arc.centre[axis], c, first);
+            first = false;
+        }
+        if !self.after_axes.is_empty() {
+            line.put(&self.sep);
+            line.put(&self.after_axes);
+        }
+        if let Some(n) = feed_units {
+            line.put_word(&self.feed, n, first);
+            self.last_feed = Some(n);
+        }
+        line.put(&self.eol);
+        // The arc word is modal on the controller: the next linear block
+        // says what it is.
+        self.motion_state = None;
+        if self.line.len > self.max_line {
+            return Err(self.too_long(block.cl_line));
+        }
+        self.blocks += 1;
+        Ok(self.out.write_all(self.line.as_slice())?)
     }
 
     /// The value exactly as it is written for machine axis `axis_index`
@@ -605,13 +762,24 @@ impl<W: Write> NcWriter<W> {
     pub fn cutter_compensation(&mut self, on: Option<(bool, u32)>) -> Result<(), NcError> {
         match on {
             None => self.required_command(TemplateKind::CutcomOff, Vec::new()),
-            Some((left, register)) => self.required_command(
-                TemplateKind::CutcomOn,
-                vec![
-                    ("side", Value::from(if left { "left" } else { "right" })),
-                    ("register", Value::from(register)),
-                ],
-            ),
+            Some((left, register)) => {
+                // The templates compensate in the XY plane of the header:
+                // select it again after an arc in another plane.
+                if let Some(a) = self.arc.as_mut()
+                    && a.plane.is_some_and(|p| p != crate::ArcPlane::Xy)
+                {
+                    a.plane = Some(crate::ArcPlane::Xy);
+                    let word = String::from_utf8_lossy(&a.planes[0]).into_owned();
+                    self.insert(&word)?;
+                }
+                self.required_command(
+                    TemplateKind::CutcomOn,
+                    vec![
+                        ("side", Value::from(if left { "left" } else { "right" })),
+                        ("register", Value::from(register)),
+                    ],
+                )
+            }
         }
     }
 
@@ -905,7 +1073,7 @@ impl<W: Write> NcWriter<W> {
     /// Fails for a wrong number of axis values, a value that is not finite
     /// or too large to write, a line longer than the dialect allows, or the
     /// output.
-    #[inline]
+    #[inline(always)]
     pub fn block(&mut self, block: &Block) -> Result<(), BlockError> {
         if block.axes.len() != self.formats.len() {
             return Err(BlockError::AxisCount {

@@ -10,12 +10,15 @@ use kinpost_machine::tolerance::{
     CHECK_SLACK_MM, CHECK_SLACK_RAD, LEVER_PROBE_DEG, REFERENCE_NORMAL_MIN, SECOND_ORDER_MARGIN,
 };
 use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, lever_over};
-use kinpost_nc::{Block, BlockError};
+use kinpost_nc::{ArcBlock, Block, BlockError};
 use nalgebra::Vector3;
 
-use crate::command::Pending;
+use crate::command::{Command, Pending};
 use crate::error::{CheckError, PostError};
 use crate::motion::{MotionBlock, MotionSink};
+use crate::native_arc::{self, NativeArc, ProgramAxes};
+use kinpost_diag::{Diagnostic, Located};
+use kinpost_machine::tolerance::NATIVE_ARC_MIN_SAMPLES;
 
 /// Where the blocks of a program go, once checked: the NC writer, or a
 /// test's list ([`Recorded`](crate::Recorded)).
@@ -36,6 +39,26 @@ pub trait BlockSink {
 
     /// Whether a feed word of `word` writes as 0.
     fn feed_rounds_to_zero(&self, word: f64) -> bool;
+
+    /// Whether this sink writes circular blocks ([`BlockSink::arc`]);
+    /// without, the check hands every arc on as its lines.
+    fn writes_arcs(&self) -> bool {
+        false
+    }
+
+    /// An arc block's centre offset (program X, Y, Z) as this sink writes
+    /// it.
+    fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
+        offset
+    }
+
+    /// A circular block, its end point and centre as checked.
+    fn arc(&mut self, block: &ArcBlock) -> Result<(), BlockError> {
+        let _ = block;
+        Err(BlockError::NoArcWords {
+            dialect: "(this sink)".to_string(),
+        })
+    }
 }
 
 /// How far a block may put the tool from its CL pose.
@@ -211,6 +234,9 @@ pub struct CheckReport {
     pub max_beyond_reach_rad: f64,
     /// The CL line of the first.
     pub first_beyond_reach_line: Option<usize>,
+    /// CL arcs written as circular blocks (pieces of a full circle or
+    /// helix counted one by one).
+    pub native_arcs: u64,
 }
 
 /// How the check is set up.
@@ -240,7 +266,36 @@ pub struct Check<S> {
     /// The sines and cosines of the written rotary values, for the next
     /// block's check.
     sin_cos: SinCosMemo,
+    /// A block has been checked (`written` holds its values).
+    started: bool,
+    /// The program's X, Y, Z axes, when the sink writes arcs and the
+    /// machine has them.
+    program_axes: Option<ProgramAxes>,
+    /// The blocks of an arc being gathered (see [`Command::ArcBegin`]).
+    arc: Option<Box<Gathered>>,
     report: CheckReport,
+}
+
+/// The blocks of a CL arc, checked and held back until its end.
+struct Gathered {
+    arc: Box<kinpost_cl::Arc>,
+    /// The values written before the arc (its start).
+    start: Joints,
+    /// Each block: values handed over (pressure last), values as written,
+    /// motion, CL line, feed.
+    blocks: Vec<HeldBlock>,
+    /// The kinematics of the first block (the machine at its pressure).
+    kin: Option<Kinematics>,
+    /// Only an XY block may be written (see [`Command::ArcBegin`]).
+    xy_only: bool,
+}
+
+struct HeldBlock {
+    row: [f64; MAX_AXES + 1],
+    written: Joints,
+    motion: kinpost_nc::Motion,
+    cl_line: Option<usize>,
+    feed: Option<f64>,
 }
 
 impl<S: BlockSink> Check<S> {
@@ -255,7 +310,6 @@ impl<S: BlockSink> Check<S> {
                 .sum::<f64>()
         };
         Check {
-            sink,
             rounding_travel: (free(true).to_radians(), free(false)),
             n: axes.len(),
             has_pressure: machine.pressure.is_some(),
@@ -266,10 +320,19 @@ impl<S: BlockSink> Check<S> {
                 beyond_reach_blocks: 0,
                 max_beyond_reach_rad: 0.0,
                 first_beyond_reach_line: None,
+                native_arcs: 0,
             },
+            program_axes: if sink.writes_arcs() && settings.tcp.is_none() {
+                ProgramAxes::of(machine)
+            } else {
+                None
+            },
+            sink,
             settings,
             written: [0.0; MAX_AXES],
             sin_cos: SinCosMemo::default(),
+            started: false,
+            arc: None,
         }
     }
 
@@ -319,6 +382,123 @@ impl<S: BlockSink> Check<S> {
         r.max_beyond_reach_rad = r.max_beyond_reach_rad.max(gap);
         r.first_beyond_reach_line.get_or_insert(line);
         true
+    }
+
+    /// Holds block `b` (its values handed over in `row`, as written in
+    /// `self.written`) back among the blocks of the arc being gathered.
+    #[cold]
+    #[inline(never)]
+    fn hold(&mut self, kin: &Kinematics, b: &MotionBlock<'_>, row: &[f64; MAX_AXES + 1]) {
+        if let Some(g) = &mut self.arc {
+            if g.kin.is_none() {
+                g.kin = Some(kin.clone());
+            }
+            g.blocks.push(HeldBlock {
+                row: *row,
+                written: self.written,
+                motion: b.motion,
+                cl_line: b.cl_line,
+                feed: b.feed,
+            });
+        }
+    }
+
+    /// The end of a gathered arc: one circular block when the machine can
+    /// write it and it passes the check (see [`crate::native_arc`]),
+    /// otherwise its blocks as they are (each passed the check already).
+    /// `at`: the CL statement, for an error of the writer.
+    fn end_arc(&mut self, at: &Diagnostic) -> Result<(), PostError> {
+        let Some(g) = self.arc.take() else {
+            return Ok(());
+        };
+        let locate = |e: BlockError| {
+            PostError::from(Located {
+                diagnostic: Box::new(Diagnostic {
+                    message: e.to_string(),
+                    ..at.clone()
+                }),
+                error: e,
+            })
+        };
+        if let Some((block, deviation)) = self.native_block(&g) {
+            let held = g.blocks.last().expect("a native arc has blocks");
+            let n = self.n;
+            self.sink
+                .arc(&ArcBlock {
+                    cl_line: held.cl_line,
+                    plane: block.plane,
+                    clockwise: block.clockwise,
+                    axes: &held.row[..n + usize::from(self.has_pressure)],
+                    centre_offset: block.centre_offset,
+                    feed: held.feed,
+                })
+                .map_err(locate)?;
+            let stats = &mut self.report.stats;
+            if deviation > stats.max_position_error_mm {
+                stats.max_position_error_mm = deviation;
+                stats.worst_line = held.cl_line;
+            }
+            self.report.native_arcs += 1;
+            return Ok(());
+        }
+        let n = self.n + usize::from(self.has_pressure);
+        for held in &g.blocks {
+            self.sink
+                .block(&Block {
+                    cl_line: held.cl_line,
+                    motion: held.motion,
+                    axes: &held.row[..n],
+                    feed: held.feed,
+                })
+                .map_err(locate)?;
+        }
+        Ok(())
+    }
+
+    /// The circular block of a gathered arc and its largest distance from
+    /// the CL arc, if it can be written: every block a feed block at one
+    /// feed, no pressure axis, every free axis but X, Y, Z as at the start, the
+    /// arc in a program plane there, and the block as written within the
+    /// tolerance of the CL arc at its sampled points.
+    fn native_block(&self, g: &Gathered) -> Option<(NativeArc, f64)> {
+        // (A machine with a pressure word writes it on a line of its own
+        // before the block that changes it: its arcs stay lines.)
+        if self.has_pressure {
+            return None;
+        }
+        let axes = self.program_axes.as_ref()?;
+        let kin = g.kin.as_ref()?;
+        let last = g.blocks.last()?;
+        let n = self.n;
+        let steady = g.blocks.iter().all(|b| {
+            b.motion == kinpost_nc::Motion::Feed
+                && b.feed == last.feed
+                && b.row[n].to_bits() == last.row[n].to_bits()
+                && axes
+                    .others
+                    .iter()
+                    .all(|&i| b.written[i].to_bits() == g.start[i].to_bits())
+        });
+        if !steady {
+            return None;
+        }
+        let start = &g.start[..n];
+        let mut native = native_arc::fit(kin, axes, &g.arc, start)?;
+        if g.xy_only && native.plane != kinpost_nc::ArcPlane::Xy {
+            return None;
+        }
+        native.centre_offset = self.sink.round_centre(native.centre_offset);
+        let samples = (2 * g.blocks.len()).max(NATIVE_ARC_MIN_SAMPLES);
+        let deviation = native_arc::deviation_mm(
+            kin,
+            axes,
+            &g.arc,
+            start,
+            &last.written[..n],
+            &native,
+            samples,
+        );
+        (deviation <= self.report.tolerance.position_mm).then_some((native, deviation))
     }
 
     /// With the derived tolerance, a block beyond the machine-wide bound is
@@ -383,6 +563,11 @@ impl<S: BlockSink> MotionSink for Check<S> {
         let mut row = [f64::NAN; MAX_AXES + 1];
         row[..MAX_AXES].copy_from_slice(b.values);
         row[n] = b.pressure;
+        self.started = true;
+        if self.arc.is_some() {
+            self.hold(kin, b, &row);
+            return Ok(lever);
+        }
         self.sink
             .block(&Block {
                 cl_line: b.cl_line,
@@ -395,7 +580,26 @@ impl<S: BlockSink> MotionSink for Check<S> {
     }
 
     fn command(&mut self, pending: Pending) -> Result<(), PostError> {
-        self.sink.command(pending)
+        match pending.command {
+            Command::ArcBegin { arc, xy_only } => {
+                self.end_arc(&pending.at)?;
+                if self.program_axes.is_some() && self.started {
+                    self.arc = Some(Box::new(Gathered {
+                        arc,
+                        start: self.written,
+                        blocks: Vec::new(),
+                        kin: None,
+                        xy_only,
+                    }));
+                }
+                Ok(())
+            }
+            Command::ArcEnd => self.end_arc(&pending.at),
+            _ => {
+                self.end_arc(&pending.at)?;
+                self.sink.command(pending)
+            }
+        }
     }
 
     fn inverse_time(&mut self, on: bool) -> Result<(), PostError> {

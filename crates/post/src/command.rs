@@ -30,6 +30,20 @@ pub enum Command {
     /// Cutter radius compensation on (`Some((left, register))`) or off
     /// (`CUTCOM`).
     CutterCompensation(Option<(bool, u32)>),
+    /// The blocks up to the next [`Command::ArcEnd`] lie on this arc (part
+    /// frame): the closed-loop check writes them as one circular block
+    /// where the machine can (see [`crate::native_arc`]), else as they
+    /// are. Never written itself.
+    ArcBegin {
+        /// The arc.
+        arc: Box<kinpost_cl::Arc>,
+        /// Only a G17 (XY) block may be written: cutter radius
+        /// compensation is on, in the XY plane, and a controller does not
+        /// change planes under it.
+        xy_only: bool,
+    },
+    /// The end of the blocks of a [`Command::ArcBegin`].
+    ArcEnd,
 }
 
 /// A command with its CL statement: it is written after the reader has

@@ -34,6 +34,8 @@ pub struct PostOptions {
     pub units: Option<kinpost_cl::Units>,
     /// What a CL `INSERT` becomes (`--insert`).
     pub insert: InsertMode,
+    /// How a CL `CIRCLE`'s arc is written (`--arcs`).
+    pub arcs: ArcMode,
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
@@ -91,6 +93,18 @@ pub enum InsertMode {
     Drop,
 }
 
+/// How the arc of a CL `CIRCLE` is written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ArcMode {
+    /// One circular block (G2/G3) where the arc lies in a plane of the
+    /// machine at constant rotary axes, the dialect has `[arc]` words and
+    /// the output is joint output; lines within `--lintol` elsewhere.
+    #[default]
+    Native,
+    /// Lines within `--lintol` everywhere.
+    Linear,
+}
+
 /// What the feed word of a feed block means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FeedMode {
@@ -138,6 +152,8 @@ pub struct Config {
     pub units: Option<kinpost_cl::Units>,
     /// What a CL `INSERT` becomes.
     pub insert: InsertMode,
+    /// How arcs are written.
+    pub arcs: ArcMode,
     /// Joint or tool-centre-point output.
     pub output: OutputMode,
     /// What the feed words mean.
@@ -227,6 +243,7 @@ impl Config {
             default_axis: options.default_axis,
             units: options.units,
             insert: options.insert,
+            arcs: options.arcs,
             output: options.output.or(machine.post.output).unwrap_or_default(),
             feed_mode: options
                 .feed_mode

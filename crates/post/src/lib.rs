@@ -25,7 +25,9 @@
 //! 5. **Closed-loop check** ([`check::Check`] → [`check::BlockSink`]):
 //!    every block rounded as the sink writes it, run through the forward
 //!    kinematics and compared with its target; only a block that passes is
-//!    handed on.
+//!    handed on. The blocks of a CL arc are held back and written as one
+//!    circular block where the machine can and the block as written lies on
+//!    the CL arc ([`native_arc`], `--arcs`), else as they are.
 //! 6. **Block sink**: the NC writer of a dialect ([`nc`]), or a
 //!    [`Recorded`] list in tests; [`ReadBack`] re-reads what a writer wrote
 //!    and compares it with what it was given.
@@ -54,6 +56,7 @@ pub mod cycle;
 mod error;
 mod machine_templates;
 pub mod motion;
+pub mod native_arc;
 mod pressure;
 pub mod program;
 mod readback;
@@ -70,7 +73,7 @@ use kinpost_machine::Machine;
 use kinpost_nc::{Dialect, NcWriter};
 
 pub use command::{Command, Pending};
-pub use config::{Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
+pub use config::{ArcMode, Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
 pub use error::{
     CheckError, ConfigError, LinearizationFailure, MotionError, MotionWarning, PointError,
     PostError, PressureError, PressureWarning, ProgramError, SetupError,

@@ -4,7 +4,7 @@
 
 use std::io::Write;
 
-use kinpost_nc::{AxisSpec, Block, BlockError, Dialect, Motion, NcWriter, ProgramInfo};
+use kinpost_nc::{ArcBlock, AxisSpec, Block, BlockError, Dialect, Motion, NcWriter, ProgramInfo};
 
 use crate::check::BlockSink;
 use crate::command::{Command, Pending};
@@ -16,7 +16,9 @@ impl<W: Write> BlockSink for NcWriter<W> {
         self.quantize_axes(values, written);
     }
 
-    #[inline]
+    // (Inlined into the check as before native arcs: the GOTO-only post
+    // keeps its speed.)
+    #[inline(always)]
     fn block(&mut self, block: &Block) -> Result<(), BlockError> {
         NcWriter::block(self, block)
     }
@@ -33,6 +35,8 @@ impl<W: Write> BlockSink for NcWriter<W> {
             Command::Stop { optional } => self.stop(*optional),
             Command::Dwell(seconds) => self.dwell(*seconds),
             Command::CutterCompensation(on) => self.cutter_compensation(*on),
+            // The closed-loop check acts on these; nothing to write.
+            Command::ArcBegin { .. } | Command::ArcEnd => Ok(()),
         };
         written.map_err(|e| p.locate(e).into())
     }
@@ -44,6 +48,18 @@ impl<W: Write> BlockSink for NcWriter<W> {
     #[inline]
     fn feed_rounds_to_zero(&self, word: f64) -> bool {
         NcWriter::feed_rounds_to_zero(self, word)
+    }
+
+    fn writes_arcs(&self) -> bool {
+        NcWriter::writes_arcs(self)
+    }
+
+    fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|k| self.quantized_centre(k, offset[k]))
+    }
+
+    fn arc(&mut self, block: &ArcBlock) -> Result<(), BlockError> {
+        NcWriter::arc(self, block)
     }
 }
 

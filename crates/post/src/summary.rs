@@ -83,6 +83,10 @@ pub struct Planning {
     pub max_beyond_reach_rad: f64,
     /// See `beyond_reach_blocks`.
     pub first_beyond_reach_line: Option<usize>,
+    /// CL arcs (pieces of a full turn counted one by one) written as
+    /// circular blocks (`--arcs native`); left out of the JSON when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub native_arcs: u64,
 }
 
 impl Planning {
@@ -106,8 +110,13 @@ impl Planning {
             beyond_reach_blocks: c.beyond_reach_blocks,
             max_beyond_reach_rad: c.max_beyond_reach_rad,
             first_beyond_reach_line: c.first_beyond_reach_line,
+            native_arcs: c.native_arcs,
         }
     }
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 #[derive(Serialize)]
@@ -213,6 +222,9 @@ impl Summary {
                 p.max_beyond_reach_rad,
                 p.first_beyond_reach_line.unwrap_or(0)
             );
+        }
+        if p.native_arcs > 0 {
+            planning += &format!("; {} arc(s) written as circular blocks", p.native_arcs);
         }
         if p.feed_clamp_count > 0 {
             planning += &format!("; {} feed block(s) clamped", p.feed_clamp_count);

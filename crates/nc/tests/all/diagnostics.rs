@@ -96,7 +96,7 @@ fn every_unknown_key_and_value_at_once() {
         [
             (
                 3,
-                "unknown key `colour`, expected one of `name`, `extension`, `description`, `kind`, `block`, `linear`, `rotary`, `endless`, `axis`, `pressure`, `feed`, `motion`, `numbering`, `comment`, `templates`"
+                "unknown key `colour`, expected one of `name`, `extension`, `description`, `kind`, `block`, `linear`, `rotary`, `endless`, `axis`, `pressure`, `feed`, `motion`, `arc`, `numbering`, `comment`, `templates`"
             ),
             (5, &format!("unknown key `prefx`, {word}")[..]),
             (7, &format!("unknown key `decimal`, {word}")[..]),

@@ -1132,3 +1132,100 @@ fn fanuc_comments_and_header_names_are_ascii() {
     assert!(out.contains("(Schrupp fr?sen)\n"), "{out}");
     assert!(out.is_ascii(), "{out}");
 }
+
+#[test]
+fn arc_blocks_write_plane_arc_and_centre_words() {
+    use kinpost_nc::{ArcBlock, ArcPlane};
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::linear("Y"),
+        AxisSpec::linear("Z"),
+    ];
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    assert!(w.writes_arcs());
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[10.0, 0.0, 5.0],
+        feed: Some(300.0),
+    })
+    .unwrap();
+    let arc = |plane, clockwise, axes: &'static [f64], centre_offset| ArcBlock {
+        cl_line: Some(3),
+        plane,
+        clockwise,
+        axes,
+        centre_offset,
+        feed: Some(300.0),
+    };
+    w.arc(&arc(
+        ArcPlane::Xy,
+        false,
+        &[0.0, 10.0, 5.0],
+        [-10.0, 0.0, 7.0],
+    ))
+    .unwrap();
+    // The plane is written when it changes; the centre words in I J K
+    // order; a linear block after an arc has its motion word.
+    w.arc(&arc(
+        ArcPlane::Zx,
+        true,
+        &[0.0, 10.0, -5.0],
+        [0.0, 1.0, -5.0],
+    ))
+    .unwrap();
+    w.arc(&arc(ArcPlane::Zx, true, &[0.0, 10.0, 5.0], [0.0, 1.0, 5.0]))
+        .unwrap();
+    w.block(&Block {
+        cl_line: None,
+        motion: Motion::Feed,
+        axes: &[1.0, 10.0, 5.0],
+        feed: Some(300.0),
+    })
+    .unwrap();
+    let text = String::from_utf8(w.finish().unwrap()).unwrap();
+    assert_eq!(
+        text,
+        "G01 X10.000 Y0.000 Z5.000 F300.\n\
+         G17 G03 X0.000 Y10.000 I-10.000 J0.000\n\
+         G18 G02 Z-5.000 I0.000 K-5.000\n\
+         G02 Z5.000 I0.000 K5.000\n\
+         G01 X1.000\n"
+    );
+}
+
+#[test]
+fn a_dialect_without_arc_words_refuses_arc_blocks() {
+    use kinpost_nc::{ArcBlock, ArcPlane, BlockError};
+    let dialect = Dialect::builtin("heidenhain").unwrap();
+    assert!(dialect.arc_words().is_none());
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::linear("Y"),
+        AxisSpec::linear("Z"),
+    ];
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    assert!(!w.writes_arcs());
+    let e = w
+        .arc(&ArcBlock {
+            cl_line: None,
+            plane: ArcPlane::Xy,
+            clockwise: false,
+            axes: &[0.0, 1.0, 0.0],
+            centre_offset: [0.0; 3],
+            feed: None,
+        })
+        .unwrap_err();
+    assert!(matches!(e, BlockError::NoArcWords { .. }), "{e}");
+}
+
+#[test]
+fn an_arc_table_needs_all_its_words() {
+    let e = Dialect::from_toml(
+        "name = \"x\"\nextension = \"nc\"\n[arc]\nclockwise = \"G2\"\n",
+        "x.toml",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("counter_clockwise"), "{e}");
+}

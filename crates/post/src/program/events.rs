@@ -10,15 +10,17 @@ use std::f64::consts::PI;
 use std::io::BufRead;
 
 use kinpost_cl::{
-    Circle, ClEvent, ClReader, CutcomSide, Dwell, Motion, Move, Nurbs, Plane, SpindleSpeed, Vec3,
+    Arc, Circle, ClEvent, ClReader, CutcomSide, Dwell, Motion, Move, Nurbs, Plane, SpindleSpeed,
+    Vec3,
 };
 use kinpost_diag::Severity;
+use kinpost_machine::OutputMode;
 use kinpost_machine::tolerance::DEFAULT_LINTOL_MM;
 use kinpost_nc::Spindle;
 
 use super::{Program, ProgramSink, locate};
 use crate::command::Command;
-use crate::config::InsertMode;
+use crate::config::{ArcMode, FeedMode, InsertMode};
 use crate::cycle::{CycleError, HoleCycle, HoleStep};
 use crate::error::{PostError, ProgramError};
 
@@ -164,7 +166,11 @@ impl Program<'_> {
 
     /// The arc of `pending` to the `GOTO`: points along it within the
     /// chord tolerance (equal angles), each with the tool axis blended from
-    /// the start's to the `GOTO`'s, the last the `GOTO` itself.
+    /// the start's to the `GOTO`'s, the last the `GOTO` itself. Where a
+    /// circular block may be written (see [`Program::native_arc_pieces`]),
+    /// the points of each piece stand between [`Command::ArcBegin`] and
+    /// [`Command::ArcEnd`]: the closed-loop check writes them as one block
+    /// where the machine can.
     fn arc_to<R: BufRead, S: ProgramSink>(
         &mut self,
         pending: PendingArc,
@@ -176,21 +182,86 @@ impl Program<'_> {
             .circle
             .arc(pending.start, goto.point)
             .map_err(|e| PostError::from(locate(reader, ProgramError::Arc(e))))?;
-        let points = arc
-            .sample(self.chord_tolerance_mm())
-            .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
-        let n = points.len();
-        let mut m = *goto;
         let counted = self.report.cl_points;
-        for (k, p) in points.iter().take(n.saturating_sub(1)).enumerate() {
-            m.point = *p;
-            m.axis = blend_axis(pending.axis, goto.axis, (k + 1) as f64 / n as f64);
-            self.goto(&m, reader, sink)?;
+        if let Some(pieces) = self.native_arc_pieces(&arc, &pending, goto, reader)? {
+            // The points of the whole arc, as --arcs linear has them (their
+            // number rounded up to a multiple of the pieces), so that an
+            // arc the check writes as lines is mostly written as there.
+            let segments = arc
+                .segments(self.chord_tolerance_mm())
+                .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
+            let per_piece = segments.div_ceil(pieces.len());
+            let total = (per_piece * pieces.len()) as f64;
+            let mut m = *goto;
+            for (j, piece) in pieces.into_iter().enumerate() {
+                let begin = Command::ArcBegin {
+                    arc: Box::new(piece),
+                    xy_only: self.cutcom_on,
+                };
+                self.command(begin, reader, sink)?;
+                for k in j * per_piece + 1..=(j + 1) * per_piece {
+                    m.point = arc.point_at(k as f64 / total);
+                    self.goto(&m, reader, sink)?;
+                }
+                self.command(Command::ArcEnd, reader, sink)?;
+            }
+        } else {
+            let points = arc
+                .sample(self.chord_tolerance_mm())
+                .map_err(|e| PostError::from(locate(reader, ProgramError::Sample(e))))?;
+            let n = points.len();
+            let mut m = *goto;
+            for (k, p) in points.iter().take(n.saturating_sub(1)).enumerate() {
+                m.point = *p;
+                m.axis = blend_axis(pending.axis, goto.axis, (k + 1) as f64 / n as f64);
+                self.goto(&m, reader, sink)?;
+            }
+            self.goto(goto, reader, sink)?;
         }
-        self.goto(goto, reader, sink)?;
         // The summary counts the CL's points: the arc is its GOTO.
         self.report.cl_points = counted + 1;
         Ok(())
+    }
+
+    /// The pieces of `arc` to offer as circular blocks: none (`None`) with
+    /// `--arcs linear`, tool-centre-point output, a feed mode other than
+    /// `tip` (a circular block has one feed word), a dialect without arc
+    /// words, a rapid, or a tool axis that changes along the arc; the arc
+    /// itself, or half turns where it turns a whole circle or more (a
+    /// full circle is written as two halves: portable, and no controller
+    /// takes a start equal to the end for a point).
+    fn native_arc_pieces<R: BufRead>(
+        &self,
+        arc: &Arc,
+        pending: &PendingArc,
+        goto: &Move,
+        reader: &ClReader<R>,
+    ) -> Result<Option<Vec<Arc>>, PostError> {
+        let c = self.config;
+        if c.arcs != ArcMode::Native
+            || c.output != OutputMode::Joint
+            || c.feed_mode != FeedMode::Tip
+            || self.dialect.arc_words().is_none()
+            || goto.motion != Motion::Feed
+            || pending.axis != goto.axis
+        {
+            return Ok(None);
+        }
+        let full = std::f64::consts::TAU;
+        if arc.sweep_rad() < full - 1e-9 {
+            return Ok(Some(vec![arc.clone()]));
+        }
+        let halves = (2.0 * arc.sweep_rad() / full).round().max(2.0) as usize;
+        let mut pieces = Vec::with_capacity(halves);
+        let mut from = arc.start();
+        for k in 1..=halves {
+            let to = arc.point_at(k as f64 / halves as f64);
+            let piece = Arc::new(from, to, arc.centre(), arc.axis(), 1)
+                .map_err(|e| PostError::from(locate(reader, ProgramError::Arc(e))))?;
+            pieces.push(piece);
+            from = to;
+        }
+        Ok(Some(pieces))
     }
 
     /// A `NURBS`: its points within the chord tolerance, at the feed, with
