@@ -251,24 +251,9 @@ fn operator(c: &mut Cursor<'_>, lang: Lang) -> Option<Op> {
             if two(c, b"**") {
                 return Some(Op::Pow);
             }
-            match ch {
-                b'*' => {
-                    c.i += 1;
-                    return Some(Op::Mul);
-                }
-                b'/' => {
-                    c.i += 1;
-                    return Some(Op::Div);
-                }
-                b'+' => {
-                    c.i += 1;
-                    return Some(Op::Add);
-                }
-                b'-' => {
-                    c.i += 1;
-                    return Some(Op::Sub);
-                }
-                _ => {}
+            if let Some(op) = arithmetic(ch) {
+                c.i += 1;
+                return Some(op);
             }
             for (kw, op) in [
                 ("MOD", Op::Mod),
@@ -303,32 +288,14 @@ fn operator(c: &mut Cursor<'_>, lang: Lang) -> Option<Op> {
             if c.b[c.i..].starts_with(b"<<") {
                 return None;
             }
-            match ch {
-                b'*' => {
-                    c.i += 1;
-                    return Some(Op::Mul);
-                }
-                b'/' => {
-                    c.i += 1;
-                    return Some(Op::Div);
-                }
-                b'+' => {
-                    c.i += 1;
-                    return Some(Op::Add);
-                }
-                b'-' => {
-                    c.i += 1;
-                    return Some(Op::Sub);
-                }
-                b'>' => {
-                    c.i += 1;
-                    return Some(Op::Gt);
-                }
-                b'<' => {
-                    c.i += 1;
-                    return Some(Op::Lt);
-                }
-                _ => {}
+            let single = match ch {
+                b'>' => Some(Op::Gt),
+                b'<' => Some(Op::Lt),
+                _ => arithmetic(ch),
+            };
+            if let Some(op) = single {
+                c.i += 1;
+                return Some(op);
             }
             for (kw, op) in [
                 ("DIV", Op::IntDiv),
@@ -349,15 +316,22 @@ fn operator(c: &mut Cursor<'_>, lang: Lang) -> Option<Op> {
         Lang::Heidenhain => {
             let op = match ch {
                 b'^' => Op::Pow,
-                b'*' => Op::Mul,
-                b'/' => Op::Div,
-                b'+' => Op::Add,
-                b'-' => Op::Sub,
-                _ => return None,
+                _ => arithmetic(ch)?,
             };
             c.i += 1;
             Some(op)
         }
+    }
+}
+
+/// The one-character arithmetic operators every language writes alike.
+fn arithmetic(ch: u8) -> Option<Op> {
+    match ch {
+        b'*' => Some(Op::Mul),
+        b'/' => Some(Op::Div),
+        b'+' => Some(Op::Add),
+        b'-' => Some(Op::Sub),
+        _ => None,
     }
 }
 
