@@ -30,6 +30,9 @@ pub fn write_block<W: io::Write>(
     let mut written = [0.0; 6];
     w.quantize_axes(black_box(values), &mut written);
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(cl_line),
         motion: Motion::Feed,
         axes: black_box(values),

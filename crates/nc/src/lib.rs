@@ -17,8 +17,8 @@
 //! let axes = [AxisSpec::linear("X"), AxisSpec::endless("A"), AxisSpec::linear("Y"),
 //!             AxisSpec::linear("Z"), AxisSpec::rotary("B"), AxisSpec::rotary("C").fixed()];
 //! let mut w = NcWriter::new(&dialect, &axes, Vec::new());
-//! w.block(&Block { cl_line: Some(16), motion: Motion::Feed,
-//!                  axes: &[459.0, 0.0, 8.80694, 361.36839, 0.0, 0.0], feed: Some(250.0) }).unwrap();
+//! let axis_values = [459.0, 0.0, 8.80694, 361.36839, 0.0, 0.0];
+//! w.block(&Block::feed(&axis_values[..], 250.0).with_cl_line(16)).unwrap();
 //! let text = String::from_utf8(w.finish().unwrap()).unwrap();
 //! assert_eq!(text, "X=459.000 Y=8.807 Z361.368 B0.000 A=DC(0.000) F250\n");
 //! ```
@@ -27,6 +27,7 @@
 
 use std::collections::BTreeMap;
 
+mod block;
 mod dialect;
 pub mod interp;
 mod reader;
@@ -34,6 +35,7 @@ mod sanitize;
 mod template;
 mod writer;
 
+pub use block::{ArcMotion, ArcPlane, Block, Motion};
 pub use dialect::{
     ArcWords, BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
     MotionWords, Numbering, TemplateKind, WordFormat, check_template,
@@ -41,7 +43,7 @@ pub use dialect::{
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use kinpost_number::{FormatError, MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};
 pub use minijinja::Value;
-pub use reader::{ReadBlock, ReadProgram, read_program, read_program_full};
+pub use reader::{ReadProgram, read_program, read_program_full};
 pub use template::{
     MAX_TEMPLATE_OUTPUT_BYTES, TEMPLATE_FUEL, TEMPLATE_RECURSION_LIMIT, TemplateError,
     template_span_in_toml,
@@ -113,93 +115,6 @@ impl AxisSpec {
         self.fixed = true;
         self
     }
-}
-
-/// How a block moves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Motion {
-    /// Positioning at rapid traverse (`G0`).
-    Rapid,
-    /// Linear interpolation at the programmed feed (`G1`).
-    Feed,
-}
-
-impl Motion {
-    /// `rapid` or `feed` (the CSV spelling).
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Motion::Rapid => "rapid",
-            Motion::Feed => "feed",
-        }
-    }
-}
-
-/// One motion block to write.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Block<'a> {
-    /// 1-based line of the CL record this block reaches; `None` for a block
-    /// the post inserted (retract, linearization).
-    pub cl_line: Option<usize>,
-    /// Rapid or feed.
-    pub motion: Motion,
-    /// NC values in machine order (one per axis given to [`NcWriter::new`]),
-    /// not yet rounded.
-    pub axes: &'a [f64],
-    /// Feed rate of a feed block (mm/min, or inverse time for a dialect with
-    /// `inverse_time`); ignored on rapid blocks. `None` keeps the last one.
-    pub feed: Option<f64>,
-}
-
-/// The plane of a circular block, in the program's X, Y, Z words.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum ArcPlane {
-    /// XY (`G17`), normal +Z.
-    Xy,
-    /// ZX (`G18`), normal +Y.
-    Zx,
-    /// YZ (`G19`), normal +X.
-    Yz,
-}
-
-impl ArcPlane {
-    /// 0, 1, 2 for XY, ZX, YZ (the order of [`ArcWords::planes`]).
-    pub fn index(self) -> usize {
-        match self {
-            ArcPlane::Xy => 0,
-            ArcPlane::Zx => 1,
-            ArcPlane::Yz => 2,
-        }
-    }
-
-    /// The program axes (0 = X, 1 = Y, 2 = Z) of the plane, in the order
-    /// that makes the normal positive (X Y for XY, Z X for ZX, Y Z for
-    /// YZ), then the normal's.
-    pub fn axes(self) -> [usize; 3] {
-        match self {
-            ArcPlane::Xy => [0, 1, 2],
-            ArcPlane::Zx => [2, 0, 1],
-            ArcPlane::Yz => [1, 2, 0],
-        }
-    }
-}
-
-/// One circular (or helical) block to write: the end point as in a
-/// [`Block`], the centre relative to the start point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ArcBlock<'a> {
-    /// 1-based line of the CL record whose arc this block ends.
-    pub cl_line: Option<usize>,
-    /// The plane.
-    pub plane: ArcPlane,
-    /// Clockwise looking against the plane's normal (`G2`), else `G3`.
-    pub clockwise: bool,
-    /// NC values of the end point in machine order (as in [`Block::axes`]).
-    pub axes: &'a [f64],
-    /// The centre minus the start point on the program's X, Y, Z (mm);
-    /// the two of the plane are written.
-    pub centre_offset: [f64; 3],
-    /// Feed rate (as in [`Block::feed`]).
-    pub feed: Option<f64>,
 }
 
 /// What the header and footer templates get to see.
@@ -463,6 +378,11 @@ pub enum BlockError {
         /// The dialect.
         dialect: String,
     },
+    /// An arc on a rapid block (circles are interpolated at a feed).
+    RapidArc {
+        /// The CL line of the block (`None`: a block the post added).
+        cl_line: Option<usize>,
+    },
     /// Writing failed.
     Io(std::io::Error),
 }
@@ -542,6 +462,13 @@ impl std::fmt::Display for BlockError {
                 f,
                 "dialect `{dialect}` has no [arc] words: its arcs are written as lines"
             ),
+            BlockError::RapidArc { cl_line } => {
+                write!(f, "an arc block at rapid traverse")?;
+                match cl_line {
+                    Some(l) => write!(f, " (CL line {l}): circles are interpolated at a feed"),
+                    None => write!(f, ": circles are interpolated at a feed"),
+                }
+            }
             BlockError::PressureRoundsToZero { word, value } => write!(
                 f,
                 "cannot write {word} = {value}: it would be written as 0 with the dialect's decimals"

@@ -3,33 +3,21 @@
 use kinpost_diag::Diagnostic;
 
 use crate::dialect::{Dialect, DialectKind};
-use crate::{AxisSpec, Motion};
-
-/// One motion block read from a program.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ReadBlock {
-    /// 1-based line in the program.
-    pub line: usize,
-    /// Block number (`N120`), when the line has one.
-    pub number: Option<u64>,
-    /// CL line (CSV `line` column); `None` in NC dialects.
-    pub cl_line: Option<usize>,
-    /// Rapid or feed.
-    pub motion: Motion,
-    /// Axis values in machine order, with modal values carried over;
-    /// `None` for an axis not programmed so far (e.g. a fixed axis). The
-    /// pressure word ([`AxisSpec::pressure`]) is read like a modal axis
-    /// word, also from a line of its own.
-    pub axes: Vec<Option<f64>>,
-    /// Feed in force (the last feed word), `None` before the first.
-    pub feed: Option<f64>,
-}
+use crate::{ArcMotion, ArcPlane, AxisSpec, Block, Motion};
 
 /// A program read back, with the lines that were not motion blocks.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReadProgram {
-    /// The motion blocks.
-    pub blocks: Vec<ReadBlock>,
+    /// The motion blocks, each with its program `line` and, from a CSV
+    /// table, its `cl_line`. Axis values are in machine order, with modal
+    /// values carried over; `None` for an axis not programmed so far (e.g.
+    /// a fixed axis). The pressure word ([`AxisSpec::pressure`]) is read
+    /// like a modal axis word, also from a line of its own. `feed` is the
+    /// feed in force (the last feed word), `None` before the first. A
+    /// circular block (`G2`/`G3` with the dialect's `[arc]` words) has its
+    /// arc: the plane in force, the sense, and the centre words of the
+    /// block (a centre word not written is 0).
+    pub blocks: Vec<Block<Vec<Option<f64>>>>,
     /// 1-based numbers of non-empty lines that were not (only) words of this
     /// dialect: header/footer text, inserts, commands. Comment-only lines and
     /// lines that only set modal words (`G01`, `F250`) are not listed.
@@ -43,7 +31,7 @@ pub fn read_program(
     axes: &[AxisSpec],
     file_name: &str,
     text: &str,
-) -> Result<Vec<ReadBlock>, Diagnostic> {
+) -> Result<Vec<Block<Vec<Option<f64>>>>, Diagnostic> {
     read_program_full(dialect, axes, file_name, text).map(|p| p.blocks)
 }
 
@@ -78,6 +66,12 @@ enum Token {
     RapidLiteral,
     /// `after_axes` words (`R0`): ignored.
     Ignored,
+    /// The circular motion word, clockwise (`G2`) or not (`G3`): modal.
+    Arc(bool),
+    /// A plane selection word (`G17`): modal.
+    Plane(ArcPlane),
+    /// A centre word on program axis 0, 1, 2 (`I`, `J`, `K`).
+    Centre(usize),
 }
 
 struct Candidate {
@@ -159,6 +153,24 @@ impl WordsReader {
         for w in dialect.block.after_axes.split_whitespace() {
             candidates.push(literal(w, Token::Ignored));
         }
+        if let Some(arc) = dialect.arc_words() {
+            candidates.push(literal(&arc.clockwise, Token::Arc(true)));
+            candidates.push(literal(&arc.counter_clockwise, Token::Arc(false)));
+            for (plane, word) in [ArcPlane::Xy, ArcPlane::Zx, ArcPlane::Yz]
+                .into_iter()
+                .zip(&arc.planes)
+            {
+                candidates.push(literal(word, Token::Plane(plane)));
+            }
+            for (k, prefix) in arc.centre.iter().enumerate() {
+                candidates.push(Candidate {
+                    text: prefix.clone(),
+                    suffix: String::new(),
+                    numeric: true,
+                    token: Token::Centre(k),
+                });
+            }
+        }
         candidates.retain(|c| !c.text.is_empty() || c.numeric);
         // Longest first, so that `X=` wins over `X` and `FMAX` over `F`.
         candidates.sort_by_key(|c| std::cmp::Reverse(c.text.len()));
@@ -189,6 +201,9 @@ impl WordsReader {
         let mut state: Vec<Option<f64>> = vec![None; self.n_axes];
         let mut motion = self.initial_motion;
         let mut feed: Option<f64> = None;
+        // The circular motion in force (clockwise or not) and the plane.
+        let mut circle: Option<bool> = None;
+        let mut plane = ArcPlane::Xy;
         let mut words: Vec<(Token, f64)> = Vec::new();
         for (index, raw_line) in text.lines().enumerate() {
             let line_no = index + 1;
@@ -214,6 +229,7 @@ impl WordsReader {
             }
             let mut block_motion = None;
             let mut has_axis = false;
+            let mut centre = [0.0; 3];
             for &(t, v) in &words {
                 match t {
                     Token::Axis(i) => {
@@ -222,19 +238,36 @@ impl WordsReader {
                     }
                     Token::Pressure(i) => state[i] = Some(v),
                     Token::Feed => feed = Some(v),
-                    Token::Motion(m) => motion = m,
+                    Token::Motion(m) => {
+                        motion = m;
+                        circle = None;
+                    }
                     Token::RapidLiteral => block_motion = Some(Motion::Rapid),
                     Token::Ignored => {}
+                    Token::Arc(clockwise) => {
+                        motion = Motion::Feed;
+                        circle = Some(clockwise);
+                    }
+                    Token::Plane(p) => plane = p,
+                    Token::Centre(k) => centre[k] = v,
                 }
             }
             if has_axis {
-                program.blocks.push(ReadBlock {
-                    line: line_no,
+                let motion = block_motion.unwrap_or(motion);
+                program.blocks.push(Block {
+                    line: Some(line_no),
                     number,
                     cl_line: None,
-                    motion: block_motion.unwrap_or(motion),
+                    motion,
                     axes: state.clone(),
                     feed,
+                    arc: circle
+                        .filter(|_| motion == Motion::Feed)
+                        .map(|clockwise| ArcMotion {
+                            plane,
+                            clockwise,
+                            centre_offset: centre,
+                        }),
                 });
             }
         }
@@ -441,13 +474,14 @@ fn read_csv(
                 ),
             ));
         }
-        let mut block = ReadBlock {
-            line: line_no,
-            number: None,
+        let mut block = Block {
             cl_line: None,
+            line: Some(line_no),
+            number: None,
             motion: Motion::Feed,
             axes: vec![None; axes.len()],
             feed: None,
+            arc: None,
         };
         for (k, (f, col)) in fields.iter().zip(cols).enumerate() {
             let v = f.trim();

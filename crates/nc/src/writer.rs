@@ -10,7 +10,7 @@ use crate::dialect::{
     CommentSyntax, Dialect, DialectKind, MAX_LEAD, MAX_SUFFIX, Numbering, TemplateKind,
 };
 use crate::template;
-use crate::{AxisSpec, Block, BlockError, Motion, NcError, NumbersRunOut, ProgramInfo};
+use crate::{ArcMotion, AxisSpec, Block, BlockError, Motion, NcError, NumbersRunOut, ProgramInfo};
 use kinpost_number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 
 /// Spindle state for [`NcWriter::spindle`].
@@ -437,17 +437,15 @@ impl<W: Write> NcWriter<W> {
         self.arc.is_some()
     }
 
-    /// Writes one circular block: the plane word when the plane changes,
-    /// the arc word, the axis words of the end point that change (as
-    /// [`NcWriter::block`] does), the two centre words of the plane
-    /// (relative to the start point) and the feed word. The next linear
-    /// block writes its motion word. Fails for a dialect without `[arc]`
-    /// words and as [`NcWriter::block`] does.
-    pub fn arc(&mut self, block: &crate::ArcBlock) -> Result<(), BlockError> {
-        if block.axes.len() != self.formats.len() {
-            return Err(BlockError::AxisCount {
-                got: block.axes.len(),
-                want: self.formats.len(),
+    /// Writes a circular block ([`NcWriter::block`] with an arc): the
+    /// plane word when the plane changes, the arc word, the axis words of
+    /// the end point that change, the two centre words of the plane
+    /// (relative to the start point) and the feed word. The next straight
+    /// block writes its motion word.
+    fn arc(&mut self, block: &Block<&[f64]>, circle: &ArcMotion) -> Result<(), BlockError> {
+        if block.motion == Motion::Rapid {
+            return Err(BlockError::RapidArc {
+                cl_line: block.cl_line,
             });
         }
         let Some(mut arc) = self.arc.take() else {
@@ -455,22 +453,33 @@ impl<W: Write> NcWriter<W> {
                 dialect: self.dialect_name.clone(),
             });
         };
-        let done = self.arc_line(&mut arc, block);
+        // A new pressure goes on its line before the arc, as before a
+        // straight block.
+        if let Err(e) = self.pressure_line(block) {
+            self.arc = Some(arc);
+            return Err(e);
+        }
+        let done = self.arc_line(&mut arc, block, circle);
         self.arc = Some(arc);
         done
     }
 
-    fn arc_line(&mut self, arc: &mut ArcWords, block: &crate::ArcBlock) -> Result<(), BlockError> {
+    fn arc_line(
+        &mut self,
+        arc: &mut ArcWords,
+        block: &Block<&[f64]>,
+        circle: &ArcMotion,
+    ) -> Result<(), BlockError> {
         for (k, w) in self.words.iter().enumerate() {
             let v = block.axes[w.index];
             self.units[k] = w.units(v).map_err(|e| self.bad_value(w.index, v, e))?;
         }
         // The centre words in the order I, J, K.
-        let [a, b, _] = block.plane.axes();
+        let [a, b, _] = circle.plane.axes();
         let (a, b) = (a.min(b), a.max(b));
         let mut centre = [0i64; 2];
         for (c, axis) in centre.iter_mut().zip([a, b]) {
-            let v = block.centre_offset[axis];
+            let v = circle.centre_offset[axis];
             *c = arc.centre[axis]
                 .fmt
                 .units(v)
@@ -502,11 +511,11 @@ impl<W: Write> NcWriter<W> {
             line.put(t);
             *first = false;
         };
-        if arc.plane != Some(block.plane) && !arc.planes[block.plane.index()].is_empty() {
-            put(line, &arc.planes[block.plane.index()], &mut first);
+        if arc.plane != Some(circle.plane) && !arc.planes[circle.plane.index()].is_empty() {
+            put(line, &arc.planes[circle.plane.index()], &mut first);
         }
-        arc.plane = Some(block.plane);
-        let word = if block.clockwise {
+        arc.plane = Some(circle.plane);
+        let word = if circle.clockwise {
             &arc.clockwise
         } else {
             &arc.counter_clockwise
@@ -1069,18 +1078,30 @@ impl<W: Write> NcWriter<W> {
     /// Writes one motion block. Modal words that did not change are left
     /// out; a block in which no axis word would be written is skipped
     /// entirely (with non-modal axis words every block is written; a CSV
-    /// row is written for every block).
+    /// row is written for every block). A block with an arc is written as
+    /// a circular block (see [`NcWriter::writes_arcs`]). The block's `line`
+    /// is not read (the writer knows its own lines).
     /// Fails for a wrong number of axis values, a value that is not finite
-    /// or too large to write, a line longer than the dialect allows, or the
-    /// output.
+    /// or too large to write, a line longer than the dialect allows, an arc
+    /// on a rapid block or for a dialect without arc words, or the output.
     #[inline(always)]
-    pub fn block(&mut self, block: &Block) -> Result<(), BlockError> {
+    pub fn block<A: AsRef<[f64]>>(&mut self, block: &Block<A>) -> Result<(), BlockError> {
+        let block = block.map_axes(|a| a.as_ref());
         if block.axes.len() != self.formats.len() {
             return Err(BlockError::AxisCount {
                 got: block.axes.len(),
                 want: self.formats.len(),
             });
         }
+        if let Some(circle) = &block.arc {
+            return self.arc(&block, circle);
+        }
+        self.straight(&block)
+    }
+
+    /// A straight block (see [`NcWriter::block`]), its axis count checked.
+    #[inline(always)]
+    fn straight(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         if self.kind == DialectKind::Csv {
             return self.csv_block(block);
         }
@@ -1197,7 +1218,7 @@ impl<W: Write> NcWriter<W> {
     /// looked up. Nothing changes (the block number included) when a value
     /// cannot be written.
     #[inline(always)]
-    fn plain_block(&mut self, block: &Block) -> Result<(), BlockError> {
+    fn plain_block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         let write_motion = !self.motion_word(block.motion).is_empty()
             && (!self.motion_modal || self.motion_state != Some(block.motion));
         let number_before = self.next_number;
@@ -1292,7 +1313,7 @@ impl<W: Write> NcWriter<W> {
     /// The pressure word on its own line, when the block's pressure differs
     /// from the last one written (then the `pressure` template, if any, e.g.
     /// a dwell while the wheel settles). NaN: no pressure programmed.
-    fn pressure_line(&mut self, block: &Block) -> Result<(), BlockError> {
+    fn pressure_line(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         let Some(p) = &self.pressure else {
             return Ok(());
         };
@@ -1379,7 +1400,7 @@ impl<W: Write> NcWriter<W> {
         self.out.write_all(&self.buf)
     }
 
-    fn csv_block(&mut self, block: &Block) -> Result<(), BlockError> {
+    fn csv_block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         if !self.csv_header_done {
             self.csv_header()?;
         }

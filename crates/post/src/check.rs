@@ -10,13 +10,13 @@ use kinpost_machine::tolerance::{
     CHECK_SLACK_MM, CHECK_SLACK_RAD, LEVER_PROBE_DEG, REFERENCE_NORMAL_MIN, SECOND_ORDER_MARGIN,
 };
 use kinpost_machine::{Joints, Kinematics, MAX_AXES, Machine, Pose, lever_over};
-use kinpost_nc::{ArcBlock, Block, BlockError};
+use kinpost_nc::{ArcMotion, Block, BlockError};
 use nalgebra::Vector3;
 
 use crate::command::{Command, Pending};
 use crate::error::{CheckError, PostError};
 use crate::motion::{MotionBlock, MotionSink};
-use crate::native_arc::{self, NativeArc, ProgramAxes};
+use crate::native_arc::{self, ProgramAxes};
 use kinpost_diag::{Diagnostic, Located};
 use kinpost_machine::tolerance::NATIVE_ARC_MIN_SAMPLES;
 
@@ -28,8 +28,9 @@ pub trait BlockSink {
     fn round(&mut self, values: &[f64], written: &mut [f64]);
 
     /// A motion block: the machine's axis values (and its pressure, if it
-    /// has a pressure axis) exactly as they were checked.
-    fn block(&mut self, block: &Block) -> Result<(), BlockError>;
+    /// has a pressure axis) exactly as they were checked; a circular block
+    /// (with an arc) only to a sink that [writes arcs](BlockSink::writes_arcs).
+    fn block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError>;
 
     /// A command, in its place among the blocks.
     fn command(&mut self, pending: Pending) -> Result<(), PostError>;
@@ -40,8 +41,8 @@ pub trait BlockSink {
     /// Whether a feed word of `word` writes as 0.
     fn feed_rounds_to_zero(&self, word: f64) -> bool;
 
-    /// Whether this sink writes circular blocks ([`BlockSink::arc`]);
-    /// without, the check hands every arc on as its lines.
+    /// Whether this sink writes circular blocks; without, the check hands
+    /// every arc on as its lines.
     fn writes_arcs(&self) -> bool {
         false
     }
@@ -50,14 +51,6 @@ pub trait BlockSink {
     /// it.
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         offset
-    }
-
-    /// A circular block, its end point and centre as checked.
-    fn arc(&mut self, block: &ArcBlock) -> Result<(), BlockError> {
-        let _ = block;
-        Err(BlockError::NoArcWords {
-            dialect: "(this sink)".to_string(),
-        })
     }
 }
 
@@ -424,13 +417,14 @@ impl<S: BlockSink> Check<S> {
             let held = g.blocks.last().expect("a native arc has blocks");
             let n = self.n;
             self.sink
-                .arc(&ArcBlock {
+                .block(&Block {
                     cl_line: held.cl_line,
-                    plane: block.plane,
-                    clockwise: block.clockwise,
+                    line: None,
+                    number: None,
+                    motion: held.motion,
                     axes: &held.row[..n + usize::from(self.has_pressure)],
-                    centre_offset: block.centre_offset,
                     feed: held.feed,
+                    arc: Some(block),
                 })
                 .map_err(locate)?;
             let stats = &mut self.report.stats;
@@ -446,9 +440,12 @@ impl<S: BlockSink> Check<S> {
             self.sink
                 .block(&Block {
                     cl_line: held.cl_line,
+                    line: None,
+                    number: None,
                     motion: held.motion,
                     axes: &held.row[..n],
                     feed: held.feed,
+                    arc: None,
                 })
                 .map_err(locate)?;
         }
@@ -460,7 +457,7 @@ impl<S: BlockSink> Check<S> {
     /// feed, no pressure axis, every free axis but X, Y, Z as at the start, the
     /// arc in a program plane there, and the block as written within the
     /// tolerance of the CL arc at its sampled points.
-    fn native_block(&self, g: &Gathered) -> Option<(NativeArc, f64)> {
+    fn native_block(&self, g: &Gathered) -> Option<(ArcMotion, f64)> {
         // (A machine with a pressure word writes it on a line of its own
         // before the block that changes it: its arcs stay lines.)
         if self.has_pressure {
@@ -571,9 +568,12 @@ impl<S: BlockSink> MotionSink for Check<S> {
         self.sink
             .block(&Block {
                 cl_line: b.cl_line,
+                line: None,
+                number: None,
                 motion: b.motion,
                 axes: &row[..n + usize::from(self.has_pressure)],
                 feed: b.feed,
+                arc: None,
             })
             .map_err(|e| PostError::from(b.site.locate(e)))?;
         Ok(lever)

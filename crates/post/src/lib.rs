@@ -87,7 +87,7 @@ pub use kinpost_machine::tolerance::{
 pub use kinpost_nc as nc;
 pub use kinpost_plan as plan;
 pub use machine_templates::check_machine_templates;
-pub use readback::{ReadBack, ReadBackError, WrittenBlock, compare_read_back};
+pub use readback::{ReadBack, ReadBackError, compare_read_back};
 pub use setup::axis_specs;
 pub use sink::{Event, Recorded};
 pub use summary::Summary;

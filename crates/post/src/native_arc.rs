@@ -18,7 +18,7 @@ use kinpost_machine::tolerance::{
     NATIVE_ARC_PLANE_COS, NATIVE_ARC_RADIUS_MISMATCH_MM, NATIVE_ARC_RIGID,
 };
 use kinpost_machine::{Kinematics, MAX_AXES, Machine};
-use kinpost_nc::ArcPlane;
+use kinpost_nc::{ArcMotion, ArcPlane};
 use nalgebra::{Matrix3, Vector3};
 
 /// The machine axes that carry the program's X, Y, Z words, and the other
@@ -54,23 +54,11 @@ impl ProgramAxes {
     }
 }
 
-/// A circular block: plane, sense and centre relative to the start.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NativeArc {
-    /// The plane (G17, G18, G19).
-    pub plane: ArcPlane,
-    /// Clockwise looking against the plane's normal (`G2`).
-    pub clockwise: bool,
-    /// The centre minus the start on the program's X, Y, Z, mm (the
-    /// component along the plane's normal is not written).
-    pub centre_offset: [f64; 3],
-}
-
 /// The circular block of `arc` (part frame) from machine values `start`
 /// (as written), if the arc lies in a program plane at these rotary
 /// values; `None` when the linear axes are not a rigid map there or the
 /// arc's normal is not along X, Y or Z of the program.
-pub fn fit(kin: &Kinematics, axes: &ProgramAxes, arc: &Arc, start: &[f64]) -> Option<NativeArc> {
+pub fn fit(kin: &Kinematics, axes: &ProgramAxes, arc: &Arc, start: &[f64]) -> Option<ArcMotion> {
     let p0 = kin.fk(start).point;
     let mut q = [0.0; MAX_AXES];
     q[..start.len()].copy_from_slice(start);
@@ -97,7 +85,7 @@ pub fn fit(kin: &Kinematics, axes: &ProgramAxes, arc: &Arc, start: &[f64]) -> Op
     // turns the sense over.
     let counter_clockwise = (normal[k] > 0.0) != (m.determinant() < 0.0);
     let centre = m.transpose() * (Vector3::from(arc.centre()) - p0);
-    Some(NativeArc {
+    Some(ArcMotion {
         plane,
         clockwise: !counter_clockwise,
         centre_offset: [centre.x, centre.y, centre.z],
@@ -117,7 +105,7 @@ pub fn deviation_mm(
     arc: &Arc,
     start: &[f64],
     end: &[f64],
-    native: &NativeArc,
+    native: &ArcMotion,
     samples: usize,
 ) -> f64 {
     let [a, b, h] = native.plane.axes();

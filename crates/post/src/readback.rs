@@ -6,9 +6,7 @@
 use std::io::Write;
 
 use kinpost_diag::Diagnostic;
-use kinpost_nc::{
-    AxisSpec, Block, BlockError, Dialect, Motion, NcWriter, ProgramInfo, read_program,
-};
+use kinpost_nc::{AxisSpec, Block, BlockError, Dialect, NcWriter, ProgramInfo, read_program};
 
 use crate::check::BlockSink;
 use crate::command::Pending;
@@ -63,25 +61,16 @@ impl<W: Write> Write for Tee<W> {
     }
 }
 
-/// A block as written: its line in the program, its motion and its values
-/// rounded as written (NaN: no value, e.g. no pressure programmed).
-#[derive(Debug, Clone, PartialEq)]
-pub struct WrittenBlock {
-    /// 1-based line of the program.
-    pub line: usize,
-    /// Rapid or feed.
-    pub motion: Motion,
-    /// The values, machine order, rounded as written.
-    pub values: Vec<f64>,
-}
-
 /// An NC writer whose program is read back at [`ProgramWriter::finish`]
 /// (see the module's documentation).
 pub struct ReadBack<W: Write> {
     writer: NcWriter<Tee<W>>,
     dialect: Dialect,
     axes: Vec<AxisSpec>,
-    written: Vec<WrittenBlock>,
+    /// The blocks as written: their program line, their values rounded as
+    /// written (NaN: no value, e.g. no pressure programmed), their arc's
+    /// centre offset too.
+    written: Vec<Block<Vec<f64>>>,
 }
 
 /// The program `text` read with `dialect`'s reader against the blocks the
@@ -92,37 +81,51 @@ pub struct ReadBack<W: Write> {
 pub fn compare_read_back(
     dialect: &Dialect,
     axes: &[AxisSpec],
-    written: &[WrittenBlock],
+    written: &[Block<Vec<f64>>],
     text: &str,
 ) -> Result<(), ReadBackError> {
     let read = read_program(dialect, axes, "read-back", text)
         .map_err(|d| ReadBackError::Unreadable(Box::new(d)))?;
     let mut at = read.iter().peekable();
     for (index, w) in written.iter().enumerate() {
-        while at.next_if(|r| r.line < w.line).is_some() {}
-        let Some(r) = at.next_if(|r| r.line == w.line) else {
-            return Err(ReadBackError::Missing {
-                index,
-                line: w.line,
-            });
+        let line = w.line.unwrap_or(0);
+        while at.next_if(|r| r.line < Some(line)).is_some() {}
+        let Some(r) = at.next_if(|r| r.line == Some(line)) else {
+            return Err(ReadBackError::Missing { index, line });
         };
-        // (An axis the dialect never writes, a locked one, reads back as
-        // no value.)
-        let same = w.motion == r.motion
-            && w.values.iter().zip(&r.axes).all(|(w, r)| match r {
-                Some(r) => w.to_bits() == r.to_bits(),
-                None => true,
-            });
-        if !same {
+        if !reads_as_written(w, r) {
             return Err(ReadBackError::Block {
                 index,
-                line: r.line,
-                written: format!("{:?} {:?}", w.motion, w.values),
-                read: format!("{:?} {:?}", r.motion, r.axes),
+                line,
+                written: format!("{:?} {:?} {:?}", w.motion, w.axes, w.arc),
+                read: format!("{:?} {:?} {:?}", r.motion, r.axes, r.arc),
             });
         }
     }
     Ok(())
+}
+
+/// Whether block `r` as read carries what `w` wrote: the motion, every
+/// value (an axis the dialect never writes, a locked one, reads back as no
+/// value), the arc's plane, sense and the two centre words of its plane.
+fn reads_as_written(w: &Block<Vec<f64>>, r: &Block<Vec<Option<f64>>>) -> bool {
+    let same_values = w.axes.iter().zip(&r.axes).all(|(w, r)| match r {
+        Some(r) => w.to_bits() == r.to_bits(),
+        None => true,
+    });
+    let same_arc = match (&w.arc, &r.arc) {
+        (None, None) => true,
+        (Some(w), Some(r)) => {
+            let [a, b, _] = w.plane.axes();
+            w.plane == r.plane
+                && w.clockwise == r.clockwise
+                && [a, b]
+                    .iter()
+                    .all(|&k| w.centre_offset[k].to_bits() == r.centre_offset[k].to_bits())
+        }
+        _ => false,
+    };
+    w.motion == r.motion && same_values && same_arc
 }
 
 impl<W: Write> ReadBack<W> {
@@ -137,7 +140,7 @@ impl<W: Write> BlockSink for ReadBack<W> {
         self.writer.round(values, written);
     }
 
-    fn block(&mut self, block: &Block) -> Result<(), BlockError> {
+    fn block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         let values = block
             .axes
             .iter()
@@ -155,10 +158,13 @@ impl<W: Write> BlockSink for ReadBack<W> {
         // A block that changes no word is not written.
         let after = self.writer_lines();
         if after > before {
-            self.written.push(WrittenBlock {
-                line: after,
-                motion: block.motion,
-                values,
+            self.written.push(Block {
+                line: Some(after),
+                arc: block.arc.map(|mut arc| {
+                    arc.centre_offset = self.writer.round_centre(arc.centre_offset);
+                    arc
+                }),
+                ..block.map_axes(|_| values)
             });
         }
         Ok(())
@@ -174,6 +180,14 @@ impl<W: Write> BlockSink for ReadBack<W> {
 
     fn feed_rounds_to_zero(&self, word: f64) -> bool {
         self.writer.feed_rounds_to_zero(word)
+    }
+
+    fn writes_arcs(&self) -> bool {
+        self.writer.writes_arcs()
+    }
+
+    fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
+        self.writer.round_centre(offset)
     }
 }
 

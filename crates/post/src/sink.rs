@@ -4,7 +4,7 @@
 
 use std::io::Write;
 
-use kinpost_nc::{ArcBlock, AxisSpec, Block, BlockError, Dialect, Motion, NcWriter, ProgramInfo};
+use kinpost_nc::{AxisSpec, Block, BlockError, Dialect, NcWriter, ProgramInfo};
 
 use crate::check::BlockSink;
 use crate::command::{Command, Pending};
@@ -19,7 +19,7 @@ impl<W: Write> BlockSink for NcWriter<W> {
     // (Inlined into the check as before native arcs: the GOTO-only post
     // keeps its speed.)
     #[inline(always)]
-    fn block(&mut self, block: &Block) -> Result<(), BlockError> {
+    fn block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
         NcWriter::block(self, block)
     }
 
@@ -57,26 +57,14 @@ impl<W: Write> BlockSink for NcWriter<W> {
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         [0, 1, 2].map(|k| self.quantized_centre(k, offset[k]))
     }
-
-    fn arc(&mut self, block: &ArcBlock) -> Result<(), BlockError> {
-        NcWriter::arc(self, block)
-    }
 }
 
 /// What a [`Recorded`] sink received, in order.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Event {
-    /// A block: its CL line, motion, values (unrounded) and feed word.
-    Block {
-        /// CL line (`None`: a block the post inserted).
-        cl_line: Option<usize>,
-        /// Rapid or feed.
-        motion: Motion,
-        /// The values as handed over (the pressure last, if any).
-        axes: Vec<f64>,
-        /// The feed word of a feed block.
-        feed: Option<f64>,
-    },
+    /// A block as handed over: its values unrounded, the pressure last
+    /// if any.
+    Block(Block<Vec<f64>>),
     /// A command.
     Command(Command),
     /// Inverse time on or off.
@@ -103,14 +91,9 @@ impl Recorded {
     }
 
     /// The blocks received, in order.
-    pub fn blocks(&self) -> impl Iterator<Item = (Option<usize>, Motion, &[f64])> + '_ {
+    pub fn blocks(&self) -> impl Iterator<Item = &Block<Vec<f64>>> + '_ {
         self.events.iter().filter_map(|e| match e {
-            Event::Block {
-                cl_line,
-                motion,
-                axes,
-                ..
-            } => Some((*cl_line, *motion, axes.as_slice())),
+            Event::Block(b) => Some(b),
             _ => None,
         })
     }
@@ -124,13 +107,9 @@ impl BlockSink for Recorded {
         }
     }
 
-    fn block(&mut self, block: &Block) -> Result<(), BlockError> {
-        self.events.push(Event::Block {
-            cl_line: block.cl_line,
-            motion: block.motion,
-            axes: block.axes.to_vec(),
-            feed: block.feed,
-        });
+    fn block(&mut self, block: &Block<&[f64]>) -> Result<(), BlockError> {
+        self.events
+            .push(Event::Block(block.map_axes(|a| a.to_vec())));
         Ok(())
     }
 

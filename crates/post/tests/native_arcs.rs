@@ -7,13 +7,14 @@
 //! within the chord tolerance (plus 1e-4 mm) of the linear path. Arcs in
 //! each plane, both senses, full circles and helices, on a three-axis
 //! mill and a 3+2 trunnion, and the arcs of the real CL files of
-//! `data/cl`; arcs in a plane of no program axis stay lines.
+//! `data/cl`; arcs in a plane of no program axis stay lines. Every program
+//! is also read back through the read-back stage.
 
 use std::path::{Path, PathBuf};
 
 use kinpost_post::machine::{Machine, builtin, machine_from_toml};
 use kinpost_post::nc::Dialect;
-use kinpost_post::{ArcMode, PostOptions, post};
+use kinpost_post::{ArcMode, PostOptions, post_read_back};
 
 /// The chord tolerance of the linear programs, mm.
 const LINTOL_MM: f64 = 0.002;
@@ -34,9 +35,11 @@ fn post_cl(cl: &str, machine: &Machine, dialect: &str, arcs: ArcMode) -> String 
         ..Default::default()
     };
     let dialect = Dialect::builtin(dialect).unwrap();
-    let mut out = Vec::new();
-    let summary = post(cl.as_bytes(), machine, &dialect, &mut out, &options)
+    // Through the read-back stage: every block, circular ones too, reads
+    // back with the dialect's reader as it was written.
+    let (out, summary) = post_read_back(cl.as_bytes(), machine, &dialect, Vec::new(), &options)
         .unwrap_or_else(|e| panic!("{e}"));
+    let out = out.unwrap_or_else(|e| panic!("{}: {e}", dialect.name()));
     assert!(summary.max_position_error_mm <= summary.tolerance_mm);
     String::from_utf8(out).unwrap()
 }
@@ -455,9 +458,15 @@ fn tool_centre_point_output_writes_lines() {
     };
     let dialect = Dialect::builtin("linuxcnc").unwrap();
     let run = |arcs| {
-        let mut out = Vec::new();
-        post(cl.as_bytes(), &machine, &dialect, &mut out, &options(arcs)).unwrap();
-        String::from_utf8(out).unwrap()
+        let (out, _) = post_read_back(
+            cl.as_bytes(),
+            &machine,
+            &dialect,
+            Vec::new(),
+            &options(arcs),
+        )
+        .unwrap();
+        String::from_utf8(out.unwrap()).unwrap()
     };
     let native = run(ArcMode::Native);
     assert!(
@@ -597,17 +606,16 @@ fn the_corpus_arcs_read_as_their_lines_in_linuxcnc() {
                 arcs,
                 ..Default::default()
             };
-            let mut out = Vec::new();
             let dialect = Dialect::builtin("linuxcnc").unwrap();
-            post(
+            let (out, _) = post_read_back(
                 cl.as_slice(),
                 &test_machine(machine_name),
                 &dialect,
-                &mut out,
+                Vec::new(),
                 &options,
             )
             .unwrap();
-            String::from_utf8(out).unwrap()
+            String::from_utf8(out.unwrap_or_else(|e| panic!("{file}: {e}"))).unwrap()
         };
         let native = trace(&rs274, &run(ArcMode::Native));
         let linear = trace(&rs274, &run(ArcMode::Linear));

@@ -436,7 +436,7 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
         }
         let Some(&(pose, _)) = next else {
             return Err(TestCaseError::fail(format!(
-                "NC line {}: no CL pose left",
+                "NC line {:?}: no CL pose left",
                 b.line
             )));
         };
@@ -449,7 +449,7 @@ fn posts_at_several_pressures(seed: u64) -> Result<(), TestCaseError> {
         let dp = (got.point - pose.point).norm();
         prop_assert!(
             dp <= summary.tolerance_mm + 1e-8,
-            "NC line {}: {} mm",
+            "NC line {:?}: {} mm",
             b.line,
             dp
         );
@@ -633,7 +633,7 @@ fn tilted_mts1600_job_reads_back_onto_the_cl_at_every_pressure() {
         let blocks = read_program(&d, &kinpost_post::axis_specs(&machine), "job", &nc).unwrap();
         let blocks = &blocks[blocks.len() - reached.len()..];
         for (b, (want, h1)) in blocks.iter().zip(&reached) {
-            assert_eq!(b.axes[6], Some(*h1), "{dialect} line {}", b.line);
+            assert_eq!(b.axes[6], Some(*h1), "{dialect} line {:?}", b.line);
             let q: Vec<f64> = b.axes[..6].iter().map(|v| v.unwrap_or(0.0)).collect();
             let got = Kinematics::new(&mts1600_at(*h1)).fk(&q);
             let dp = (got.point - want.point).norm();

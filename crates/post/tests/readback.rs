@@ -73,7 +73,7 @@ fn every_dialect_reads_back_onto_the_cl() {
                     // The CL itself is rounded to 4 / 7 decimals.
                     assert!(
                         dp <= summary.tolerance_mm + 1e-4 && da <= summary.tolerance_rad + 1e-6,
-                        "{name}/{dialect_name}/{output:?} line {}: {dp} mm, {da} rad",
+                        "{name}/{dialect_name}/{output:?} line {:?}: {dp} mm, {da} rad",
                         b.line
                     );
                 }

@@ -7,11 +7,10 @@
 use kinpost_post::diag::Site;
 use kinpost_post::machine::{Kinematics, builtin};
 use kinpost_post::motion::{MotionBlock, MotionSink, MotionStage};
-use kinpost_post::nc::{Dialect, Motion};
+use kinpost_post::nc::{ArcMotion, ArcPlane, Block, Dialect, Motion};
 use kinpost_post::plan::{Node, PlanSink, Planned};
 use kinpost_post::{
-    Config, Pending, PostError, PostOptions, ReadBackError, WrittenBlock, compare_read_back,
-    post_read_back,
+    Config, Pending, PostError, PostOptions, ReadBackError, compare_read_back, post_read_back,
 };
 use nalgebra::Vector3;
 
@@ -142,6 +141,16 @@ fn every_dialect_reads_back_as_written() {
     }
 }
 
+/// A block as written at program `line`.
+fn written(line: usize, motion: Motion, values: Vec<f64>) -> Block<Vec<f64>> {
+    Block {
+        line: Some(line),
+        number: None,
+        motion,
+        ..Block::rapid(values)
+    }
+}
+
 /// The read-back comparison finds a block that does not read back as
 /// written: a value changed, a block missing, another motion.
 #[test]
@@ -152,16 +161,8 @@ fn a_block_that_does_not_read_back_is_found() {
         kinpost_post::nc::AxisSpec::linear("Y"),
     ];
     let text = "%\nG0 X1.0000 Y2.0000\nG1 X1.5000 F250.0\nM2\n%\n";
-    let written = |y: f64, line: usize, motion| WrittenBlock {
-        line,
-        motion,
-        values: vec![1.5, y],
-    };
-    let first = WrittenBlock {
-        line: 2,
-        motion: Motion::Rapid,
-        values: vec![1.0, 2.0],
-    };
+    let written = |y: f64, line: usize, motion| written(line, motion, vec![1.5, y]);
+    let first = written(2.0, 2, Motion::Rapid).map_axes(|_| vec![1.0, 2.0]);
     let ok = [first.clone(), written(2.0, 3, Motion::Feed)];
     assert!(compare_read_back(&d, &axes, &ok, text).is_ok());
     let value = [first.clone(), written(2.5, 3, Motion::Feed)];
@@ -180,4 +181,61 @@ fn a_block_that_does_not_read_back_is_found() {
         compare_read_back(&d, &axes, &missing, text),
         Err(ReadBackError::Missing { index: 1, line: 4 })
     ));
+}
+
+/// A circular block reads back with its plane, sense and the centre words
+/// of its plane; another centre, sense or plane, or a straight block where
+/// an arc was written, is found.
+#[test]
+fn an_arc_reads_back_as_written() {
+    let d = Dialect::builtin("fanuc").unwrap();
+    let axes = [
+        kinpost_post::nc::AxisSpec::linear("X"),
+        kinpost_post::nc::AxisSpec::linear("Y"),
+        kinpost_post::nc::AxisSpec::linear("Z"),
+    ];
+    let text = "%\nG0 X10.000 Y0.000 Z5.000\nG18 G02 X0.000 Z15.000 I-10.000 K0.000 F300.\nG17 G03 X-10.000 Y0.000 J0.000 I-10.000\nG1 X0.000\nM30\n%\n";
+    let arc = |plane, clockwise, centre_offset| {
+        Some(ArcMotion {
+            plane,
+            clockwise,
+            centre_offset,
+        })
+    };
+    let blocks = |second: Option<ArcMotion>| {
+        let mut b = vec![
+            written(2, Motion::Rapid, vec![10.0, 0.0, 5.0]),
+            written(3, Motion::Feed, vec![0.0, 0.0, 15.0]),
+            written(4, Motion::Feed, vec![-10.0, 0.0, 15.0]),
+            written(5, Motion::Feed, vec![0.0, 0.0, 15.0]),
+        ];
+        b[1].arc = second;
+        // (The centre word along the plane's normal is not written: any
+        // value there reads back.)
+        b[2].arc = arc(ArcPlane::Xy, false, [-10.0, 0.0, 7.0]);
+        b
+    };
+    let good = blocks(arc(ArcPlane::Zx, true, [-10.0, 3.0, 0.0]));
+    compare_read_back(&d, &axes, &good, text).unwrap();
+    for bad in [
+        blocks(arc(ArcPlane::Zx, true, [-10.0, 0.0, 0.5])),
+        blocks(arc(ArcPlane::Zx, false, [-10.0, 0.0, 0.0])),
+        blocks(arc(ArcPlane::Xy, true, [-10.0, 0.0, 0.0])),
+        blocks(None),
+    ] {
+        assert!(
+            matches!(
+                compare_read_back(&d, &axes, &bad, text),
+                Err(ReadBackError::Block {
+                    index: 1,
+                    line: 3,
+                    ..
+                })
+            ),
+            "{bad:?}"
+        );
+    }
+    let mut straight = good.clone();
+    straight[3].arc = arc(ArcPlane::Xy, false, [-10.0, 0.0, 0.0]);
+    assert!(compare_read_back(&d, &axes, &straight, text).is_err());
 }

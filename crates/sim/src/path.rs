@@ -5,7 +5,8 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use kinpost_nc::interp::{MAX_AXES, Plane};
+use kinpost_nc::ArcPlane;
+use kinpost_nc::interp::MAX_AXES;
 
 /// Joint values of every machine axis (NC values with the work offset
 /// applied), machine order; the first `n` entries are meaningful.
@@ -57,12 +58,12 @@ pub struct BlockPath {
 
 /// The machine axes of a plane: its two coordinates and its normal, from
 /// the machine's X, Y, Z axes (`xyz`); `None` when the machine lacks one.
-pub fn plane_axes(plane: Plane, xyz: [Option<usize>; 3]) -> Option<[usize; 3]> {
+pub fn plane_axes(plane: ArcPlane, xyz: [Option<usize>; 3]) -> Option<[usize; 3]> {
     let [x, y, z] = xyz;
     Some(match plane {
-        Plane::Xy => [x?, y?, z?],
-        Plane::Zx => [z?, x?, y?],
-        Plane::Yz => [y?, z?, x?],
+        ArcPlane::Xy => [x?, y?, z?],
+        ArcPlane::Zx => [z?, x?, y?],
+        ArcPlane::Yz => [y?, z?, x?],
     })
 }
 

@@ -1,8 +1,8 @@
 //! Arc geometry: centre from a radius, sweep, full turns, the radius check,
 //! arcs through an intermediate point.
 
-use super::machine::{Tolerances, plane_axes};
-use super::{Arc, Plane};
+use super::machine::Tolerances;
+use super::{Arc, ArcPlane};
 
 /// How the centre of an arc is given.
 #[derive(Debug, Clone, Copy)]
@@ -48,7 +48,7 @@ impl std::fmt::Display for ArcError {
 /// An arc from `start` to `end` (X, Y, Z, mm) in `plane`, with `turns`
 /// extra full turns.
 pub(crate) fn arc(
-    plane: Plane,
+    plane: ArcPlane,
     clockwise: bool,
     start: [f64; 3],
     end: [f64; 3],
@@ -56,7 +56,7 @@ pub(crate) fn arc(
     turns: u32,
     tol: &Tolerances,
 ) -> Result<Arc, ArcError> {
-    let [a, b, n] = plane_axes(plane);
+    let [a, b, n] = plane.axes();
     let (sa, sb, ea, eb) = (start[a], start[b], end[a], end[b]);
     let c = match centre {
         Centre::At(c) => c,
@@ -88,6 +88,7 @@ pub(crate) fn arc(
         plane,
         clockwise,
         centre_mm,
+        start_mm: start,
         radius_mm: r0,
         turns,
         sweep_deg: sweep.to_degrees(),
@@ -165,7 +166,7 @@ pub(crate) fn end_tangent((before, after, arc): LastElement) -> Option<[f64; 3]>
             after[2] - before[2],
         ],
         Some(a) => {
-            let [pa, pb, _] = plane_axes(a.plane);
+            let [pa, pb, _] = a.plane.axes();
             let (ra, rb) = (after[pa] - a.centre_mm[pa], after[pb] - a.centre_mm[pb]);
             let mut t = [0.0; 3];
             // Perpendicular to the radius, in the sense of turning.
@@ -217,24 +218,24 @@ mod tests {
     fn quarter_circles() {
         let s = [1.0, 0.0, 0.0];
         let e = [0.0, 1.0, 0.0];
-        let ccw = arc(Plane::Xy, false, s, e, Centre::Radius(1.0), 0, &tol()).unwrap();
+        let ccw = arc(ArcPlane::Xy, false, s, e, Centre::Radius(1.0), 0, &tol()).unwrap();
         assert!((ccw.centre_mm[0]).abs() < 1e-12 && ccw.centre_mm[1].abs() < 1e-12);
         assert!((ccw.sweep_deg - 90.0).abs() < 1e-9);
         // Clockwise the short way: centre (1, 1), 90°.
-        let cw = arc(Plane::Xy, true, s, e, Centre::Radius(1.0), 0, &tol()).unwrap();
+        let cw = arc(ArcPlane::Xy, true, s, e, Centre::Radius(1.0), 0, &tol()).unwrap();
         assert!((cw.centre_mm[0] - 1.0).abs() < 1e-12 && (cw.centre_mm[1] - 1.0).abs() < 1e-12);
         assert!((cw.sweep_deg - 90.0).abs() < 1e-9);
         // R < 0: the long way round, 270°, centre (1, 1) for CCW.
-        let long = arc(Plane::Xy, false, s, e, Centre::Radius(-1.0), 0, &tol()).unwrap();
+        let long = arc(ArcPlane::Xy, false, s, e, Centre::Radius(-1.0), 0, &tol()).unwrap();
         assert!((long.centre_mm[0] - 1.0).abs() < 1e-12);
         assert!((long.sweep_deg - 270.0).abs() < 1e-9);
         // Full circle by centre, two extra turns.
-        let full = arc(Plane::Xy, true, s, s, Centre::At([0.0, 0.0]), 2, &tol()).unwrap();
+        let full = arc(ArcPlane::Xy, true, s, s, Centre::At([0.0, 0.0]), 2, &tol()).unwrap();
         assert!((full.sweep_deg - 3.0 * 360.0).abs() < 1e-9);
-        assert!(arc(Plane::Xy, true, s, s, Centre::Radius(1.0), 0, &tol()).is_err());
+        assert!(arc(ArcPlane::Xy, true, s, s, Centre::Radius(1.0), 0, &tol()).is_err());
         assert!(
             arc(
-                Plane::Xy,
+                ArcPlane::Xy,
                 true,
                 s,
                 [5.0, 0.0, 0.0],
@@ -246,7 +247,7 @@ mod tests {
         );
         assert!(
             arc(
-                Plane::Xy,
+                ArcPlane::Xy,
                 true,
                 s,
                 [0.0, 2.0, 0.0],

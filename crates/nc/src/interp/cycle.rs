@@ -5,7 +5,7 @@
 //! list of [`Op`]s from the R plane down and back; [`drill`] positions the
 //! tool and runs the ops as moves, dwells and spindle events.
 
-use super::machine::{Machine, plane_axes};
+use super::machine::Machine;
 use super::{CycleRef, SpindleDir};
 
 /// One step of a cycle, along the tool axis.
@@ -54,7 +54,7 @@ pub(crate) struct Hole {
 /// level, raised to the R plane first if it is below and the cycle asks
 /// so), rapids down to the R plane, then runs the ops.
 pub(crate) fn drill(m: &mut Machine<'_>, hole: &Hole) {
-    let [a, b, n] = plane_axes(m.state.plane);
+    let [a, b, n] = m.state.plane.axes();
     let saved = m.cycle;
     m.cycle = Some(hole.cycle);
     let level = |m: &Machine<'_>| m.xyz_pos()[n];

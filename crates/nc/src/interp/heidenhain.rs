@@ -17,11 +17,11 @@ use kinpost_diag::Diagnostic;
 use super::arc::{self, Centre};
 use super::cycle::{self, Hole, Op};
 use super::expr::{self, Cursor, Lang, Operands, Upper};
-use super::machine::{Machine, RotaryMode, plane_axes};
+use super::machine::{Machine, RotaryMode};
 use super::num::{read_number, read_uint};
 use super::source::{Fail, Line, Pos, Source, diagnostic, fail};
 use super::{
-    CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Plane, Report, Sink,
+    ArcPlane, CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Report, Sink,
     SpindleDir, StopKind, WorkOffset,
 };
 use crate::AxisSpec;
@@ -490,9 +490,9 @@ impl<'a> Interp<'a, '_> {
             let w_at = c.i;
             let id = c.ident().map(str::to_ascii_uppercase).unwrap_or_default();
             match id.as_str() {
-                "X" => self.m.set_plane(Plane::Yz),
-                "Y" => self.m.set_plane(Plane::Zx),
-                "Z" => self.m.set_plane(Plane::Xy),
+                "X" => self.m.set_plane(ArcPlane::Yz),
+                "Y" => self.m.set_plane(ArcPlane::Zx),
+                "Z" => self.m.set_plane(ArcPlane::Xy),
                 _ if id.starts_with('S')
                     || id.starts_with('F')
                     || id.starts_with("DL")

@@ -7,8 +7,8 @@ use kinpost_diag::Diagnostic;
 
 use super::source::{Fail, fail};
 use super::{
-    AxisValues, CutterComp, CycleRef, Event, FeedMode, MAX_AXES, ModalState, MotionKind, Move,
-    Options, Plane, Report, Sink, SpindleDir, Step, WorkOffset,
+    ArcPlane, AxisValues, CutterComp, CycleRef, Event, FeedMode, MAX_AXES, ModalState, MotionKind,
+    Move, Options, Report, Sink, SpindleDir, Step, WorkOffset,
 };
 use crate::AxisSpec;
 
@@ -125,7 +125,7 @@ impl<'s> Machine<'s> {
             coolant_mist: false,
             coolant_flood: false,
             tool: None,
-            plane: Plane::Xy,
+            plane: ArcPlane::Xy,
         };
         Machine {
             axes: axes[..n].to_vec(),
@@ -401,10 +401,10 @@ impl<'s> Machine<'s> {
         self.state.offset = new;
     }
 
-    pub fn set_plane(&mut self, p: Plane) {
+    pub fn set_plane(&mut self, p: ArcPlane) {
         if self.state.plane != p {
             self.state.plane = p;
-            self.emit(Event::Plane(p));
+            self.emit(Event::ArcPlane(p));
         }
     }
 
@@ -475,14 +475,6 @@ impl<'s> Machine<'s> {
 
 /// The (first, second, normal) indices into (X, Y, Z) of a plane, in the
 /// right-handed order arcs turn in (G18: Z, X, Y).
-pub(crate) fn plane_axes(p: Plane) -> [usize; 3] {
-    match p {
-        Plane::Xy => [0, 1, 2],
-        Plane::Zx => [2, 0, 1],
-        Plane::Yz => [1, 2, 0],
-    }
-}
-
 /// An angle in [0, 360).
 #[inline]
 pub(crate) fn wrap(v: f64) -> f64 {

@@ -47,8 +47,8 @@ use std::collections::BTreeMap;
 
 use kinpost_diag::Diagnostic;
 
-use crate::AxisSpec;
 use crate::dialect::{Dialect, DialectKind};
+use crate::{ArcMotion, ArcPlane, AxisSpec, Block, Motion};
 
 mod arc;
 mod csv;
@@ -152,28 +152,19 @@ impl std::ops::Index<usize> for AxisValues {
     }
 }
 
-/// Working plane of arcs and cycles.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Plane {
-    /// `G17`: XY, tool along Z.
-    Xy,
-    /// `G18`: ZX, tool along Y.
-    Zx,
-    /// `G19`: YZ, tool along X.
-    Yz,
-}
-
 /// An arc (circular or helical interpolation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arc {
-    /// Plane of the circle.
-    pub plane: Plane,
+    /// ArcPlane of the circle.
+    pub plane: ArcPlane,
     /// Clockwise seen from the positive end of the plane's normal (`G2`,
     /// `DR-`), else counter-clockwise.
     pub clockwise: bool,
     /// Absolute centre in the work coordinate system, mm, as (X, Y, Z); the
     /// coordinate along the plane's normal is the start's.
     pub centre_mm: [f64; 3],
+    /// Start point in the work coordinate system, mm, as (X, Y, Z).
+    pub start_mm: [f64; 3],
     /// Radius at the start, mm.
     pub radius_mm: f64,
     /// Full turns before the last partial one (LinuxCNC `P2` → 1,
@@ -272,7 +263,7 @@ pub struct ModalState {
     /// Tool in the spindle (after the last tool change), if any.
     pub tool: Option<u32>,
     /// Working plane.
-    pub plane: Plane,
+    pub plane: ArcPlane,
 }
 
 /// A drilling cycle a move belongs to.
@@ -318,6 +309,47 @@ impl Move {
     /// The end values as a slice (machine order).
     pub fn axes(&self) -> &[f64] {
         self.end.as_slice()
+    }
+
+    /// The move as the block model has it (the type the post's writers
+    /// take): rapid or feed, the end values, the feed in force on a feed
+    /// move (`None` before the first feed word and on rapids), and an arc's
+    /// plane, sense and centre relative to its start. Where it stands in
+    /// the program is the [`Step`]'s ([`Step::block`]).
+    pub fn block(&self) -> Block<&[f64]> {
+        let rapid = self.kind == MotionKind::Rapid;
+        Block {
+            cl_line: None,
+            line: None,
+            number: None,
+            motion: if rapid { Motion::Rapid } else { Motion::Feed },
+            axes: self.axes(),
+            feed: (!rapid && self.feed > 0.0).then_some(self.feed),
+            arc: match &self.kind {
+                MotionKind::Arc(arc) => Some(ArcMotion {
+                    plane: arc.plane,
+                    clockwise: arc.clockwise,
+                    centre_offset: [0, 1, 2].map(|k| arc.centre_mm[k] - arc.start_mm[k]),
+                }),
+                _ => None,
+            },
+        }
+    }
+}
+
+impl Step {
+    /// The block of a motion step ([`Move::block`]); `None` for the other
+    /// events.
+    pub fn block(&self) -> Option<Block<&[f64]>> {
+        match &self.event {
+            Event::Move(m) => Some(Block {
+                cl_line: self.cl_line,
+                line: Some(self.line),
+                number: self.number,
+                ..m.block()
+            }),
+            _ => None,
+        }
     }
 }
 
@@ -384,7 +416,7 @@ pub enum Event {
     /// Cutter radius compensation changed (reported only).
     CutterComp(CutterComp),
     /// Working plane changed.
-    Plane(Plane),
+    ArcPlane(ArcPlane),
     /// Feed mode changed.
     FeedMode(FeedMode),
     /// The pressure word was programmed (`H1=3000`): axis index and value.

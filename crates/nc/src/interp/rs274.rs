@@ -14,11 +14,11 @@ use std::collections::HashMap;
 use super::arc::{self, Centre};
 use super::cycle::{self, Hole, Op};
 use super::expr::{self, Cursor, Lang, Operands, VACANT, is_vacant};
-use super::machine::{MM_PER_INCH, Machine, RotaryMode, plane_axes};
+use super::machine::{MM_PER_INCH, Machine, RotaryMode};
 use super::num::{read_number, read_uint};
 use super::source::{Fail, Line, Pos, Source, diagnostic, fail};
 use super::{
-    CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Plane, Report, Sink,
+    ArcPlane, CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Report, Sink,
     SpindleDir, StopKind, WorkOffset,
 };
 use crate::AxisSpec;

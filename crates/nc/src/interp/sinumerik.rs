@@ -16,11 +16,11 @@ use kinpost_diag::Diagnostic;
 use super::arc::{self, Centre};
 use super::cycle::{self, Hole, Op};
 use super::expr::{self, Cursor, Lang, Operands, Upper};
-use super::machine::{MM_PER_INCH, Machine, RotaryMode, plane_axes, wrap};
+use super::machine::{MM_PER_INCH, Machine, RotaryMode, wrap};
 use super::num::{read_number, read_uint};
 use super::source::{Fail, Line, Pos, Source, diagnostic, fail};
 use super::{
-    CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Plane, Report, Sink,
+    ArcPlane, CutterComp, CycleRef, Event, FeedMode, MAX_AXES, MotionKind, Options, Report, Sink,
     SpindleDir, StopKind, WorkOffset,
 };
 use crate::AxisSpec;

@@ -88,6 +88,9 @@ fn program(name: &str) -> String {
     w.coolant(Some("flood")).unwrap();
     for (k, (motion, values, feed)) in BLOCKS.iter().enumerate() {
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(10 + k),
             motion: *motion,
             axes: values,
@@ -189,7 +192,7 @@ fn other_lines_are_the_non_motion_lines() {
         let dialect = Dialect::builtin(name).unwrap();
         let text = program(name);
         let p = read_program_full(&dialect, &axes, "demo", &text).unwrap();
-        let motion_lines: Vec<usize> = p.blocks.iter().map(|b| b.line).collect();
+        let motion_lines: Vec<usize> = p.blocks.iter().filter_map(|b| b.line).collect();
         for (i, line) in text.lines().enumerate() {
             let n = i + 1;
             let is_motion = motion_lines.contains(&n);
@@ -234,6 +237,9 @@ fn fanuc_numbering_can_be_turned_on() {
     w.tool_change(3, "T").unwrap();
     for k in 0..3 {
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[k as f64, 1.0],

@@ -212,6 +212,9 @@ fn block_numbers_that_would_overflow_are_an_error() {
     for i in 0..10 {
         let values = [f64::from(i), 0.0, 0.0];
         let block = Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(1),
             motion: Motion::Feed,
             axes: &values,

@@ -10,8 +10,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use kinpost_nc::ArcPlane;
 use kinpost_nc::AxisSpec;
-use kinpost_nc::interp::{Event, Family, MotionKind, Options, Plane, read_all};
+use kinpost_nc::interp::{Event, Family, MotionKind, Options, read_all};
 
 fn rs274() -> Option<PathBuf> {
     if let Some(p) = std::env::var_os("RS274") {
@@ -79,7 +80,7 @@ fn run_rs274(rs274: &Path, program: &str, label: &str) -> Vec<Motion> {
         "{label}: rs274 rejected the program: {stderr}"
     );
     let mut moves = Vec::new();
-    let mut plane = Plane::Xy;
+    let mut plane = ArcPlane::Xy;
     let mut feed = 0.0;
     // rs274 prints program units: inch after G20.
     let mut unit = 1.0;
@@ -96,9 +97,9 @@ fn run_rs274(rs274: &Path, program: &str, label: &str) -> Vec<Motion> {
         match name {
             "SELECT_PLANE" => {
                 plane = match args {
-                    "CANON_PLANE_XY" => Plane::Xy,
-                    "CANON_PLANE_XZ" => Plane::Zx,
-                    "CANON_PLANE_YZ" => Plane::Yz,
+                    "CANON_PLANE_XY" => ArcPlane::Xy,
+                    "CANON_PLANE_XZ" => ArcPlane::Zx,
+                    "CANON_PLANE_YZ" => ArcPlane::Yz,
                     other => panic!("plane {other}"),
                 }
             }
@@ -122,9 +123,9 @@ fn run_rs274(rs274: &Path, program: &str, label: &str) -> Vec<Motion> {
                 // rotation, axis end, a, b, c.
                 let (mut at, mut c) = ([0.0; 6], [f64::NAN; 3]);
                 let [fa, sa, na] = match plane {
-                    Plane::Xy => [0, 1, 2],
-                    Plane::Zx => [2, 0, 1],
-                    Plane::Yz => [1, 2, 0],
+                    ArcPlane::Xy => [0, 1, 2],
+                    ArcPlane::Zx => [2, 0, 1],
+                    ArcPlane::Yz => [1, 2, 0],
                 };
                 at[fa] = v[0] * unit;
                 at[sa] = v[1] * unit;

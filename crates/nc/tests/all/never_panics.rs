@@ -31,6 +31,9 @@ fn program(name: &str) -> String {
         let v = [k as f64 * 1.25, 350.0 + k as f64 * 7.0, -12.5, 0.0, h1];
         let motion = if k == 0 { Motion::Rapid } else { Motion::Feed };
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(k + 1),
             motion,
             axes: &v,
@@ -75,6 +78,9 @@ fn exercise(dialect: &Dialect) {
     let _ = w.header(&ProgramInfo::default(), None);
     let v = [1.0, -400.0, 12.25, 0.0, 3000.0];
     let _ = w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &v,

@@ -165,6 +165,9 @@ fn round_trip(dialect: &Dialect, input: &[(bool, [f64; 6], f64)]) -> Result<(), 
         let motion = if *rapid { Motion::Rapid } else { Motion::Feed };
         w.comment("block (k)").unwrap();
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(k + 1),
             motion,
             axes: &v,
@@ -216,7 +219,7 @@ proptest! {
         for (k, (rapid, v, f)) in input.iter().enumerate() {
             let motion = if *rapid { Motion::Rapid } else { Motion::Feed };
             let cl = (k % 3 != 0).then_some(k);
-            w.block(&Block { cl_line: cl, motion, axes: v, feed: Some(*f) }).unwrap();
+            w.block(&Block { cl_line: cl, motion, ..Block::feed(v, *f) }).unwrap();
         }
         let text = String::from_utf8(w.finish().unwrap()).unwrap();
         let read = read_program(&d, &axes, "rt.csv", &text).unwrap();

@@ -58,6 +58,9 @@ fn golden_qiao_figure28_feed_blocks() {
         let e = if k % 2 == 0 { 3.7e-5 } else { -4.1e-5 };
         let values = [x + e, a - 2.0e-5, y - e, z + e, b + e, 0.0];
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(17 + k),
             motion: Motion::Feed,
             axes: &values,
@@ -85,6 +88,9 @@ fn sinumerik_rapid_then_feed_and_modal_feed() {
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
     let p = [459.0, -90.0, 8.5, 380.0, 10.25, 0.0];
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(10),
         motion: Motion::Rapid,
         axes: &p,
@@ -92,6 +98,9 @@ fn sinumerik_rapid_then_feed_and_modal_feed() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(12),
         motion: Motion::Rapid,
         axes: &p,
@@ -99,6 +108,9 @@ fn sinumerik_rapid_then_feed_and_modal_feed() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(14),
         motion: Motion::Feed,
         axes: &p,
@@ -106,6 +118,9 @@ fn sinumerik_rapid_then_feed_and_modal_feed() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(15),
         motion: Motion::Feed,
         axes: &p,
@@ -113,6 +128,9 @@ fn sinumerik_rapid_then_feed_and_modal_feed() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(16),
         motion: Motion::Feed,
         axes: &p,
@@ -205,6 +223,9 @@ fn figure_28b_header_as_machine_override() {
     let mut f = true;
     for (_, [x, y, z, b, a]) in figure_blocks() {
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[x, a, y, z, b, 0.0],
@@ -281,6 +302,9 @@ fn mts_axes_with_pressure() -> Vec<AxisSpec> {
 /// One feed block at X = `x` with pressure `h1` (NaN: none programmed).
 fn pressure_block<W: std::io::Write>(w: &mut NcWriter<W>, x: f64, h1: f64) {
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[x, 0.0, 8.807, 361.368, 0.0, 0.0, h1],
@@ -372,6 +396,9 @@ pressure = "G04 F2 ; {{ pressure_word }} {{ pressure }}"
     pressure_block(&mut w, 1.0, f64::NAN);
     let e = w
         .block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[1.0, 0.0, 8.807, 361.368, 0.0, 0.0, 3000.0],
@@ -513,6 +540,9 @@ fn user_dialect_heidenhain_like() {
     w.header(&info, None).unwrap();
     w.comment("approach; slowly").unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Rapid,
         axes: &[1.0, 0.0, -2.0, 3.0, 0.0, 0.0],
@@ -520,6 +550,9 @@ fn user_dialect_heidenhain_like() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[1.0, 0.0, -2.5, 3.0, 0.0, 0.0],
@@ -528,6 +561,9 @@ fn user_dialect_heidenhain_like() {
     .unwrap();
     // Nothing changed: no block at all.
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[1.0, 0.0, -2.5, 3.0, 0.0, 0.0],
@@ -535,6 +571,9 @@ fn user_dialect_heidenhain_like() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[1.0, 0.0, -2.5, 3.0004, 0.0, 0.0],
@@ -542,6 +581,9 @@ fn user_dialect_heidenhain_like() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[1.0, 0.0, -2.5, 3.5, 0.0, 0.0],
@@ -612,6 +654,9 @@ footer = "M2\n%"
     w.header(&info, None).unwrap();
     w.comment("a (nested) note").unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Rapid,
         axes: &[0.5, -0.25, 90.0],
@@ -619,6 +664,9 @@ footer = "M2\n%"
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[10.0, -0.25, 90.0],
@@ -626,6 +674,9 @@ footer = "M2\n%"
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[11.0, -0.25, 90.0],
@@ -633,6 +684,9 @@ footer = "M2\n%"
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[12.0, -0.25, 90.0],
@@ -673,6 +727,9 @@ fn csv_rows() {
     w.insert("dropped").unwrap();
     w.tool_change(1, "T").unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(10),
         motion: Motion::Rapid,
         axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
@@ -680,6 +737,9 @@ fn csv_rows() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
@@ -687,6 +747,9 @@ fn csv_rows() {
     })
     .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(17),
         motion: Motion::Feed,
         axes: &[459.0, -90.0, 8.80694, 361.368, 0.0, 0.0],
@@ -744,6 +807,9 @@ fn bad_values_are_errors() {
     let mut w = NcWriter::new(&d, &axes, Vec::new());
     let e = w
         .block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -753,6 +819,9 @@ fn bad_values_are_errors() {
     assert!(e.to_string().contains("X"), "{e}");
     assert!(
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[1e300, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -762,6 +831,9 @@ fn bad_values_are_errors() {
     );
     assert!(
         w.block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: None,
             motion: Motion::Feed,
             axes: &[0.0],
@@ -796,6 +868,9 @@ fn sinumerik_dc_only_for_endless_axes() {
     let mut w = NcWriter::new(&d, &axes, Vec::new());
     let values = [1.0, -30.0, -90.0];
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: Some(1),
         motion: Motion::Feed,
         axes: &values,
@@ -897,6 +972,9 @@ fn outside_tcp_lists_the_commands_written_with_tcp_off() {
 fn z_block(w: &mut NcWriter<Vec<u8>>, motion: Motion, z: f64) {
     let q = [459.0, -90.0, 8.5, z, 10.25, 0.0];
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion,
         axes: &q,
@@ -963,6 +1041,9 @@ fn a_repeated_point_writes_no_block() {
         let mut w = NcWriter::new(&d, &axes, Vec::new());
         for (k, (motion, values, feed)) in blocks.iter().enumerate() {
             w.block(&Block {
+                line: None,
+                number: None,
+                arc: None,
                 cl_line: Some(k + 1),
                 motion: *motion,
                 axes: values,
@@ -1104,6 +1185,9 @@ fn lines_fit_the_dialect_max_line_length() {
     w.comment("a remark longer than twenty").unwrap();
     let e = w
         .block(&Block {
+            line: None,
+            number: None,
+            arc: None,
             cl_line: Some(7),
             motion: Motion::Feed,
             axes: &[1.0, 2.0],
@@ -1135,7 +1219,7 @@ fn fanuc_comments_and_header_names_are_ascii() {
 
 #[test]
 fn arc_blocks_write_plane_arc_and_centre_words() {
-    use kinpost_nc::{ArcBlock, ArcPlane};
+    use kinpost_nc::{ArcMotion, ArcPlane};
     let dialect = Dialect::builtin("fanuc").unwrap();
     let axes = [
         AxisSpec::linear("X"),
@@ -1145,21 +1229,24 @@ fn arc_blocks_write_plane_arc_and_centre_words() {
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
     assert!(w.writes_arcs());
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[10.0, 0.0, 5.0],
         feed: Some(300.0),
     })
     .unwrap();
-    let arc = |plane, clockwise, axes: &'static [f64], centre_offset| ArcBlock {
-        cl_line: Some(3),
-        plane,
-        clockwise,
-        axes,
-        centre_offset,
-        feed: Some(300.0),
+    let arc = |plane, clockwise, axes: &'static [f64], centre_offset| Block {
+        arc: Some(ArcMotion {
+            plane,
+            clockwise,
+            centre_offset,
+        }),
+        ..Block::feed(axes, 300.0).with_cl_line(3)
     };
-    w.arc(&arc(
+    w.block(&arc(
         ArcPlane::Xy,
         false,
         &[0.0, 10.0, 5.0],
@@ -1168,16 +1255,19 @@ fn arc_blocks_write_plane_arc_and_centre_words() {
     .unwrap();
     // The plane is written when it changes; the centre words in I J K
     // order; a linear block after an arc has its motion word.
-    w.arc(&arc(
+    w.block(&arc(
         ArcPlane::Zx,
         true,
         &[0.0, 10.0, -5.0],
         [0.0, 1.0, -5.0],
     ))
     .unwrap();
-    w.arc(&arc(ArcPlane::Zx, true, &[0.0, 10.0, 5.0], [0.0, 1.0, 5.0]))
+    w.block(&arc(ArcPlane::Zx, true, &[0.0, 10.0, 5.0], [0.0, 1.0, 5.0]))
         .unwrap();
     w.block(&Block {
+        line: None,
+        number: None,
+        arc: None,
         cl_line: None,
         motion: Motion::Feed,
         axes: &[1.0, 10.0, 5.0],
@@ -1197,7 +1287,7 @@ fn arc_blocks_write_plane_arc_and_centre_words() {
 
 #[test]
 fn a_dialect_without_arc_words_refuses_arc_blocks() {
-    use kinpost_nc::{ArcBlock, ArcPlane, BlockError};
+    use kinpost_nc::{ArcMotion, ArcPlane, BlockError};
     let dialect = Dialect::builtin("heidenhain").unwrap();
     assert!(dialect.arc_words().is_none());
     let axes = [
@@ -1207,17 +1297,27 @@ fn a_dialect_without_arc_words_refuses_arc_blocks() {
     ];
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
     assert!(!w.writes_arcs());
+    let circle = Some(ArcMotion {
+        plane: ArcPlane::Xy,
+        clockwise: false,
+        centre_offset: [0.0; 3],
+    });
     let e = w
-        .arc(&ArcBlock {
-            cl_line: None,
-            plane: ArcPlane::Xy,
-            clockwise: false,
-            axes: &[0.0, 1.0, 0.0],
-            centre_offset: [0.0; 3],
-            feed: None,
+        .block(&Block {
+            arc: circle,
+            ..Block::feed(&[0.0, 1.0, 0.0], 100.0)
         })
         .unwrap_err();
     assert!(matches!(e, BlockError::NoArcWords { .. }), "{e}");
+    // A circle is a feed move, in every dialect.
+    let mut w = NcWriter::new(&Dialect::builtin("fanuc").unwrap(), &axes, Vec::new());
+    let e = w
+        .block(&Block {
+            arc: circle,
+            ..Block::rapid(&[0.0, 1.0, 0.0])
+        })
+        .unwrap_err();
+    assert!(matches!(e, BlockError::RapidArc { .. }), "{e}");
 }
 
 #[test]

@@ -262,7 +262,7 @@ impl Interp<'_, '_> {
         let Some(pole) = self.cc else {
             return fail(at, 2, "LP needs a pole: program CC first");
         };
-        let [pa, pb, _] = plane_axes(self.m.state.plane);
+        let [pa, pb, _] = self.m.state.plane.axes();
         let p = self.m.xyz_pos();
         let (r0, a0) = (
             (p[pa] - pole[pa]).hypot(p[pb] - pole[pb]),
@@ -304,7 +304,7 @@ impl Interp<'_, '_> {
             return fail(at, 1, "arc with a zero feed rate (no F programmed)");
         }
         let plane = self.m.state.plane;
-        let [pa, pb, pn] = plane_axes(plane);
+        let [pa, pb, pn] = plane.axes();
         let start = self.m.xyz_pos();
         let mut w2 = Contour {
             axis: w.axis,
@@ -576,7 +576,7 @@ impl Interp<'_, '_> {
         let Some(def) = self.cycle.clone() else {
             return fail(at, 1, "cycle call without a cycle definition (CYCL DEF)");
         };
-        let [pa, pb, _] = plane_axes(self.m.state.plane);
+        let [pa, pb, _] = self.m.state.plane.axes();
         let p = self.m.xyz_pos();
         let q = |k: usize| self.q[k];
         let surface = q(203) * self.m.unit();

@@ -252,14 +252,14 @@ impl Interp<'_, '_> {
         Ok(())
     }
 
-    /// Plane, units, compensation, coordinate system, distance and retract
+    /// ArcPlane, units, compensation, coordinate system, distance and retract
     /// modes.
     fn modal_g(&mut self, b: &Block) -> Result<(), Fail> {
         for &(code, at) in &b.g {
             match code {
-                170 => self.m.set_plane(Plane::Xy),
-                180 => self.m.set_plane(Plane::Zx),
-                190 => self.m.set_plane(Plane::Yz),
+                170 => self.m.set_plane(ArcPlane::Xy),
+                180 => self.m.set_plane(ArcPlane::Zx),
+                190 => self.m.set_plane(ArcPlane::Yz),
                 200 => self.m.set_units(true),
                 210 => self.m.set_units(false),
                 400 => self.m.set_cutter_comp(CutterComp::Off),

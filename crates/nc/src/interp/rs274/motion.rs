@@ -160,7 +160,7 @@ impl Interp<'_, '_> {
         let (t, programmed, travel, turned) = self.target(b, false)?;
         let end = [t[x], t[y], t[z]];
         let plane = self.m.state.plane;
-        let [pa, pb, _] = plane_axes(plane);
+        let [pa, pb, _] = plane.axes();
         let letters = [b'I', b'J', b'K'];
         let has_ijk = b.has(letters[pa]) || b.has(letters[pb]);
         let centre = match (b.get(b'R'), has_ijk) {
@@ -205,7 +205,7 @@ impl Interp<'_, '_> {
     /// A drilling cycle block: LinuxCNC's rules (convert_cycle of rs274ngc)
     /// and Fanuc's ("Canned cycle for drilling").
     fn cycle(&mut self, b: &Block, code: u16) -> Result<(), Fail> {
-        let [pa, pb, pn] = plane_axes(self.m.state.plane);
+        let [pa, pb, pn] = self.m.state.plane.axes();
         let xyz = self.m.xyz;
         let (Some(ia), Some(ib), Some(inn)) = (xyz[pa], xyz[pb], xyz[pn]) else {
             return fail(

@@ -558,9 +558,9 @@ impl Interp<'_, '_> {
                 1 => self.set_motion(Motion::Linear),
                 2 => self.set_motion(Motion::Cw),
                 3 => self.set_motion(Motion::Ccw),
-                17 => self.m.set_plane(Plane::Xy),
-                18 => self.m.set_plane(Plane::Zx),
-                19 => self.m.set_plane(Plane::Yz),
+                17 => self.m.set_plane(ArcPlane::Xy),
+                18 => self.m.set_plane(ArcPlane::Zx),
+                19 => self.m.set_plane(ArcPlane::Yz),
                 40 => self.m.set_cutter_comp(CutterComp::Off),
                 41 => self.m.set_cutter_comp(CutterComp::Left),
                 42 => self.m.set_cutter_comp(CutterComp::Right),
@@ -770,7 +770,7 @@ impl Interp<'_, '_> {
         let start = [self.m.pos[x], self.m.pos[y], self.m.pos[z]];
         let end = [target[x], target[y], target[z]];
         let plane = self.m.state.plane;
-        let [pa, pb, _] = plane_axes(plane);
+        let [pa, pb, _] = plane.axes();
         let unit = self.m.unit();
         let tol = self.m.options.tolerances;
         let err = |e: super::super::arc::ArcError| Fail {
@@ -793,14 +793,14 @@ impl Interp<'_, '_> {
                         None => start[k],
                     };
                 }
-                let plane = [Plane::Xy, Plane::Zx, Plane::Yz]
+                let plane = [ArcPlane::Xy, ArcPlane::Zx, ArcPlane::Yz]
                     .into_iter()
                     .find(|p| {
-                        let n = plane_axes(*p)[2];
+                        let n = p.axes()[2];
                         (mid[n] - start[n]).abs() < 1e-9 && (end[n] - start[n]).abs() < 1e-9
                     })
                     .ok_or_else(|| Fail { at, len: 3, message: "CIP through points that are not in a plane XY, ZX or YZ is not supported".into() })?;
-                let [qa, qb, _] = plane_axes(plane);
+                let [qa, qb, _] = plane.axes();
                 let (c, cw) = arc::circle_through(
                     [start[qa], start[qb]],
                     [mid[qa], mid[qb]],
@@ -857,7 +857,7 @@ impl Interp<'_, '_> {
     /// CYCLE81..CYCLE86 at the current position (Sinumerik "Cycles"
     /// programming manual, drilling cycles).
     fn cycle(&mut self, cc: CycleCall) -> Result<(), Fail> {
-        let [pa, pb, pn] = plane_axes(self.m.state.plane);
+        let [pa, pb, pn] = self.m.state.plane.axes();
         let p = self.m.xyz_pos();
         let arg = |k: usize| cc.args.get(k).copied().flatten();
         let fail_arg = |m: String| Fail {
