@@ -1,7 +1,7 @@
 //! Fuzz target: any bytes (as lossy UTF-8) read as an NC program by every
 //! built-in dialect's reader give blocks or a located diagnostic, never a
 //! panic. Run with `cargo +nightly fuzz run nc_program` (seed the corpus
-//! with `crates/post/tests/snapshots/*.snap` and
+//! with `crates/post/tests/all/snapshots/*.snap` and
 //! `data/linuxcnc/*.ngc`).
 
 #![no_main]

@@ -2,7 +2,7 @@
 //! independently of kinpost's chain: the transformation chain eq. 17-25,
 //! the normal transform eq. 26 and the angles of eq. 30. Shared by
 //! `li_eq30.rs` (the `ac-grinder`'s inverse kinematics) and by
-//! `crates/kinpost/tests/li_grinding_path.rs` (a posted grinding path), which
+//! `crates/kinpost/tests/all/li_grinding_path.rs` (a posted grinding path), which
 //! includes this file with `#[path]`.
 //!
 //! The installation offsets L_x, L_y, L_z, the wheel radius r_s1 and the
