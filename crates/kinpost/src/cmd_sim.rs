@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 use kinpost_nc::interp::{Event, Family, MotionKind, Options, Step};
-use kinpost_sim::{ClPath, SimOptions, simulate};
+use kinpost_sim::{ClPath, Cutting, SimOptions, SimReport, simulate_cutting};
+use kinpost_stock::{Design, contour, write_ply, write_stl, write_svg};
 
 use crate::sinks::{deliver, open_outputs};
 use crate::{STDIN_NAME, dialect_of_machine, load_dialect, load_machine, report, usage};
@@ -55,6 +56,44 @@ pub struct SimArgs {
     /// output.
     #[arg(long, value_name = "FILE")]
     blocks: Option<PathBuf>,
+    /// Remove material while replaying: the stock in the part frame,
+    /// `box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX`, `design+ALLOWANCE` (the design
+    /// grown by ALLOWANCE mm; needs --design), or a closed STL file. Needs
+    /// --tool. A rapid that removes material is an error (exit code 3).
+    #[arg(long, value_name = "SPEC", requires = "tool")]
+    stock: Option<String>,
+    /// The tool that cuts the stock, mm and degrees: `flat:D[,FLUTE]`,
+    /// `ball:D[,FLUTE]`, `bull:D,CORNER[,FLUTE]`,
+    /// `drill:D[,POINT_ANGLE[,FLUTE]]`, `wheel:RADIUS,WIDTH[,EDGE]` (the
+    /// belt's contact wheel; its poses need the machine's tool reference),
+    /// `disc:RADIUS,THICKNESS`. A flute length not given is four diameters
+    /// (at least 10 mm).
+    #[arg(long, value_name = "SPEC", requires = "stock")]
+    tool: Option<String>,
+    /// Ray spacing of the stock, mm (default: about 16 million rays for
+    /// the stock's size).
+    #[arg(long, value_name = "MM", requires = "stock")]
+    resolution: Option<f64>,
+    /// The design (closed STL, part frame): the simulated part is compared
+    /// with it along the rays, gouges (material removed below it: exit code
+    /// 3) and residuals (material left above it) beyond --difftol, with
+    /// the blocks that made them.
+    #[arg(long, value_name = "FILE.stl", requires = "stock")]
+    design: Option<PathBuf>,
+    /// Comparison tolerance, mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.01, requires = "design")]
+    difftol: f64,
+    /// Write the simulated part as a binary STL (a watertight mesh of the
+    /// stock as cut).
+    #[arg(long, value_name = "FILE", requires = "stock")]
+    stl_out: Option<PathBuf>,
+    /// Write the simulated part as PLY coloured by its deviation from the
+    /// design (blue residual, green within tolerance, red gouge).
+    #[arg(long, value_name = "FILE", requires = "design")]
+    ply_out: Option<PathBuf>,
+    /// Write a map of the deviation from the design, seen along Z, as SVG.
+    #[arg(long, value_name = "FILE", requires = "design")]
+    svg_out: Option<PathBuf>,
     /// Print no summary on standard error.
     #[arg(long, short)]
     quiet: bool,
@@ -88,6 +127,7 @@ pub fn sim(args: &SimArgs) -> Result<()> {
     }
     let mut sinks = open_sim_outputs(args)?;
     let machine = load_machine(&args.machine)?;
+    let removal = RemovalSetup::load(args)?;
     let family = family(args, machine.post.dialect.as_deref())?;
     let (text, file) = read_program(&args.program)?;
     let cl = match &args.cl {
@@ -111,13 +151,14 @@ pub fn sim(args: &SimArgs) -> Result<()> {
         };
         let bar = progress_bar(args.quiet, &text);
         let mut count = 0u32;
-        let result = simulate(
+        let result = simulate_cutting(
             &text,
             family,
             &file,
             &machine,
             &options,
             cl,
+            removal.as_ref().map(|r| r.cutting.clone()),
             &mut |s: &Step| {
                 if let Some(t) = &mut table {
                     t.step(s);
@@ -138,7 +179,10 @@ pub fn sim(args: &SimArgs) -> Result<()> {
         }
         result
     };
-    let report_ = result.map_err(sim_error)?;
+    let (mut report_, cut) = result.map_err(sim_error)?;
+    if let (Some(setup), Some(cut)) = (&removal, cut) {
+        setup.finish(args, &cut, &mut report_, &mut sinks)?;
+    }
     if let Some(json) = args.json.as_ref().and(sinks.get_mut(0)) {
         json.write_all(report_.to_json().as_bytes())
             .context("cannot write the JSON report")?;
@@ -154,6 +198,80 @@ pub fn sim(args: &SimArgs) -> Result<()> {
         return Err(anyhow::Error::new(Violated));
     }
     Ok(())
+}
+
+/// Material removal as the options ask for it: the stock and tool, and the
+/// design to compare with.
+struct RemovalSetup {
+    cutting: Cutting,
+    description: String,
+    design: Option<Design>,
+}
+
+impl RemovalSetup {
+    /// From `--stock`, `--tool`, `--resolution` and `--design`; `None`
+    /// without `--stock`.
+    fn load(args: &SimArgs) -> Result<Option<RemovalSetup>> {
+        let (Some(stock), Some(tool)) = (&args.stock, &args.tool) else {
+            return Ok(None);
+        };
+        if let Some(r) = args.resolution
+            && !(r.is_finite() && r > 0.0)
+        {
+            return Err(usage(format!(
+                "--resolution {r}: must be a positive number of mm"
+            )));
+        }
+        if !(args.difftol.is_finite() && args.difftol > 0.0) {
+            return Err(usage(format!(
+                "--difftol {}: must be a positive number of mm",
+                args.difftol
+            )));
+        }
+        let tool = crate::sim_stock::parse_tool(tool)?;
+        let mesh = args
+            .design
+            .as_deref()
+            .map(crate::sim_stock::read_mesh)
+            .transpose()?;
+        let (stock, description) =
+            crate::sim_stock::load_stock(stock, args.resolution, mesh.as_ref())?;
+        let design = mesh.map(crate::sim_stock::design).transpose()?;
+        Ok(Some(RemovalSetup {
+            cutting: Cutting::new(stock, tool),
+            description,
+            design,
+        }))
+    }
+
+    /// The report's removal and the files of the part: `--stl-out` (output
+    /// 2 on, after --json and --blocks), `--ply-out`, `--svg-out`.
+    fn finish(
+        &self,
+        args: &SimArgs,
+        cut: &Cutting,
+        report: &mut SimReport,
+        sinks: &mut [crate::sinks::Sink],
+    ) -> Result<()> {
+        let design = self.design.as_ref().map(|d| (d, args.difftol));
+        let (removal, cmp) = cut.report(&self.description, design)?;
+        report.removal = Some(removal);
+        let mut at = usize::from(args.json.is_some()) + usize::from(args.blocks.is_some());
+        let part = (args.stl_out.is_some() || args.ply_out.is_some()).then(|| contour(cut.stock()));
+        if let (Some(_), Some(part)) = (&args.stl_out, &part) {
+            write_stl(part, &mut sinks[at]).context("cannot write --stl-out")?;
+            at += 1;
+        }
+        if let (Some(_), Some(part), Some(cmp)) = (&args.ply_out, &part, &cmp) {
+            write_ply(part, cmp, cut.stock().resolution_mm(), &mut sinks[at])
+                .context("cannot write --ply-out")?;
+            at += 1;
+        }
+        if let (Some(_), Some(cmp)) = (&args.svg_out, &cmp) {
+            write_svg(cut.stock(), cmp, &mut sinks[at]).context("cannot write --svg-out")?;
+        }
+        Ok(())
+    }
 }
 
 /// A progress bar over the program's lines (the line being run; loops go
@@ -197,6 +315,21 @@ fn open_sim_outputs(args: &SimArgs) -> Result<Vec<crate::sinks::Sink>> {
     }
     if let Some(b) = &args.blocks {
         outputs.push(("--blocks", b.as_path()));
+    }
+    for (name, file) in [
+        ("--stl-out", &args.stl_out),
+        ("--ply-out", &args.ply_out),
+        ("--svg-out", &args.svg_out),
+    ] {
+        if let Some(f) = file {
+            outputs.push((name, f.as_path()));
+        }
+    }
+    if let Some(d) = &args.design {
+        inputs.push(("design", d.as_path()));
+    }
+    if let Some(s) = args.stock.as_deref().filter(|s| Path::new(s).is_file()) {
+        inputs.push(("stock", Path::new(s)));
     }
     open_outputs(&inputs, &outputs)
 }

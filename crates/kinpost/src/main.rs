@@ -30,6 +30,7 @@ mod cmd_sim;
 mod cmd_surface;
 mod cmd_wheel;
 mod output;
+mod sim_stock;
 mod sinks;
 
 use sinks::{Sink, deliver, open_outputs};

@@ -43,6 +43,7 @@
 pub mod cl;
 mod collide;
 pub mod path;
+mod removal;
 mod replay;
 pub mod report;
 pub mod tolerance;
@@ -52,8 +53,9 @@ use kinpost_machine::Machine;
 use kinpost_nc::interp::{self, Family, Options, Step};
 
 pub use cl::ClPath;
+pub use removal::Cutting;
 pub use replay::Replay;
-pub use report::{At, ClComparison, Contact, Deviation, Overtravel, SimReport};
+pub use report::{At, ClComparison, Contact, Deviation, Overtravel, Removal, SimReport};
 
 /// Why a program cannot be replayed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -122,6 +124,15 @@ pub enum SimError {
         /// NC line.
         line: usize,
     },
+    /// The tool cannot cut the stock along a block (an invalid pose, a
+    /// wheel without its reference direction, a move too long to sample).
+    #[error("line {line}: material removal: {source}")]
+    Cut {
+        /// NC line.
+        line: usize,
+        /// Why.
+        source: kinpost_stock::CutError,
+    },
     /// More axes than the interpreter handles.
     #[error("the machine has {0} axes; the replay handles at most 12")]
     TooManyAxes(usize),
@@ -179,6 +190,24 @@ pub fn simulate(
     cl: Option<ClPath>,
     on_step: &mut dyn FnMut(&Step),
 ) -> Result<SimReport, SimError> {
+    simulate_cutting(text, family, file, machine, options, cl, None, on_step).map(|(r, _)| r)
+}
+
+/// [`simulate`], removing material from `cutting`'s stock along the way
+/// when given: the stock as cut comes back with the report (whose
+/// `removal` the caller completes, e.g. with the comparison with the
+/// design).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_cutting(
+    text: &str,
+    family: Family,
+    file: &str,
+    machine: &Machine,
+    options: &SimOptions,
+    cl: Option<ClPath>,
+    cutting: Option<Cutting>,
+    on_step: &mut dyn FnMut(&Step),
+) -> Result<(SimReport, Option<Cutting>), SimError> {
     let axes = kinpost_post::axis_specs(machine);
     let mut options = options.clone();
     if options.interp.start.is_none() {
@@ -195,6 +224,9 @@ pub fn simulate(
     }
     let mut tcp_seen = false;
     let mut replay = Replay::new(machine, &options, cl)?;
+    if let Some(c) = cutting {
+        replay = replay.with_cutting(c);
+    }
     let report = interp::run(
         text,
         family,
@@ -208,11 +240,12 @@ pub fn simulate(
         },
     )
     .map_err(SimError::Program)?;
+    let cutting = replay.take_cutting();
     let mut report = replay.finish(&report)?;
     if remapped_tcp && tcp_seen {
         report.assumed.push(
             "M428 switches tool-centre-point control on and M429 off (the remap of LinuxCNC's 5-axis sample configurations, which kinpost's linuxcnc dialect writes)".to_string(),
         );
     }
-    Ok(report)
+    Ok((report, cutting))
 }

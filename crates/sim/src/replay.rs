@@ -6,6 +6,7 @@ use kinpost_nc::interp::{Event, FeedMode, MAX_AXES, MotionKind, Move, Step};
 use crate::cl::ClPath;
 use crate::collide::Worlds;
 use crate::path::{ArcPath, BlockPath, Joints, Shape, plane_axes};
+use crate::removal::Cutting;
 use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport};
 use crate::{SimError, SimOptions, tolerance};
 
@@ -48,6 +49,7 @@ pub struct Replay {
     report: SimReport,
     cl: Option<(ClPath, ClComparison)>,
     worlds: Option<Worlds>,
+    cutting: Option<Cutting>,
     scratch: Vec<f64>,
     untimed_blocks: u64,
     error: Option<SimError>,
@@ -146,10 +148,66 @@ impl Replay {
             report,
             cl,
             worlds,
+            cutting: None,
             scratch: Vec::new(),
             untimed_blocks: 0,
             error: None,
         })
+    }
+
+    /// The replay also removes material: the tool's poses of every block
+    /// are cut from `cutting`'s stock ([`Replay::take_cutting`] gives it
+    /// back).
+    pub fn with_cutting(mut self, cutting: Cutting) -> Replay {
+        self.cutting = Some(cutting);
+        self
+    }
+
+    /// The stock as cut, when the replay removes material.
+    pub fn take_cutting(&mut self) -> Option<Cutting> {
+        self.cutting.take()
+    }
+
+    /// The tool's poses along a block for material removal: its end alone
+    /// when its start is not known; else its start, the points where a
+    /// straight sweep ends (none inside a feed block that turns no rotary
+    /// axis, the arrival of each axis in a rapid that turns none), or
+    /// samples as fine as the CL comparison's along a block that turns a
+    /// rotary axis or an arc, and its end.
+    fn block_poses(&self, path: &BlockPath, started: bool) -> Vec<kinpost_machine::Pose> {
+        let n = self.n;
+        let end = self.kin.fk(&path.to[..n]);
+        if !started {
+            return vec![end];
+        }
+        let start = self.kin.fk(&path.from[..n]);
+        let turns = (0..n).any(|i| self.axes[i].rotary && path.to[i] != path.from[i]);
+        let mut ts: Vec<f64> = match &path.shape {
+            Shape::Joint if !turns => Vec::new(),
+            Shape::Rapid { reach } if !turns => {
+                let mut t: Vec<f64> = reach[..n]
+                    .iter()
+                    .copied()
+                    .filter(|&t| t > 0.0 && t < 1.0)
+                    .collect();
+                t.sort_by(f64::total_cmp);
+                t.dedup();
+                t
+            }
+            _ => {
+                let pieces = self.pieces(path, &(end.point - start.point).norm());
+                (1..pieces).map(|k| k as f64 / pieces as f64).collect()
+            }
+        };
+        let mut q = [0.0; MAX_AXES];
+        let mut poses = Vec::with_capacity(ts.len() + 2);
+        poses.push(start);
+        for t in ts.drain(..) {
+            path.at(t, &mut q);
+            poses.push(self.kin.fk(&q[..n]));
+        }
+        poses.push(end);
+        poses
     }
 
     /// One step of the interpreter.
@@ -242,6 +300,15 @@ impl Replay {
             {
                 self.error = Some(e);
                 return;
+            }
+            if self.cutting.is_some() {
+                let poses = self.block_poses(&path, started);
+                if let Some(c) = &mut self.cutting
+                    && let Err(e) = c.cut(&poses, &at, rapid)
+                {
+                    self.error = Some(e);
+                    return;
+                }
             }
         }
         self.q = path.to;

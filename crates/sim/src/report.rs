@@ -122,13 +122,44 @@ pub struct SimReport {
     pub assumed: Vec<String>,
     /// Warnings with their place (`file:line:column: message`).
     pub warnings: Vec<String>,
+    /// Material removal, when the replay cut a stock.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub removal: Option<Removal>,
+}
+
+/// What the tool removed from the stock, and how the part compares with
+/// the design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Removal {
+    /// How the stock was made (`box:0,0,0,250,80,40`, `design+0.2`, a
+    /// file).
+    pub stock: String,
+    /// Ray spacing, mm.
+    pub resolution_mm: f64,
+    /// Volume removed, mm³.
+    pub removed_volume_mm3: f64,
+    /// Rapid blocks that removed material (errors: a rapid into the
+    /// stock).
+    pub rapid_cuts: Vec<At>,
+    /// The comparison with the design (`--design`): gouges and residuals
+    /// with their blocks, regions, histogram.
+    pub design: Option<kinpost_stock::Report>,
+}
+
+impl Removal {
+    /// Whether the program gouges the design or cuts at rapid traverse.
+    pub fn violated(&self) -> bool {
+        !self.rapid_cuts.is_empty() || self.design.as_ref().is_some_and(|d| d.gouge_max_mm > 0.0)
+    }
 }
 
 impl SimReport {
     /// Whether anything was violated (overtravel, a collision, a rapid into
     /// stock): `kinpost sim` exits with 3.
     pub fn violated(&self) -> bool {
-        !self.overtravel.is_empty() || !self.collisions.is_empty()
+        !self.overtravel.is_empty()
+            || !self.collisions.is_empty()
+            || self.removal.as_ref().is_some_and(Removal::violated)
     }
 
     /// The report as pretty JSON, with a final newline.
@@ -190,6 +221,9 @@ impl SimReport {
         }
         more(&mut s, self.collisions.len(), "collisions");
         more(&mut s, self.near_misses.len(), "near misses");
+        if let Some(r) = &self.removal {
+            r.findings(&mut s);
+        }
         for a in &self.assumed {
             let _ = writeln!(s, "note: assumed {a}");
         }
@@ -218,7 +252,67 @@ impl SimReport {
                 );
             }
         }
+        if let Some(r) = &self.removal {
+            let _ = write!(
+                s,
+                "; {:.3} mm³ removed from {} at {} mm",
+                r.removed_volume_mm3, r.stock, r.resolution_mm
+            );
+            if let Some(d) = &r.design {
+                let _ = write!(
+                    s,
+                    ", gouge {:.4} mm, residual {:.4} mm beyond {} mm",
+                    d.gouge_max_mm, d.residual_max_mm, d.tolerance_mm
+                );
+            }
+        }
         s
+    }
+}
+
+impl Removal {
+    /// The rapid cuts and the deepest gouge and largest residual, a line
+    /// each, for the summary.
+    fn findings(&self, s: &mut String) {
+        use std::fmt::Write as _;
+        for at in self.rapid_cuts.iter().take(SUMMARY_LINES) {
+            let _ = writeln!(
+                s,
+                "error: line {}{}: a rapid removes material (fast feed cut)",
+                at.line,
+                number(at.number)
+            );
+        }
+        more(s, self.rapid_cuts.len(), "rapid cuts");
+        let Some(d) = &self.design else {
+            return;
+        };
+        for (region, what, kind) in [
+            (&d.gouge_max, "error", "gouge"),
+            (&d.residual_max, "note", "residual"),
+        ] {
+            if let Some(r) = region {
+                let _ = writeln!(
+                    s,
+                    "{what}: {}{kind} of {:.4} mm at ({:.3}, {:.3}, {:.3}){}",
+                    r.line.map_or(String::new(), |l| format!(
+                        "line {l}{}: ",
+                        r.block
+                            .as_ref()
+                            .map_or(String::new(), |b| format!(" ({b})"))
+                    )),
+                    r.deviation_mm.abs(),
+                    r.at[0],
+                    r.at[1],
+                    r.at[2],
+                    match (r.line, kind) {
+                        (Some(_), _) => "",
+                        (None, "gouge") => " (no material left along the ray)",
+                        (None, _) => " (uncut stock)",
+                    }
+                );
+            }
+        }
     }
 }
 

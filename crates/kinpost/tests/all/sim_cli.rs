@@ -149,3 +149,230 @@ fn outputs_are_all_or_nothing() {
     assert!(!dir.join("r.json").exists() && !dir.join("b.csv").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A 3-axis program for the material-removal tests: a 4 mm end mill
+/// plunges 0.3 mm into the top of a 40 × 40 × 10 mm box at feed (line 3),
+/// cuts a slot 30 mm long (line 4), then plunges 5 mm at rapid (line 7).
+const SLOT: &str = "G21 G90 G17\nG0 X5 Y10 Z20\nG1 Z9.7 F100\nG1 X35 F500\nG0 Z20\nG0 X20 Y30\nG0 Z5\nG0 Z20\nM2\n";
+
+/// A closed box as an ASCII STL (12 triangles, outward normals).
+fn box_stl(lo: [f64; 3], hi: [f64; 3]) -> String {
+    let c = |i: usize| {
+        [
+            if i & 1 == 0 { lo[0] } else { hi[0] },
+            if i & 2 == 0 { lo[1] } else { hi[1] },
+            if i & 4 == 0 { lo[2] } else { hi[2] },
+        ]
+    };
+    // Faces as corner indices, counter-clockwise seen from outside.
+    let faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut s = String::from("solid box\n");
+    for f in faces {
+        for t in [[f[0], f[1], f[2]], [f[0], f[2], f[3]]] {
+            s += "facet normal 0 0 0\nouter loop\n";
+            for i in t {
+                let p = c(i);
+                s += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
+            }
+            s += "endloop\nendfacet\n";
+        }
+    }
+    s + "endsolid box\n"
+}
+
+fn free3() -> String {
+    root()
+        .join("crates/post/tests/machines/free3.toml")
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The slot and the plunge: the volume a flat end mill sweeps (the slot
+/// and the plunge's cylinder, within the resolution), the
+/// rapid plunge an error at its line, and against the uncut box as the
+/// design the deepest gouge (the plunge's 5 mm) and the slot's 0.3 mm
+/// named by their lines; the part's STL, PLY and SVG are written.
+#[test]
+fn a_slot_and_a_rapid_plunge_are_cut_and_compared_with_the_design() {
+    let dir = temp_dir("removal");
+    std::fs::write(dir.join("slot.ngc"), SLOT).unwrap();
+    std::fs::write(dir.join("box.stl"), box_stl([0.0; 3], [40.0, 40.0, 10.0])).unwrap();
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "slot.ngc",
+            "--machine",
+            &free3(),
+            "--stock",
+            "box:0,0,0,40,40,10",
+            "--tool",
+            "flat:4",
+            "--resolution",
+            "0.1",
+            "--design",
+            "box.stl",
+            "--json",
+            "report.json",
+        ],
+    );
+    assert_exit(&o, 3);
+    let err = stderr(&o);
+    assert!(
+        err.contains("error: line 7: a rapid removes material"),
+        "{err}"
+    );
+    assert!(err.contains("error: line 7: gouge of 5.0"), "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let r = &json["removal"];
+    assert_eq!(r["stock"], "box:0,0,0,40,40,10");
+    assert_eq!(r["resolution_mm"], 0.1);
+    // The slot (4 × 0.3 × 30 and two half discs at its ends) and the
+    // plunge (π · 2² · 5).
+    let pi = std::f64::consts::PI;
+    let want = 4.0 * 0.3 * 30.0 + pi * 4.0 * 0.3 + pi * 4.0 * 5.0;
+    let got = r["removed_volume_mm3"].as_f64().unwrap();
+    assert!((got - want).abs() < 0.02 * want, "{got} against {want}");
+    let rapid = r["rapid_cuts"].as_array().unwrap();
+    assert_eq!(rapid.len(), 1, "{r}");
+    assert_eq!(rapid[0]["line"], 7);
+    let d = &r["design"];
+    assert!(
+        (d["gouge_max_mm"].as_f64().unwrap() - 5.0).abs() < 1e-9,
+        "{d}"
+    );
+    assert_eq!(d["gouge_max"]["line"], 7);
+    // Two regions: the plunge's 5 mm (line 7) and the slot's 0.3 mm (one
+    // region, named by the feed block of its deepest point: line 3 or 4).
+    let regions = d["gouge_regions"].as_array().unwrap();
+    assert_eq!(regions.len(), 2, "{regions:?}");
+    assert_eq!(regions[0]["line"], 7);
+    assert!(
+        [3, 4].contains(&regions[1]["line"].as_u64().unwrap())
+            && (regions[1]["deviation_mm"].as_f64().unwrap() + 0.3).abs() < 1e-9,
+        "{regions:?}"
+    );
+    assert_eq!(d["residual_max_mm"], 0.0);
+    // The part as STL, PLY and SVG (at 1 mm: the files stay small).
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "slot.ngc",
+            "--machine",
+            &free3(),
+            "--stock",
+            "box:0,0,0,40,40,10",
+            "--tool",
+            "flat:4",
+            "--resolution",
+            "1",
+            "--design",
+            "box.stl",
+            "--stl-out",
+            "part.stl",
+            "--ply-out",
+            "part.ply",
+            "--svg-out",
+            "map.svg",
+        ],
+    );
+    assert_exit(&o, 3);
+    let stl = std::fs::read(dir.join("part.stl")).unwrap();
+    let triangles = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
+    assert!(triangles > 12 && stl.len() == 84 + 50 * triangles);
+    assert!(
+        std::fs::read(dir.join("part.ply"))
+            .unwrap()
+            .starts_with(b"ply\n")
+    );
+    let svg = std::fs::read_to_string(dir.join("map.svg")).unwrap();
+    assert!(svg.contains("<svg"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A stock grown from the design by 0.2 mm, and a program that cuts
+/// nothing: a residual of 0.2 mm, no gouge, exit 0.
+#[test]
+fn an_allowance_left_is_a_residual() {
+    let dir = temp_dir("allowance");
+    std::fs::write(dir.join("air.ngc"), "G0 X-20 Y-20 Z30\nG1 X60 F800\nM2\n").unwrap();
+    std::fs::write(dir.join("box.stl"), box_stl([0.0; 3], [40.0, 40.0, 10.0])).unwrap();
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "air.ngc",
+            "--machine",
+            &free3(),
+            "--stock",
+            "design+0.2",
+            "--tool",
+            "ball:6",
+            "--resolution",
+            "0.1",
+            "--design",
+            "box.stl",
+            "--difftol",
+            "0.05",
+            "--json",
+            "-",
+        ],
+    );
+    assert_exit(&o, 0);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &json["removal"];
+    assert_eq!(r["stock"], "design+0.2");
+    assert_eq!(r["removed_volume_mm3"], 0.0);
+    let d = &r["design"];
+    assert_eq!(d["gouge_max_mm"], 0.0);
+    let residual = d["residual_max_mm"].as_f64().unwrap();
+    assert!((residual - 0.2).abs() < 0.1 + 1e-9, "{d}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The removal options: a tool without a stock and a stock without a tool
+/// are usage errors, as are a bad tool, a bad box and `design+` without a
+/// design; nothing is written.
+#[test]
+fn removal_options_are_checked() {
+    let dir = temp_dir("removal-options");
+    std::fs::write(dir.join("slot.ngc"), SLOT).unwrap();
+    let machine = free3();
+    for (extra, want) in [
+        (&["--stock", "box:0,0,0,40,40,10"][..], "--tool"),
+        (&["--tool", "flat:4"][..], "--stock"),
+        (
+            &["--stock", "box:0,0,0,40,40,10", "--tool", "cone:4"][..],
+            "unknown tool kind",
+        ),
+        (
+            &["--stock", "box:0,0,0,40,40,10", "--tool", "flat:-4"][..],
+            "--tool flat:-4",
+        ),
+        (
+            &["--stock", "box:0,0,40,40,10", "--tool", "flat:4"][..],
+            "six numbers",
+        ),
+        (
+            &["--stock", "design+0.2", "--tool", "flat:4"][..],
+            "needs --design",
+        ),
+    ] {
+        let mut args = vec!["sim", "slot.ngc", "--machine", &machine, "--json", "r.json"];
+        args.extend_from_slice(extra);
+        let o = run_in(&dir, &args);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(want), "{extra:?}: {}", stderr(&o));
+        assert!(!dir.join("r.json").exists());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

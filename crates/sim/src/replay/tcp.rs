@@ -124,6 +124,18 @@ impl Replay {
                 w.check(&sub(0, pieces), at, rapid, false, self.pressure)?;
             }
         }
+        if self.cutting.is_some() {
+            // The tool point moves straight under TCP: its samples are the
+            // poses (the start's only once known).
+            let first = if started { 0 } else { pieces };
+            let poses: Vec<_> = joints[first..]
+                .iter()
+                .map(|q| self.kin.fk(&q[..self.n]))
+                .collect();
+            if let Some(c) = &mut self.cutting {
+                c.cut(&poses, at, rapid)?;
+            }
+        }
         Ok(())
     }
 
