@@ -376,3 +376,66 @@ fn removal_options_are_checked() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Five axes and the belt's contact wheel: a straight pass 0.1 mm deep
+/// across a flat blank, posted for `mts1600` and replayed with the wheel
+/// (radius 25 mm, width 25 mm; its axis is the feed direction × the tool
+/// axis, from the machine's tool reference): the volume ground is the
+/// closed form's, width × (length × depth + the circular segment of the
+/// wheel's ends), and against the blank as the design the deepest gouge
+/// is the pass's depth.
+#[test]
+fn a_wheel_pass_grinds_its_closed_form_volume() {
+    let dir = temp_dir("wheel");
+    let mut cl = String::from("TOOL PATH/WHEEL,TOOL,W\nFEDRAT/MMPM,500\n");
+    let goto = |x: f64, z: f64| format!("GOTO/{x:.4},50.0000,{z:.4},0,0,1,1,0,0\n");
+    cl += &goto(-420.0, 20.0);
+    for k in 0..=40 {
+        cl += &goto(-420.0 + 5.0 * f64::from(k), -0.1);
+    }
+    cl += &goto(-220.0, 20.0);
+    std::fs::write(dir.join("pass.cls"), cl).unwrap();
+    std::fs::write(
+        dir.join("blank.stl"),
+        box_stl([-440.0, 0.0, -10.0], [-200.0, 100.0, 0.0]),
+    )
+    .unwrap();
+    let o = run_in(
+        &dir,
+        &["post", "pass.cls", "--machine", "mts1600", "-o", "pass.mpf"],
+    );
+    assert_exit(&o, 0);
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "pass.mpf",
+            "--machine",
+            "mts1600",
+            "--no-collisions",
+            "--stock",
+            "box:-440,0,-10,-200,100,0",
+            "--tool",
+            "wheel:25,25",
+            "--resolution",
+            "0.1",
+            "--design",
+            "blank.stl",
+            "--json",
+            "-",
+        ],
+    );
+    assert_exit(&o, 3);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &json["removal"];
+    let (radius, depth, length, width) = (25.0f64, 0.1f64, 200.0, 25.0);
+    let segment = radius * radius * ((radius - depth) / radius).acos()
+        - (radius - depth) * (2.0 * radius * depth - depth * depth).sqrt();
+    let want = width * (length * depth + segment);
+    let got = r["removed_volume_mm3"].as_f64().unwrap();
+    assert!((got - want).abs() < 0.01 * want, "{got} against {want}");
+    assert!(r["rapid_cuts"].as_array().unwrap().is_empty(), "{r}");
+    let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
+    assert!((gouge - depth).abs() < 1e-6, "{gouge}");
+    std::fs::remove_dir_all(&dir).ok();
+}
