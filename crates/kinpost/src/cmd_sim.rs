@@ -70,6 +70,14 @@ pub struct SimArgs {
     /// (at least 10 mm).
     #[arg(long, value_name = "SPEC", requires = "stock")]
     tool: Option<String>,
+    /// Grind with the belt-grinding process model of this file (TOML:
+    /// `[force]` the pressure word's force table, `[wheel]` Preston's
+    /// coefficient and the wheel's stiffness; `kinpost calibrate` fits
+    /// them): feed blocks of the contact wheel (--tool wheel:…) with the
+    /// spindle on remove Preston's depth at the force the pressure word
+    /// gives, the belt speed the spindle speed gives and the block's feed.
+    #[arg(long, value_name = "FILE.toml", requires = "stock")]
+    process: Option<PathBuf>,
     /// Ray spacing of the stock, mm (default: about 16 million rays for
     /// the stock's size).
     #[arg(long, value_name = "MM", requires = "stock")]
@@ -229,6 +237,18 @@ impl RemovalSetup {
             )));
         }
         let tool = crate::sim_stock::parse_tool(tool)?;
+        let process = match &args.process {
+            None => None,
+            Some(p) => {
+                if !matches!(tool, kinpost_stock::Tool::ContactWheel { .. }) {
+                    return Err(usage(format!(
+                        "--process grinds with the belt's contact wheel: give --tool wheel:RADIUS,WIDTH (not the {})",
+                        tool.name()
+                    )));
+                }
+                Some(crate::sim_stock::read_process(p)?)
+            }
+        };
         let mesh = args
             .design
             .as_deref()
@@ -237,8 +257,12 @@ impl RemovalSetup {
         let (stock, description) =
             crate::sim_stock::load_stock(stock, args.resolution, mesh.as_ref())?;
         let design = mesh.map(crate::sim_stock::design).transpose()?;
+        let mut cutting = Cutting::new(stock, tool);
+        if let Some(model) = process {
+            cutting = cutting.with_process(model);
+        }
         Ok(Some(RemovalSetup {
-            cutting: Cutting::new(stock, tool),
+            cutting,
             description,
             design,
         }))
@@ -330,6 +354,9 @@ fn open_sim_outputs(args: &SimArgs) -> Result<Vec<crate::sinks::Sink>> {
     }
     if let Some(s) = args.stock.as_deref().filter(|s| Path::new(s).is_file()) {
         inputs.push(("stock", Path::new(s)));
+    }
+    if let Some(p) = &args.process {
+        inputs.push(("process file", p.as_path()));
     }
     open_outputs(&inputs, &outputs)
 }

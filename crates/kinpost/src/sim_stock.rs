@@ -158,6 +158,23 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
     Ok(Mesh::read_stl(std::io::BufReader::new(file), &name)?)
 }
 
+/// Largest process file read, bytes: a process file is a few lines.
+const MAX_PROCESS_FILE_BYTES: usize = 1 << 20;
+
+/// The belt-grinding process model of `--process` (located errors).
+pub fn read_process(path: &Path) -> Result<kinpost_stock::ProcessModel> {
+    let text = crate::read_text(path, "process file", MAX_PROCESS_FILE_BYTES)?;
+    if text.len() > MAX_PROCESS_FILE_BYTES {
+        anyhow::bail!(
+            "process file {} is larger than {} bytes",
+            path.display(),
+            MAX_PROCESS_FILE_BYTES
+        );
+    }
+    kinpost_stock::ProcessModel::from_toml(&text, &path.display().to_string())
+        .map_err(crate::report)
+}
+
 /// The design of `--design` as the comparison measures it.
 pub fn design(mesh: Mesh) -> Result<Design> {
     Ok(Design::from_mesh(mesh)?)

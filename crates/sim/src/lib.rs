@@ -133,6 +133,25 @@ pub enum SimError {
         /// Why.
         source: kinpost_stock::CutError,
     },
+    /// The process model cannot grind a block.
+    #[error("line {line}: the grinding process model: {source}")]
+    Grind {
+        /// NC line.
+        line: usize,
+        /// Why.
+        source: kinpost_stock::ProcessError,
+    },
+    /// A feed block ground with the process model before any pressure
+    /// word set the force.
+    #[error(
+        "line {line}: the grinding process model needs the force, and no `{word}` word has set it yet"
+    )]
+    NoPressure {
+        /// NC line.
+        line: usize,
+        /// The pressure word.
+        word: String,
+    },
     /// More axes than the interpreter handles.
     #[error("the machine has {0} axes; the replay handles at most 12")]
     TooManyAxes(usize),

@@ -2,10 +2,14 @@
 //! sampled along the path the machine really takes (joint interpolation,
 //! arcs, tool-centre-point control), are cut from a tri-dexel stock
 //! (`kinpost-stock`); a rapid that removes material is reported, as
-//! VERICUT reports a "fast feed cut".
+//! VERICUT reports a "fast feed cut". With a process model the contact
+//! wheel grinds by Preston's law instead (`kinpost_stock::process`).
 
 use kinpost_machine::Pose;
-use kinpost_stock::{BlockRef, Comparison, Design, DesignError, Stock, Tool, ToolPose, compare};
+use kinpost_stock::{
+    BlockRef, Comparison, Conditions, Design, DesignError, GrindStats, GrindingSummary,
+    ProcessModel, Stock, Tool, ToolPose, compare,
+};
 use nalgebra::{Point3, Unit};
 
 use crate::SimError;
@@ -16,9 +20,25 @@ use crate::report::{At, Removal};
 pub struct Cutting {
     stock: Stock,
     tool: Tool,
+    /// The belt-grinding process model: feed blocks of the contact wheel
+    /// remove Preston's depth instead of the rigid wheel's sweep.
+    process: Option<ProcessModel>,
     /// The block of every move id: move `k` is the `k`-th block cut.
     blocks: Vec<BlockRef>,
     rapid_cuts: Vec<At>,
+    /// What each block ground with the process model.
+    ground: Vec<(u32, GrindStats)>,
+}
+
+/// What the process model needs of a feed block besides its poses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BlockConditions {
+    /// The pressure word in force (NaN: never programmed).
+    pub pressure: f64,
+    /// The spindle (belt drive) speed, rpm; 0 when the spindle is off.
+    pub spindle_rpm: f64,
+    /// The block's time, seconds.
+    pub seconds: f64,
 }
 
 impl Cutting {
@@ -27,9 +47,22 @@ impl Cutting {
         Cutting {
             stock,
             tool,
+            process: None,
             blocks: Vec::new(),
             rapid_cuts: Vec::new(),
+            ground: Vec::new(),
         }
+    }
+
+    /// Feed blocks grind with `model` (the tool must be the contact wheel):
+    /// the normal force from the pressure word through the model's force
+    /// table, the belt speed from the spindle speed, the feed from the
+    /// block's length and time; Preston's depth is removed along the tool
+    /// axis under the contact patch ([`Stock::grind_move`]). Blocks with the
+    /// spindle off, and rapids, cut as the rigid wheel.
+    pub fn with_process(mut self, model: ProcessModel) -> Cutting {
+        self.process = Some(model);
+        self
     }
 
     /// The stock as cut so far.
@@ -66,6 +99,10 @@ impl Cutting {
             design: cmp
                 .as_ref()
                 .map(|c| kinpost_stock::Report::new(stock, &self.stock, c, &self.blocks)),
+            grinding: self
+                .process
+                .as_ref()
+                .map(|_| GrindingSummary::new(&self.ground, &self.blocks)),
         };
         Ok((removal, cmp))
     }
@@ -73,7 +110,14 @@ impl Cutting {
     /// Cuts one block: the tool at `poses` (the block's start first, then
     /// samples along it, its end last; one pose when its start is not
     /// known), swept from each to the next.
-    pub(crate) fn cut(&mut self, poses: &[Pose], at: &At, rapid: bool) -> Result<(), SimError> {
+    /// `conditions`: a feed block's, for the process model.
+    pub(crate) fn cut(
+        &mut self,
+        poses: &[Pose],
+        at: &At,
+        rapid: bool,
+        conditions: Option<BlockConditions>,
+    ) -> Result<(), SimError> {
         let id = u32::try_from(self.blocks.len()).unwrap_or(u32::MAX);
         self.blocks.push(BlockRef {
             block: at.number.map(|n| format!("N{n}")),
@@ -88,6 +132,11 @@ impl Cutting {
         // volume is summed before and after it then.)
         let volume_before = (rapid && self.reaches_stock(&tool_poses).map_err(cut_error)?)
             .then(|| self.stock.volume_mm3());
+        if let Some(c) = conditions.filter(|_| !rapid)
+            && let Some(grinding) = self.grinding_conditions(&tool_poses, &c, at)?
+        {
+            return self.grind(&tool_poses, &grinding, id, at);
+        }
         match tool_poses.as_slice() {
             [] => {}
             [only] => self
@@ -106,6 +155,80 @@ impl Cutting {
             && self.stock.volume_mm3() < before
         {
             self.rapid_cuts.push(at.clone());
+        }
+        Ok(())
+    }
+
+    /// The process model's conditions of a feed block along `poses`, when
+    /// it grinds with the model: a model, the spindle on, the block moving
+    /// in time.
+    fn grinding_conditions(
+        &self,
+        poses: &[ToolPose],
+        c: &BlockConditions,
+        at: &At,
+    ) -> Result<Option<Conditions>, SimError> {
+        let Some(model) = &self.process else {
+            return Ok(None);
+        };
+        let travel_mm: f64 = poses
+            .windows(2)
+            .map(|w| (w[1].point - w[0].point).norm())
+            .sum();
+        if !(c.spindle_rpm > 0.0 && c.seconds > 0.0 && travel_mm > 0.0) {
+            return Ok(None);
+        }
+        if !c.pressure.is_finite() {
+            return Err(SimError::NoPressure {
+                line: at.line,
+                word: model.force.axis.clone(),
+            });
+        }
+        Ok(Some(Conditions {
+            force_n: model.force_n(c.pressure),
+            spindle_rpm: c.spindle_rpm,
+            feed_mm_min: travel_mm / c.seconds * 60.0,
+            // (A pass's depth does not depend on the curvature: it shapes
+            // the contact patch, not the pressure's integral.)
+            curvature_per_mm: 0.0,
+        }))
+    }
+
+    /// Grinds a feed block with the process model, piece by piece.
+    fn grind(
+        &mut self,
+        poses: &[ToolPose],
+        conditions: &Conditions,
+        id: u32,
+        at: &At,
+    ) -> Result<(), SimError> {
+        let Some(model) = &self.process else {
+            return Ok(());
+        };
+        let mut total: Option<GrindStats> = None;
+        for w in poses.windows(2) {
+            let s = self
+                .stock
+                .grind_move(model, &self.tool, &w[0], &w[1], conditions, id)
+                .map_err(|source| SimError::Grind {
+                    line: at.line,
+                    source,
+                })?;
+            total = Some(match total {
+                None => s,
+                Some(t) => GrindStats {
+                    rays: t.rays + s.rays,
+                    removed_volume_mm3: t.removed_volume_mm3 + s.removed_volume_mm3,
+                    depth_range_mm: [
+                        t.depth_range_mm[0].min(s.depth_range_mm[0]),
+                        t.depth_range_mm[1].max(s.depth_range_mm[1]),
+                    ],
+                    ..t
+                },
+            });
+        }
+        if let Some(t) = total {
+            self.ground.push((id, t));
         }
         Ok(())
     }

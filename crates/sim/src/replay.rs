@@ -6,7 +6,7 @@ use kinpost_nc::interp::{Event, FeedMode, MAX_AXES, MotionKind, Move, Step};
 use crate::cl::ClPath;
 use crate::collide::Worlds;
 use crate::path::{ArcPath, BlockPath, Joints, Shape, plane_axes};
-use crate::removal::Cutting;
+use crate::removal::{BlockConditions, Cutting};
 use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport};
 use crate::{SimError, SimOptions, tolerance};
 
@@ -168,6 +168,17 @@ impl Replay {
         self.cutting.take()
     }
 
+    /// A block's conditions for the grinding process model: the pressure
+    /// word in force, the spindle speed when it turns, the block's time.
+    pub(crate) fn conditions(&self, m: &Move, seconds: f64) -> BlockConditions {
+        let turning = m.state.spindle != kinpost_nc::interp::SpindleDir::Off;
+        BlockConditions {
+            pressure: self.pressure,
+            spindle_rpm: if turning { m.state.spindle_speed } else { 0.0 },
+            seconds,
+        }
+    }
+
     /// The tool's poses along a block for material removal: its end alone
     /// when its start is not known; else its start, the points where a
     /// straight sweep ends (none inside a feed block that turns no rotary
@@ -287,7 +298,8 @@ impl Replay {
         let known_before = self.known;
         self.known |= m.programmed & self.all;
         self.check_travel(&path, &at, known_before);
-        self.report.duration_s += self.block_time_s(m, &path, &path);
+        let seconds = self.block_time_s(m, &path, &path);
+        self.report.duration_s += seconds;
         let rapid = m.kind == MotionKind::Rapid;
         let started = known_before == self.all;
         if self.known == self.all {
@@ -303,8 +315,9 @@ impl Replay {
             }
             if self.cutting.is_some() {
                 let poses = self.block_poses(&path, started);
+                let conditions = self.conditions(m, seconds);
                 if let Some(c) = &mut self.cutting
-                    && let Err(e) = c.cut(&poses, &at, rapid)
+                    && let Err(e) = c.cut(&poses, &at, rapid, Some(conditions))
                 {
                     self.error = Some(e);
                     return;

@@ -144,6 +144,10 @@ pub struct Removal {
     /// The comparison with the design (`--design`): gouges and residuals
     /// with their blocks, regions, histogram.
     pub design: Option<kinpost_stock::Report>,
+    /// What the belt-grinding process model predicts (`--process`): the
+    /// force, contact pressure, pass depth and the depth range removed,
+    /// block by block.
+    pub grinding: Option<kinpost_stock::GrindingSummary>,
 }
 
 impl Removal {
@@ -263,6 +267,16 @@ impl SimReport {
                     s,
                     ", gouge {:.4} mm, residual {:.4} mm beyond {} mm",
                     d.gouge_max_mm, d.residual_max_mm, d.tolerance_mm
+                );
+            }
+            if let Some(g) = &r.grinding {
+                let _ = write!(
+                    s,
+                    "; the process model ground {:.3} mm³ in {} blocks ({:.4} to {:.4} mm a block)",
+                    g.removed_volume_mm3,
+                    g.blocks.len(),
+                    g.depth_range_mm[0],
+                    g.depth_range_mm[1]
                 );
             }
         }

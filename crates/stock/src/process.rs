@@ -317,6 +317,10 @@ pub struct GrindStats {
     pub rays: u64,
     /// Smallest and largest depth removed at a ray, along the tool axis, mm.
     pub depth_range_mm: [f64; 2],
+    /// Volume ground away, mm³: the length removed from every ray times
+    /// its cross-section.
+    #[serde(default)]
+    pub removed_volume_mm3: f64,
 }
 
 /// Operating conditions of a grinding move.
@@ -431,17 +435,19 @@ impl Stock {
             pass_depth_mm: model.pass_depth_mm(conditions.force_n, belt, feed, width),
             rays: 0,
             depth_range_mm: [0.0, 0.0],
+            removed_volume_mm3: 0.0,
         };
         let (Some((u0, u1)), Some((v0, v1))) = (range(u), range(v)) else {
             return Ok(stats);
         };
         let p0 = from.point.coords;
-        let per_row: Vec<(u64, f64, f64)> = fam.rays[v0 * nu..(v1 + 1) * nu]
+        let length = |ray: &crate::dexel::Ray| ray.iter().map(|s| s.hi - s.lo).sum::<f64>();
+        let per_row: Vec<(u64, f64, f64, f64)> = fam.rays[v0 * nu..(v1 + 1) * nu]
             .par_chunks_mut(nu)
             .enumerate()
             .map(|(jv, row)| {
                 let pv = origin[v] + ((v0 + jv) as f64 + 0.5) * h;
-                let mut acc = (0u64, f64::INFINITY, 0.0f64);
+                let mut acc = (0u64, f64::INFINITY, 0.0f64, 0.0f64);
                 for (ju, ray) in row[u0..=u1].iter_mut().enumerate() {
                     let pu = origin[u] + ((u0 + ju) as f64 + 0.5) * h;
                     // The contact plane n·(x − p0) = 0 on this ray.
@@ -456,6 +462,7 @@ impl Stock {
                     let dh = depth_at(&q);
                     if dh > 0.0 {
                         let along = dh / n[k].abs();
+                        let before = length(ray);
                         if facing > 0 {
                             subtract(ray, t - along, t + 1e-9, move_id);
                         } else {
@@ -464,12 +471,14 @@ impl Stock {
                         acc.0 += 1;
                         acc.1 = acc.1.min(dh);
                         acc.2 = acc.2.max(dh);
+                        acc.3 += before - length(ray);
                     }
                 }
                 acc
             })
             .collect();
-        for (rays, mn, mx) in per_row {
+        for (rays, mn, mx, removed) in per_row {
+            stats.removed_volume_mm3 += removed * h * h;
             if rays > 0 {
                 stats.depth_range_mm = if stats.rays == 0 {
                     [mn, mx]
@@ -482,6 +491,7 @@ impl Stock {
                 stats.rays += rays;
             }
         }
+        self.note_ground(stats.removed_volume_mm3);
         Ok(stats)
     }
 }

@@ -139,6 +139,9 @@ pub struct GrindBlock {
 pub struct GrindingSummary {
     /// Smallest and largest depth removed at a ray over all blocks, mm.
     pub depth_range_mm: [f64; 2],
+    /// Volume ground away, mm³.
+    #[serde(default)]
+    pub removed_volume_mm3: f64,
     /// Per block that ground something.
     pub blocks: Vec<GrindBlock>,
 }
@@ -148,6 +151,7 @@ impl GrindingSummary {
     pub fn new(moves: &[(u32, crate::GrindStats)], blocks: &[BlockRef]) -> GrindingSummary {
         let mut range = [f64::INFINITY, 0.0f64];
         let mut out = Vec::new();
+        let removed_volume_mm3 = moves.iter().map(|(_, s)| s.removed_volume_mm3).sum();
         for (id, s) in moves {
             if s.rays == 0 {
                 continue;
@@ -172,6 +176,7 @@ impl GrindingSummary {
         }
         GrindingSummary {
             depth_range_mm: range,
+            removed_volume_mm3,
             blocks: out,
         }
     }

@@ -102,6 +102,9 @@ pub struct Stock {
     counts: [usize; 3],
     families: [Family; 3],
     initial_volume: f64,
+    /// Volume ground away by the process model, mm³: it removes along one
+    /// family of rays only (`Stock::grind_move`).
+    ground_volume: f64,
     last: Option<(Tool, ToolPose)>,
     removal: Removal,
 }
@@ -295,6 +298,7 @@ impl Stock {
             counts,
             families: [family(0), family(1), family(2)],
             initial_volume: 0.0,
+            ground_volume: 0.0,
             last: None,
             removal: Removal::Fast,
         })
@@ -418,8 +422,21 @@ impl Stock {
 
     /// The material volume, mm³: the mean over the three families of the
     /// summed interval lengths times the cell area (each family alone
-    /// integrates the volume by the midpoint rule).
+    /// integrates the volume by the midpoint rule), less two thirds of the
+    /// volume ground by the process model: grinding removes its depths
+    /// (often a fraction of the ray spacing) along the family nearest the
+    /// tool axis only, which the other two families do not see.
     pub fn volume_mm3(&self) -> f64 {
+        self.family_mean_volume() - 2.0 / 3.0 * self.ground_volume
+    }
+
+    /// The volume grinding removed so far ([`Stock::volume_mm3`]).
+    pub(crate) fn note_ground(&mut self, volume_mm3: f64) {
+        self.ground_volume += volume_mm3;
+    }
+
+    /// The mean over the three families of their integrated volumes.
+    fn family_mean_volume(&self) -> f64 {
         let h2 = self.resolution * self.resolution;
         let sum: f64 = self
             .families

@@ -366,6 +366,17 @@ fn removal_options_are_checked() {
             &["--stock", "design+0.2", "--tool", "flat:4"][..],
             "needs --design",
         ),
+        (
+            &[
+                "--stock",
+                "box:0,0,0,40,40,10",
+                "--tool",
+                "flat:4",
+                "--process",
+                "p.toml",
+            ][..],
+            "--process grinds with the belt's contact wheel",
+        ),
     ] {
         let mut args = vec!["sim", "slot.ngc", "--machine", &machine, "--json", "r.json"];
         args.extend_from_slice(extra);
@@ -437,5 +448,92 @@ fn a_wheel_pass_grinds_its_closed_form_volume() {
     assert!(r["rapid_cuts"].as_array().unwrap().is_empty(), "{r}");
     let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
     assert!((gouge - depth).abs() < 1e-6, "{gouge}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The belt-grinding process model on the same pass, with the belt turning
+/// (3000 rpm) and H1 = 3300 (150 N on the force table of
+/// `crates/stock/process/mts1600.toml`): every point of the pass loses
+/// Preston's depth h = K_p · v_belt · F / (v_f · W) (Qi (thesis), §4.2;
+/// the module doc of `kinpost_stock::process`), so the volume ground is
+/// W · L · h, whatever the wheel's position, and the design comparison
+/// finds the pass's depth.
+#[test]
+fn the_process_model_grinds_prestons_depth() {
+    let dir = temp_dir("process");
+    let mut cl = String::from("TOOL PATH/WHEEL,TOOL,W\nFEDRAT/MMPM,500\nSPINDL/RPM,3000,CLW\n");
+    let goto = |x: f64, z: f64| format!("GOTO/{x:.4},50.0000,{z:.4},0,0,1,1,0,0\n");
+    cl += &goto(-420.0, 20.0);
+    cl += &goto(-420.0, -0.1);
+    cl += &goto(-220.0, -0.1);
+    cl += &goto(-220.0, 20.0);
+    std::fs::write(dir.join("pass.cls"), cl).unwrap();
+    std::fs::write(
+        dir.join("blank.stl"),
+        box_stl([-440.0, 0.0, -10.0], [-200.0, 100.0, 0.0]),
+    )
+    .unwrap();
+    let o = run_in(
+        &dir,
+        &[
+            "post",
+            "pass.cls",
+            "--machine",
+            "mts1600",
+            "--pressure",
+            "3300",
+            "-o",
+            "pass.mpf",
+        ],
+    );
+    assert_exit(&o, 0);
+    let process = root().join("crates/stock/process/mts1600.toml");
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "pass.mpf",
+            "--machine",
+            "mts1600",
+            "--no-collisions",
+            "--stock",
+            "box:-440,0,-10,-200,100,0",
+            "--tool",
+            "wheel:25,25",
+            "--resolution",
+            "0.1",
+            "--process",
+            process.to_str().unwrap(),
+            "--design",
+            "blank.stl",
+            "--json",
+            "-",
+        ],
+    );
+    assert_exit(&o, 3);
+    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &json["removal"];
+    // K_p = 2.5e-6 mm²/N, 3000 rpm on a 25 mm wheel, 150 N, 500 mm/min,
+    // a 25 mm belt, a 200 mm pass.
+    let belt = 2.0 * std::f64::consts::PI * 3000.0 / 60.0 * 25.0;
+    let h = 2.5e-6 * belt * 150.0 / (500.0 / 60.0 * 25.0);
+    let want = 25.0 * 200.0 * h;
+    let g = &r["grinding"];
+    let ground = g["removed_volume_mm3"].as_f64().unwrap();
+    assert!(
+        (ground - want).abs() < 0.01 * want,
+        "{ground} against {want}"
+    );
+    let total = r["removed_volume_mm3"].as_f64().unwrap();
+    assert!((total - want).abs() < 0.01 * want, "{total} against {want}");
+    let pass = g["blocks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|b| b["force_n"] == 150.0)
+        .expect("the pass is ground at 150 N");
+    assert!((pass["pass_depth_mm"].as_f64().unwrap() - h).abs() < 1e-9);
+    let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
+    assert!((gouge - h).abs() < 1e-3 * h, "{gouge} against {h}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -13,6 +13,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::Replay;
 use crate::path::{BlockPath, Joints, Shape};
+use crate::removal::BlockConditions;
 use crate::report::At;
 use crate::{SimError, tolerance};
 
@@ -69,14 +70,17 @@ impl Replay {
             to: last,
             shape: Shape::Joint,
         };
-        self.report.duration_s += self.block_time_s(m, &programmed, &joint_path);
+        let seconds = self.block_time_s(m, &programmed, &joint_path);
+        self.report.duration_s += seconds;
         if self.known == self.all {
             self.complete_at.get_or_insert(line);
+            let conditions = self.conditions(m, seconds);
             self.tcp_checks(
                 &joints,
                 at,
                 m.kind == MotionKind::Rapid,
                 known_before == self.all,
+                conditions,
             )?;
         }
         self.q = last;
@@ -92,6 +96,7 @@ impl Replay {
         at: &At,
         rapid: bool,
         started: bool,
+        conditions: BlockConditions,
     ) -> Result<(), SimError> {
         let pieces = joints.len() - 1;
         if self.cl.is_some() && !rapid {
@@ -133,7 +138,7 @@ impl Replay {
                 .map(|q| self.kin.fk(&q[..self.n]))
                 .collect();
             if let Some(c) = &mut self.cutting {
-                c.cut(&poses, at, rapid)?;
+                c.cut(&poses, at, rapid, Some(conditions))?;
             }
         }
         Ok(())
