@@ -2,14 +2,17 @@
 //! error, never a panic; what loads becomes a stock (a lattice of 16 rays
 //! across its longest extent, at least 1 µm apart), is cut, compared with itself as the design,
 //! meshed, and grown by an allowance. The same bytes, as text, go to the
-//! process-file reader. Run with `cargo +nightly fuzz run stock_stl` from
+//! process-file and trace-file readers, and the traces read to the
+//! calibration (a fit or an error). Run with `cargo +nightly fuzz run stock_stl` from
 //! the repository root.
 
 #![no_main]
 
 use std::io::Cursor;
 
-use kinpost_stock::{Design, Mesh, ProcessModel, Stock, Tool, ToolPose, compare, contour};
+use kinpost_stock::{
+    Design, Mesh, ProcessModel, Stock, Tool, ToolPose, TraceFile, calibrate, compare, contour,
+};
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
 
@@ -17,6 +20,14 @@ fuzz_target!(|data: &[u8]| {
     let text = String::from_utf8_lossy(data);
     if let Err(d) = ProcessModel::from_toml(&text, "fuzz.toml") {
         assert!(d.line <= text.split('\n').count());
+    }
+    match TraceFile::from_toml(&text, "traces.toml") {
+        Ok(t) => {
+            if let Ok(fit) = calibrate(&t.trace) {
+                assert!(fit.preston_mm2_per_n.is_finite());
+            }
+        }
+        Err(d) => assert!(d.line <= text.split('\n').count()),
     }
     let Ok(mesh) = Mesh::read_stl(Cursor::new(data), "fuzz.stl") else {
         return;

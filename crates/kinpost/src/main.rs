@@ -26,6 +26,7 @@ macro_rules! note {
     }};
 }
 
+mod cmd_calibrate;
 mod cmd_sim;
 mod cmd_surface;
 mod cmd_wheel;
@@ -40,7 +41,7 @@ use sinks::{Sink, deliver, open_outputs};
     name = "kinpost",
     version,
     about = "Multi-axis CNC post-processor: CL data to NC code through a machine's kinematic chain, checked in closed loop",
-    after_help = "Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error, 3 `sim` found overtravel or a collision."
+    after_help = "Exit codes: 0 success (warnings allowed), 1 bad input, 2 usage error, 3 `sim` found overtravel, a collision, a rapid into the stock or a gouge."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -111,6 +112,10 @@ enum Command {
     /// travel, collisions and (with --cl) the deviation from its CL; exit
     /// code 3 when anything is violated.
     Sim(Box<cmd_sim::SimArgs>),
+    /// Belt grinding: fit Preston's coefficient and the contact wheel's
+    /// stiffness to measured trace depths, and write them into a process
+    /// file for `sim --process`.
+    Calibrate(cmd_calibrate::CalibrateArgs),
 }
 
 #[derive(clap::Args)]
@@ -423,6 +428,15 @@ fn run(cli: Cli) -> Result<()> {
         Command::Surface(c) => cmd_surface::surface(c),
         Command::Path(a) => cmd_surface::path(*a),
         Command::Sim(a) => cmd_sim::sim(&a),
+        Command::Calibrate(a) => {
+            // (With the process file on standard output, the fit goes to
+            // standard error.)
+            if a.writes_stdout() {
+                cmd_calibrate::calibrate_command(&a, &mut io::stderr().lock())
+            } else {
+                cmd_calibrate::calibrate_command(&a, &mut out)
+            }
+        }
     }
 }
 

@@ -107,7 +107,7 @@ pub use design::{Comparison, Design, DesignError, Region, Sample, compare};
 pub use mesh::{Mesh, MeshError};
 pub use output::{write_ply, write_stl, write_svg};
 pub use process::{
-    Calibration, Conditions, Contact, GrindStats, ProcessError, ProcessModel, Trace,
+    Calibration, Conditions, Contact, GrindStats, ProcessError, ProcessModel, Trace, TraceFile,
     belt_speed_mm_s, calibrate,
 };
 pub use report::{BlockRef, GrindBlock, GrindingSummary, Report, ReportRegion};

@@ -530,6 +530,67 @@ pub enum Trace {
     },
 }
 
+/// A file of measured traces (TOML), for [`calibrate`]:
+///
+/// ```toml
+/// [[trace]]
+/// kind = "pass"        # a pass over a flat at constant feed: its steady depth
+/// force_n = 150.0
+/// belt_mm_s = 7854.0   # 2π · rpm / 60 · wheel radius
+/// feed_mm_s = 8.333
+/// width_mm = 25.0
+/// depth_mm = 0.0141
+///
+/// [[trace]]
+/// kind = "dwell"       # the wheel held still: the trace's peak depth
+/// force_n = 150.0
+/// belt_mm_s = 7854.0
+/// dwell_s = 2.0
+/// width_mm = 25.0
+/// radius_mm = 25.0
+/// depth_mm = 0.029
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TraceFile {
+    /// The traces.
+    pub trace: Vec<Trace>,
+}
+
+impl TraceFile {
+    /// Reads a trace file (located errors).
+    pub fn from_toml(src: &str, file: &str) -> Result<TraceFile, Diagnostic> {
+        toml::from_str(src).map_err(|e| {
+            Diagnostic::at_byte_span(
+                Severity::Error,
+                file,
+                src,
+                e.span().unwrap_or(0..0),
+                e.message().trim_end(),
+            )
+        })
+    }
+}
+
+impl ProcessModel {
+    /// The model as a process file (TOML; the inverse of
+    /// [`ProcessModel::from_toml`]).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// The same model with the wheel's coefficients of `fit` (the
+    /// stiffness kept when the fit has no dwell).
+    pub fn calibrated(&self, fit: &Calibration) -> ProcessModel {
+        let mut m = self.clone();
+        m.wheel.preston_mm2_per_n = fit.preston_mm2_per_n;
+        if let Some(k) = fit.stiffness_n_per_mm3 {
+            m.wheel.stiffness_n_per_mm3 = k;
+        }
+        m
+    }
+}
+
 /// The fitted coefficients.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Calibration {

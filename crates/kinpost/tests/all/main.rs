@@ -7,6 +7,7 @@
 mod li_paper;
 
 mod architecture;
+mod calibrate_cli;
 mod cli;
 mod data_manifest;
 mod hostile;
