@@ -388,21 +388,24 @@ fn removal_options_are_checked() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Five axes and the belt's contact wheel: a straight pass 0.1 mm deep
-/// across a flat blank, posted for `mts1600` and replayed with the wheel
-/// (radius 25 mm, width 25 mm; its axis is the feed direction × the tool
-/// axis, from the machine's tool reference): the volume ground is the
-/// closed form's, width × (length × depth + the circular segment of the
-/// wheel's ends), and against the blank as the design the deepest gouge
-/// is the pass's depth.
-#[test]
-fn a_wheel_pass_grinds_its_closed_form_volume() {
-    let dir = temp_dir("wheel");
-    let mut cl = String::from("TOOL PATH/WHEEL,TOOL,W\nFEDRAT/MMPM,500\n");
+/// A straight wheel pass 0.1 mm deep from at Y50 (in
+/// `pieces` GOTOs) across a flat blank (-440..-200, 0..100, -10..0),
+/// posted for `mts1600` with `post_extra`, replayed with the 25 × 25 mm
+/// contact wheel, the blank as stock and design, and `sim_extra`: the JSON
+/// report.
+fn wheel_pass(
+    name: &str,
+    head: &str,
+    pieces: u32,
+    post_extra: &[&str],
+    sim_extra: &[&str],
+) -> serde_json::Value {
+    let dir = temp_dir(name);
+    let mut cl = format!("TOOL PATH/WHEEL,TOOL,W\nFEDRAT/MMPM,500\n{head}");
     let goto = |x: f64, z: f64| format!("GOTO/{x:.4},50.0000,{z:.4},0,0,1,1,0,0\n");
     cl += &goto(-420.0, 20.0);
-    for k in 0..=40 {
-        cl += &goto(-420.0 + 5.0 * f64::from(k), -0.1);
+    for k in 0..=pieces {
+        cl += &goto(-420.0 + 200.0 * f64::from(k) / f64::from(pieces), -0.1);
     }
     cl += &goto(-220.0, 20.0);
     std::fs::write(dir.join("pass.cls"), cl).unwrap();
@@ -411,33 +414,44 @@ fn a_wheel_pass_grinds_its_closed_form_volume() {
         box_stl([-440.0, 0.0, -10.0], [-200.0, 100.0, 0.0]),
     )
     .unwrap();
-    let o = run_in(
-        &dir,
-        &["post", "pass.cls", "--machine", "mts1600", "-o", "pass.mpf"],
-    );
-    assert_exit(&o, 0);
-    let o = run_in(
-        &dir,
-        &[
-            "sim",
-            "pass.mpf",
-            "--machine",
-            "mts1600",
-            "--no-collisions",
-            "--stock",
-            "box:-440,0,-10,-200,100,0",
-            "--tool",
-            "wheel:25,25",
-            "--resolution",
-            "0.1",
-            "--design",
-            "blank.stl",
-            "--json",
-            "-",
-        ],
-    );
+    let mut post = vec!["post", "pass.cls", "--machine", "mts1600", "-o", "pass.mpf"];
+    post.extend_from_slice(post_extra);
+    assert_exit(&run_in(&dir, &post), 0);
+    let mut sim = vec![
+        "sim",
+        "pass.mpf",
+        "--machine",
+        "mts1600",
+        "--no-collisions",
+        "--stock",
+        "box:-440,0,-10,-200,100,0",
+        "--tool",
+        "wheel:25,25",
+        "--resolution",
+        "0.1",
+        "--design",
+        "blank.stl",
+        "--json",
+        "-",
+    ];
+    sim.extend_from_slice(sim_extra);
+    let o = run_in(&dir, &sim);
+    // (The pass gouges the blank as design: exit code 3.)
     assert_exit(&o, 3);
-    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    std::fs::remove_dir_all(&dir).ok();
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// Five axes and the belt's contact wheel: a straight pass 0.1 mm deep
+/// across a flat blank in 40 blocks, posted for `mts1600` and replayed
+/// with the wheel (radius 25 mm, width 25 mm; its axis is the feed
+/// direction × the tool axis, from the machine's tool reference): the
+/// volume ground is the closed form's, width × (length × depth + the
+/// circular segment of the wheel's ends), and against the blank as the
+/// design the deepest gouge is the pass's depth.
+#[test]
+fn a_wheel_pass_grinds_its_closed_form_volume() {
+    let json = wheel_pass("wheel", "", 40, &[], &[]);
     let r = &json["removal"];
     let (radius, depth, length, width) = (25.0f64, 0.1f64, 200.0, 25.0);
     let segment = radius * radius * ((radius - depth) / radius).acos()
@@ -448,11 +462,10 @@ fn a_wheel_pass_grinds_its_closed_form_volume() {
     assert!(r["rapid_cuts"].as_array().unwrap().is_empty(), "{r}");
     let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
     assert!((gouge - depth).abs() < 1e-6, "{gouge}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The belt-grinding process model on the same pass, with the belt turning
-/// (3000 rpm) and H1 = 3300 (150 N on the force table of
+/// The belt-grinding process model on the same pass in one block, with
+/// the belt turning (3000 rpm) and H1 = 3300 (150 N on the force table of
 /// `crates/stock/process/mts1600.toml`): every point of the pass loses
 /// Preston's depth h = K_p · v_belt · F / (v_f · W) (Qi (thesis), §4.2;
 /// the module doc of `kinpost_stock::process`), so the volume ground is
@@ -460,58 +473,14 @@ fn a_wheel_pass_grinds_its_closed_form_volume() {
 /// finds the pass's depth.
 #[test]
 fn the_process_model_grinds_prestons_depth() {
-    let dir = temp_dir("process");
-    let mut cl = String::from("TOOL PATH/WHEEL,TOOL,W\nFEDRAT/MMPM,500\nSPINDL/RPM,3000,CLW\n");
-    let goto = |x: f64, z: f64| format!("GOTO/{x:.4},50.0000,{z:.4},0,0,1,1,0,0\n");
-    cl += &goto(-420.0, 20.0);
-    cl += &goto(-420.0, -0.1);
-    cl += &goto(-220.0, -0.1);
-    cl += &goto(-220.0, 20.0);
-    std::fs::write(dir.join("pass.cls"), cl).unwrap();
-    std::fs::write(
-        dir.join("blank.stl"),
-        box_stl([-440.0, 0.0, -10.0], [-200.0, 100.0, 0.0]),
-    )
-    .unwrap();
-    let o = run_in(
-        &dir,
-        &[
-            "post",
-            "pass.cls",
-            "--machine",
-            "mts1600",
-            "--pressure",
-            "3300",
-            "-o",
-            "pass.mpf",
-        ],
-    );
-    assert_exit(&o, 0);
     let process = root().join("crates/stock/process/mts1600.toml");
-    let o = run_in(
-        &dir,
-        &[
-            "sim",
-            "pass.mpf",
-            "--machine",
-            "mts1600",
-            "--no-collisions",
-            "--stock",
-            "box:-440,0,-10,-200,100,0",
-            "--tool",
-            "wheel:25,25",
-            "--resolution",
-            "0.1",
-            "--process",
-            process.to_str().unwrap(),
-            "--design",
-            "blank.stl",
-            "--json",
-            "-",
-        ],
+    let json = wheel_pass(
+        "process",
+        "SPINDL/RPM,3000,CLW\n",
+        1,
+        &["--pressure", "3300"],
+        &["--process", process.to_str().unwrap()],
     );
-    assert_exit(&o, 3);
-    let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let r = &json["removal"];
     // K_p = 2.5e-6 mm²/N, 3000 rpm on a 25 mm wheel, 150 N, 500 mm/min,
     // a 25 mm belt, a 200 mm pass.
@@ -535,5 +504,4 @@ fn the_process_model_grinds_prestons_depth() {
     assert!((pass["pass_depth_mm"].as_f64().unwrap() - h).abs() < 1e-9);
     let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
     assert!((gouge - h).abs() < 1e-3 * h, "{gouge} against {h}");
-    std::fs::remove_dir_all(&dir).ok();
 }
