@@ -167,15 +167,7 @@ fn check(what: &'static str, value: f64, why: &'static str, ok: bool) -> Result<
 impl ProcessModel {
     /// Reads a process file (TOML, the form in the module doc).
     pub fn from_toml(src: &str, file: &str) -> Result<ProcessModel, Diagnostic> {
-        let m: ProcessModel = toml::from_str(src).map_err(|e| {
-            Diagnostic::at_byte_span(
-                Severity::Error,
-                file,
-                src,
-                e.span().unwrap_or(0..0),
-                e.message().trim_end(),
-            )
-        })?;
+        let m: ProcessModel = from_toml(src, file)?;
         m.validate().map_err(|e| {
             let key = match e {
                 ProcessError::Value { what, .. } if what.starts_with("force") => "newtons",
@@ -560,16 +552,21 @@ pub struct TraceFile {
 impl TraceFile {
     /// Reads a trace file (located errors).
     pub fn from_toml(src: &str, file: &str) -> Result<TraceFile, Diagnostic> {
-        toml::from_str(src).map_err(|e| {
-            Diagnostic::at_byte_span(
-                Severity::Error,
-                file,
-                src,
-                e.span().unwrap_or(0..0),
-                e.message().trim_end(),
-            )
-        })
+        from_toml(src, file)
     }
+}
+
+/// A TOML file's value, or the parser's error located in `file`.
+fn from_toml<T: serde::de::DeserializeOwned>(src: &str, file: &str) -> Result<T, Diagnostic> {
+    toml::from_str(src).map_err(|e| {
+        Diagnostic::at_byte_span(
+            Severity::Error,
+            file,
+            src,
+            e.span().unwrap_or(0..0),
+            e.message().trim_end(),
+        )
+    })
 }
 
 impl ProcessModel {

@@ -5,25 +5,12 @@
 //! file keeps the force table and is read by `sim --process`; bad trace
 //! files are located errors.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kinpost"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run kinpost")
-}
+use crate::common::{self, root, run_in};
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kinpost-calibrate-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir(&format!("calibrate-{name}"))
 }
 
 /// The number after `label` in `text`.

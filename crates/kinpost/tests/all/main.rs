@@ -9,6 +9,7 @@ mod li_paper;
 mod architecture;
 mod calibrate_cli;
 mod cli;
+mod common;
 mod data_manifest;
 mod hostile;
 mod li_grinding_path;

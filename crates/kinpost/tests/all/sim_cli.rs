@@ -3,20 +3,10 @@
 //! 1 bad input, 2 usage, 3 violated), the summary, the JSON report and the
 //! block table, and that the outputs are written all or nothing.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
+use std::process::Output;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kinpost"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run kinpost")
-}
+use crate::common::{self, root, run_in};
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
@@ -28,9 +18,7 @@ fn assert_exit(o: &Output, code: i32) {
 }
 
 fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("kinpost-sim-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::temp_dir(&format!("sim-cli-{name}"))
 }
 
 #[test]
