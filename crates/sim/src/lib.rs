@@ -259,8 +259,7 @@ pub fn simulate_cutting(
         },
     )
     .map_err(SimError::Program)?;
-    let cutting = replay.take_cutting();
-    let mut report = replay.finish(&report)?;
+    let (mut report, cutting) = replay.finish_cutting(&report)?;
     if remapped_tcp && tcp_seen {
         report.assumed.push(
             "M428 switches tool-centre-point control on and M429 off (the remap of LinuxCNC's 5-axis sample configurations, which kinpost's linuxcnc dialect writes)".to_string(),

@@ -156,16 +156,11 @@ impl Replay {
     }
 
     /// The replay also removes material: the tool's poses of every block
-    /// are cut from `cutting`'s stock ([`Replay::take_cutting`] gives it
-    /// back).
+    /// are cut from `cutting`'s stock ([`Replay::finish_cutting`] gives
+    /// it back).
     pub fn with_cutting(mut self, cutting: Cutting) -> Replay {
         self.cutting = Some(cutting);
         self
-    }
-
-    /// The stock as cut, when the replay removes material.
-    pub fn take_cutting(&mut self) -> Option<Cutting> {
-        self.cutting.take()
     }
 
     /// A block's conditions for the grinding process model: the pressure
@@ -238,7 +233,16 @@ impl Replay {
     }
 
     /// The report, with what the interpreter reported (`interp`).
-    pub fn finish(mut self, interp: &kinpost_nc::interp::Report) -> Result<SimReport, SimError> {
+    pub fn finish(self, interp: &kinpost_nc::interp::Report) -> Result<SimReport, SimError> {
+        self.finish_cutting(interp).map(|(r, _)| r)
+    }
+
+    /// [`Replay::finish`], with the stock as cut when the replay removed
+    /// material ([`Replay::with_cutting`]).
+    pub fn finish_cutting(
+        mut self,
+        interp: &kinpost_nc::interp::Report,
+    ) -> Result<(SimReport, Option<Cutting>), SimError> {
         if let Some(e) = self.error {
             return Err(e);
         }
@@ -270,7 +274,20 @@ impl Replay {
             r.collisions = collisions;
             r.near_misses = near;
         }
-        Ok(self.report)
+        r.rapid_into_stock = r
+            .collisions
+            .iter()
+            .filter(|c| c.kind == "rapid_into_stock")
+            .map(|c| c.at.clone())
+            .chain(
+                self.cutting
+                    .iter()
+                    .flat_map(|c| c.rapid_cuts().iter().cloned()),
+            )
+            .collect();
+        r.rapid_into_stock.sort_by_key(|a| a.block);
+        r.rapid_into_stock.dedup_by_key(|a| a.block);
+        Ok((self.report, self.cutting))
     }
 
     /// A motion block.

@@ -109,6 +109,11 @@ pub struct SimReport {
     pub collisions: Vec<Contact>,
     /// Pairs within their warning clearance (warnings).
     pub near_misses: Vec<Contact>,
+    /// Rapid blocks into the stock, in program order: a rapid that touches
+    /// a stock solid of the machine file (also among `collisions`), or
+    /// that removes material from `--stock` (also among
+    /// `removal.rapid_cuts`).
+    pub rapid_into_stock: Vec<At>,
     /// Largest position deviation from the CL along the path, mm (with
     /// `--cl`).
     pub max_position_error_mm: Option<f64>,

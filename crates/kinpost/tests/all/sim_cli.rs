@@ -232,6 +232,7 @@ fn a_slot_and_a_rapid_plunge_are_cut_and_compared_with_the_design() {
     let rapid = r["rapid_cuts"].as_array().unwrap();
     assert_eq!(rapid.len(), 1, "{r}");
     assert_eq!(rapid[0]["line"], 7);
+    assert_eq!(json["rapid_into_stock"], serde_json::json!([rapid[0]]));
     let d = &r["design"];
     assert!(
         (d["gouge_max_mm"].as_f64().unwrap() - 5.0).abs() < 1e-9,
