@@ -825,12 +825,13 @@ pub(crate) fn cut_row(
 pub(crate) static FORCE_PORTABLE: std::sync::atomic::AtomicBool =
     std::sync::atomic::AtomicBool::new(false);
 
-#[cfg(test)]
+#[cfg(all(test, target_arch = "x86_64"))]
 fn portable_forced() -> bool {
     FORCE_PORTABLE.load(std::sync::atomic::Ordering::Relaxed)
 }
 
-#[cfg(not(test))]
+// (Only the x86-64 dispatch asks.)
+#[cfg(all(not(test), target_arch = "x86_64"))]
 #[inline(always)]
 fn portable_forced() -> bool {
     false
