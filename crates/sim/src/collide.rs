@@ -8,9 +8,9 @@ use std::collections::HashMap;
 use kinpost_collide::{ContactKind, Motion, World};
 use kinpost_machine::Machine;
 
-use crate::SimError;
 use crate::path::BlockPath;
 use crate::report::{At, Contact};
+use crate::{SimError, tolerance};
 
 /// Worlds at most kept for other pressures (the oldest is dropped beyond).
 const PRESSURE_WORLDS: usize = 8;
@@ -88,21 +88,11 @@ impl Worlds {
                         q.resize(n, 0.0);
                         path.at(ta + t * (tb - ta), q);
                     };
-                    for c in world.check_path(&piece, motion) {
+                    for mut c in world.check_path(&piece, motion) {
+                        // The sweep stops at the first pose within the
+                        // clearance: the pair may come nearer after it.
+                        nearest_after(world, &piece, c.fraction, motion, &mut c.contact);
                         found.push((c.contact, ta + c.fraction * (tb - ta)));
-                    }
-                }
-                // The sweep stops at the first pose within the clearance:
-                // the block's end may be nearer (a move that stops short).
-                if !found.is_empty() {
-                    for end in world.check_pose(&path.to[..n], motion) {
-                        if let Some((c, _)) =
-                            found.iter_mut().find(|(c, _)| c.indices == end.indices)
-                            && end.distance_mm < c.distance_mm
-                        {
-                            c.distance_mm = end.distance_mm;
-                            c.penetration_mm = deeper(c.penetration_mm, end.penetration_mm);
-                        }
                     }
                 }
             } else {
@@ -161,6 +151,58 @@ impl Worlds {
 }
 
 /// The deeper of two overlaps, where computed.
+/// Lowers `contact`'s distance (and deepens its penetration) to the
+/// nearest the pair comes on `piece` from `from` (a fraction of it) to its
+/// end: [`tolerance::NEAREST_SAMPLES`] poses, then a golden-section search
+/// around the nearest of them. (The pair's distance along a piece is not
+/// convex in general: the search finds the nearest sampled valley to
+/// within [`tolerance::NEAREST_FRACTION`] of the piece.)
+fn nearest_after(
+    world: &World,
+    piece: &(dyn Fn(f64, &mut Vec<f64>) + Sync),
+    from: f64,
+    motion: Motion,
+    contact: &mut kinpost_collide::Contact,
+) {
+    let mut q = Vec::new();
+    let mut at = |t: f64, contact: &mut kinpost_collide::Contact| -> f64 {
+        piece(t, &mut q);
+        let pair = world
+            .check_pose(&q, motion)
+            .into_iter()
+            .find(|c| c.indices == contact.indices);
+        match pair {
+            Some(c) => {
+                contact.penetration_mm = deeper(contact.penetration_mm, c.penetration_mm);
+                contact.distance_mm = contact.distance_mm.min(c.distance_mm);
+                c.distance_mm
+            }
+            None => f64::INFINITY,
+        }
+    };
+    let k = tolerance::NEAREST_SAMPLES;
+    let ts: Vec<f64> = (0..=k)
+        .map(|i| from + (1.0 - from) * i as f64 / k as f64)
+        .collect();
+    let ds: Vec<f64> = ts.iter().map(|&t| at(t, contact)).collect();
+    let Some(best) = (0..ds.len()).min_by(|&a, &b| ds[a].total_cmp(&ds[b])) else {
+        return;
+    };
+    if ds[best] <= 0.0 {
+        return;
+    }
+    let (mut lo, mut hi) = (ts[best.saturating_sub(1)], ts[(best + 1).min(k)]);
+    let phi = 0.5 * (5f64.sqrt() - 1.0);
+    while hi - lo > tolerance::NEAREST_FRACTION {
+        let (a, b) = (hi - phi * (hi - lo), lo + phi * (hi - lo));
+        if at(a, contact) <= at(b, contact) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+}
+
 fn deeper(a: Option<f64>, b: Option<f64>) -> Option<f64> {
     match (a, b) {
         (Some(a), Some(b)) => Some(a.max(b)),

@@ -48,9 +48,9 @@ pub struct Contact {
     pub solids: [String; 2],
     /// `collision`, `rapid_into_stock` or `near_miss`.
     pub kind: &'static str,
-    /// Their smallest distance found, mm (0 touching or overlapping): at
-    /// the first pose of each block within the clearance and at the block's
-    /// end.
+    /// Their smallest distance, mm (0 touching or overlapping): the
+    /// nearest the pair comes in the blocks of the contact, from the first
+    /// pose within the clearance on (sampled and refined; `collide.rs`).
     pub distance_mm: f64,
     /// The deepest overlap found, mm, where it is computed.
     pub penetration_mm: Option<f64>,

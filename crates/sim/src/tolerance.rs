@@ -46,3 +46,12 @@ pub const TCP_CHORD_DEG: f64 = 1.0;
 /// Largest travel of a linear axis over one chord of a block under
 /// tool-centre-point control in the collision check, mm.
 pub const TCP_CHORD_MM: f64 = 10.0;
+
+/// Poses sampled after a contact's first pose to find how near the pair
+/// comes in the rest of the piece (`collide.rs`): the sweep stops at the
+/// first pose within the clearance, and the report gives the nearest.
+pub const NEAREST_SAMPLES: usize = 16;
+
+/// The golden-section search for the nearest pose of a contact stops
+/// when its bracket is this fraction of the piece.
+pub const NEAREST_FRACTION: f64 = 1e-4;

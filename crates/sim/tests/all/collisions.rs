@@ -113,3 +113,69 @@ fn stopping_short_inside_the_warning_clearance_is_a_near_miss() {
     assert!(d > 0.0 && d <= 0.2, "{d}");
     assert!(!r.violated(), "{:?}", r.overtravel);
 }
+
+/// A ball on the tool passing a post: the nearest approach is in the
+/// middle of the block (11 mm between the axes, 1 mm between the
+/// surfaces), well after the first pose inside the 3 mm warning
+/// clearance: the near miss reports the nearest distance, not the
+/// distance where the sweep first came within the clearance.
+#[test]
+fn a_near_miss_reports_the_nearest_approach_along_the_block() {
+    let src = r#"
+name = "pass-by"
+[[axis]]
+name = "X"
+kind = "linear"
+side = "tool"
+direction = [1, 0, 0]
+[[axis]]
+name = "Y"
+kind = "linear"
+side = "tool"
+direction = [0, 1, 0]
+[[axis]]
+name = "Z"
+kind = "linear"
+side = "tool"
+direction = [0, 0, 1]
+[workpiece]
+origin = [0, 0, 0]
+x = [1, 0, 0]
+z = [0, 0, 1]
+[tool]
+point = [0, 0, 0]
+axis = [0, 0, 1]
+[[solid]]
+name = "ball"
+on = "tool"
+sphere = { radius = 5 }
+[[solid]]
+name = "post"
+on = "base"
+cylinder = { radius = 5, height = 100 }
+origin = [0, 20, -50]
+[collision]
+warning_clearance = 3
+error_clearance = 0
+"#;
+    let m = kinpost_machine::machine_from_toml(src, "pass-by.toml").unwrap();
+    let r = simulate(
+        "G21 G90 G94\nG1 X-50 Y9 Z0 F1000\nG1 X50\nM2\n",
+        Family::LinuxCnc,
+        "p.ngc",
+        &m,
+        &SimOptions::default(),
+        None,
+        &mut |_| {},
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.collisions.is_empty(), "{:?}", r.collisions);
+    assert_eq!(r.near_misses.len(), 1, "{:?}", r.near_misses);
+    let c = &r.near_misses[0];
+    assert_eq!((c.at.line, names(c)), (3, ["ball", "post"]));
+    // (The post is a 48-sided prism up to 0.21 % of its radius larger
+    // than the cylinder.)
+    assert!((c.distance_mm - 1.0).abs() < 0.02, "{}", c.distance_mm);
+    // It first came within the clearance about 6.9 mm before the axis.
+    assert!(c.fraction < 0.5, "{}", c.fraction);
+}
