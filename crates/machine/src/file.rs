@@ -63,6 +63,9 @@ struct RawPost {
     retract: Option<Spanned<f64>>,
     /// Singular cone half-angle, degrees.
     singular_cone: Option<Spanned<f64>>,
+    /// The machine's home, NC values by axis name (`GOHOME` without a
+    /// point goes there).
+    home: Option<Spanned<std::collections::BTreeMap<String, Spanned<f64>>>>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq)]
@@ -412,7 +415,7 @@ pub fn machine_from_toml_with(
         return Err(Diagnostics(c.errors));
     };
     let tool = check_tool(&mut c, tool, &axes);
-    let post = check_post(&mut c, raw.post);
+    let post = check_post(&mut c, raw.post, &axes);
     let pressure = raw
         .pressure
         .as_ref()
@@ -601,7 +604,8 @@ fn check_tool(c: &mut Checker, tool: &Spanned<RawTool>, axes: &[Axis]) -> Tool {
 /// The post settings of `[post]`: a retract distance above zero and a
 /// singular cone from 0 to under 45° (a wider cone would take most
 /// orientations for singular).
-fn check_post(c: &mut Checker, post: RawPost) -> PostSettings {
+fn check_post(c: &mut Checker, post: RawPost, axes: &[Axis]) -> PostSettings {
+    let home = post.home.as_ref().and_then(|h| check_home(c, h, axes));
     let retract = post.retract.as_ref().map(|r| {
         let v = *r.get_ref();
         if !(v.is_finite() && v > 0.0) {
@@ -632,7 +636,64 @@ fn check_post(c: &mut Checker, post: RawPost) -> PostSettings {
         }),
         retract,
         singular_cone_deg,
+        home,
     }
+}
+
+/// `[post] home`: an NC value for every axis that is not locked (a locked
+/// axis may be named with its locked value), each inside its travel;
+/// `None` when anything is wrong (each mistake is reported).
+fn check_home(
+    c: &mut Checker,
+    home: &Spanned<std::collections::BTreeMap<String, Spanned<f64>>>,
+    axes: &[Axis],
+) -> Option<Vec<f64>> {
+    let mut values: Vec<Option<f64>> = axes.iter().map(|a| a.fixed).collect();
+    let mut ok = true;
+    for (name, v) in home.get_ref() {
+        let value = *v.get_ref();
+        let Some(i) = axes.iter().position(|a| a.name.eq_ignore_ascii_case(name)) else {
+            c.error(
+                v.span(),
+                format!("home names `{name}`, which is not an axis of this machine"),
+            );
+            ok = false;
+            continue;
+        };
+        let a = &axes[i];
+        let wrong = if !value.is_finite() {
+            Some("a finite NC value".to_string())
+        } else if a.fixed.is_some_and(|f| f != value) {
+            Some(format!(
+                "{} is locked at {}",
+                a.name,
+                a.fixed.unwrap_or(0.0)
+            ))
+        } else if let Some([lo, hi]) = a.limits.filter(|[lo, hi]| !(lo..=hi).contains(&&value)) {
+            Some(format!("{} travels from {lo} to {hi}", a.name))
+        } else {
+            None
+        };
+        if let Some(why) = wrong {
+            c.error(v.span(), format!("home {} = {value}: {why}", a.name));
+            ok = false;
+        }
+        values[i] = Some(value);
+    }
+    let missing: Vec<&str> = axes
+        .iter()
+        .zip(&values)
+        .filter(|(_, v)| v.is_none())
+        .map(|(a, _)| a.name.as_str())
+        .collect();
+    if !missing.is_empty() {
+        c.error(
+            home.span(),
+            format!("home gives no value for {}", missing.join(", ")),
+        );
+        ok = false;
+    }
+    ok.then(|| values.into_iter().map(|v| v.unwrap_or(0.0)).collect())
 }
 
 /// Checks the `[pressure]` table against the axes: its name, reference,

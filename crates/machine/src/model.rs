@@ -163,6 +163,9 @@ pub struct PostSettings {
     /// Half-angle of the cone around a singular tool-axis direction inside
     /// which the free angle is held, degrees.
     pub singular_cone_deg: Option<f64>,
+    /// The machine's home, NC values in machine order (`[post] home`):
+    /// where `GOHOME` without a point goes.
+    pub home: Option<Vec<f64>>,
 }
 
 /// What the linear axis words of a program mean.

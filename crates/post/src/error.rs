@@ -210,7 +210,7 @@ pub enum ProgramError {
     CircleInCycle,
     /// `GOHOME` with no point to go to.
     #[error(
-        "GOHOME with no home point: the CL gives no point and no FROM, and the machine file has no home; give GOHOME/x,y,z or a FROM before it"
+        "GOHOME with no home point: the CL gives no point and no FROM, and the machine file has no `[post] home`; give GOHOME/x,y,z, a FROM before it, or the machine's home axis values"
     )]
     NoHome,
     /// A surface speed with no tool diameter to turn it into rpm.

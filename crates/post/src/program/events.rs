@@ -478,14 +478,22 @@ impl Program<'_> {
                 }
             }
             ClEvent::GoHome { point, axis } => {
-                let Some(point) = point else {
-                    return Err(locate(reader, ProgramError::NoHome).into());
+                // The CL's home (its point, or FROM), else the machine's:
+                // the tool pose its home axis values give.
+                let (point, axis, reference) = match (point, &self.machine.post.home) {
+                    (Some(p), _) => (p, axis.unwrap_or(last.axis), last.reference),
+                    (None, Some(q)) => {
+                        let pose = kinpost_machine::Kinematics::new(self.machine).fk(q);
+                        let reference = pose.reference.map(|r| r.into()).or(last.reference);
+                        (pose.point.into(), pose.axis.into(), reference)
+                    }
+                    (None, None) => return Err(locate(reader, ProgramError::NoHome).into()),
                 };
                 *last = Move {
                     line,
                     point,
-                    axis: axis.unwrap_or(last.axis),
-                    reference: last.reference,
+                    axis,
+                    reference,
                     motion: Motion::Rapid,
                 };
                 self.goto(last, reader, sink)?;

@@ -335,13 +335,37 @@ fn stops_and_dwells_are_commands() {
     );
 }
 
-/// GOHOME goes back to the FROM point in rapid; with no FROM, an error.
+/// GOHOME goes back to the FROM point in rapid; with no FROM (and no home
+/// in the machine file), an error.
 #[test]
 fn gohome_returns_to_the_from_point() {
     let cl = "FROM/1,2,30,0,0,1\nFEDRAT/MMPM,100\nGOTO/5,5,0\nGOHOME\n";
     let pts = points(&run(cl));
     assert_eq!(pts.last().unwrap(), &([1.0, 2.0, 30.0], Motion::Rapid));
     assert!(error_of("RAPID\nGOTO/5,5,0,0,0,1\nGOHOME\n").contains("GOHOME"));
+}
+
+/// GOHOME with no point and no FROM goes to the machine's home
+/// (`[post] home`, NC values): a rapid to the tool pose those values give,
+/// written as those values.
+#[test]
+fn gohome_without_a_point_goes_to_the_machine_home() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/machines/free3.toml");
+    let src =
+        std::fs::read_to_string(path).unwrap() + "[post]\nhome = { X = 10, Y = 20, Z = 150 }\n";
+    let machine = kinpost_post::machine::machine_from_toml(&src, "free3-home.toml").unwrap();
+    let dialect = Dialect::builtin("csv").unwrap();
+    let options = PostOptions {
+        cl_file: "t.cls".into(),
+        default_axis: Some([0.0, 0.0, 1.0]),
+        ..Default::default()
+    };
+    let cl = "FEDRAT/MMPM,100\nGOTO/5,5,0\nGOHOME\n";
+    let mut out = Vec::new();
+    kinpost_post::post(cl.as_bytes(), &machine, &dialect, &mut out, &options).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    let last = text.lines().last().unwrap();
+    assert_eq!(last, "3,rapid,10.000000,20.000000,150.000000,", "{text}");
 }
 
 /// A surface speed in rpm from the tool diameter: n = 1000 v / (π d).
