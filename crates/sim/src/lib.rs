@@ -55,7 +55,9 @@ use kinpost_nc::interp::{self, Family, Options, Step};
 pub use cl::ClPath;
 pub use removal::Cutting;
 pub use replay::Replay;
-pub use report::{At, ClComparison, Contact, Deviation, Overtravel, Removal, SimReport};
+pub use report::{
+    At, ClComparison, Contact, Deviation, Overtravel, Removal, SimReport, SingularPassage,
+};
 
 /// Why a program cannot be replayed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

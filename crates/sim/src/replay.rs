@@ -1,13 +1,13 @@
 //! The replay: every step of the interpreter through the machine.
 
-use kinpost_machine::{Kinematics, KinematicsAtPressure, Machine};
+use kinpost_machine::{Kinematics, KinematicsAtPressure, Machine, Singularity};
 use kinpost_nc::interp::{Event, FeedMode, MAX_AXES, MotionKind, Move, Step};
 
 use crate::cl::ClPath;
 use crate::collide::Worlds;
 use crate::path::{ArcPath, BlockPath, Joints, Shape, plane_axes};
 use crate::removal::{BlockConditions, Cutting};
-use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport};
+use crate::report::{At, ClComparison, Deviation, Overtravel, SimReport, SingularPassage};
 use crate::{SimError, SimOptions, tolerance};
 
 mod tcp;
@@ -50,6 +50,9 @@ pub struct Replay {
     cl: Option<(ClPath, ClComparison)>,
     worlds: Option<Worlds>,
     cutting: Option<Cutting>,
+    /// The machine's singular tool-axis direction and the cone around it
+    /// (radians) within which a passage is reported.
+    singular: Option<(Singularity, f64)>,
     scratch: Vec<f64>,
     untimed_blocks: u64,
     error: Option<SimError>,
@@ -112,6 +115,11 @@ impl Replay {
         }
         let xyz = ["X", "Y", "Z"].map(|l| sim.axis_index(l).filter(|&i| !axes[i].rotary));
         let kin = KinematicsAtPressure::new(&sim, Kinematics::new(&sim), options.pressure_offset);
+        let cone_deg = machine
+            .post
+            .singular_cone_deg
+            .unwrap_or(kinpost_machine::tolerance::DEFAULT_SINGULAR_CONE_DEG);
+        let singular = kin.singularity().map(|s| (s, cone_deg.to_radians()));
         let mut q = [0.0; MAX_AXES];
         let start = start_joints(machine, options);
         q[..n].copy_from_slice(&start[..n]);
@@ -149,6 +157,7 @@ impl Replay {
             cl,
             worlds,
             cutting: None,
+            singular,
             scratch: Vec::new(),
             untimed_blocks: 0,
             error: None,
@@ -161,6 +170,83 @@ impl Replay {
     pub fn with_cutting(mut self, cutting: Cutting) -> Replay {
         self.cutting = Some(cutting);
         self
+    }
+
+    /// A block that turns the tool axis through the cone around the
+    /// machine's singular direction (where one rotary angle is free and
+    /// swings): a singular passage, reported with the least angle and how
+    /// far the free axis turns. The tool axis moves by at most the sum of
+    /// the rotary turns, so a block whose ends are farther from the pole
+    /// than half that sum plus the cone is passed without sampling; others
+    /// are sampled as the CL comparison samples.
+    fn singular_passage(&mut self, path: &BlockPath, at: &At) {
+        let Some((pole, cone)) = self.singular else {
+            return;
+        };
+        if !self.may_pass_pole(&path.from, &path.to, cone) {
+            return;
+        }
+        let n = self.n;
+        let pieces = self.pieces(path, &0.0);
+        let mut q = [0.0; MAX_AXES];
+        let mut least = f64::INFINITY;
+        for k in 0..=pieces {
+            path.at(k as f64 / pieces as f64, &mut q);
+            least = least.min(pole.distance(&self.kin.fk(&q[..n]).axis));
+        }
+        let turn_deg = (path.to[pole.axis] - path.from[pole.axis]).abs();
+        self.note_passage(at, least, turn_deg);
+    }
+
+    /// Whether a block from joints `from` to `to` that turns a rotary axis
+    /// may bring the tool axis within `cone` (radians) of the singular
+    /// direction: the axis moves by at most the sum of the rotary turns,
+    /// so it cannot when its ends are farther from the pole than half that
+    /// sum plus the cone.
+    pub(crate) fn may_pass_pole(&self, from: &Joints, to: &Joints, cone: f64) -> bool {
+        let Some((pole, _)) = self.singular else {
+            return false;
+        };
+        let n = self.n;
+        let turn_rad: f64 = (0..n)
+            .filter(|&i| self.axes[i].rotary)
+            .map(|i| (to[i] - from[i]).abs().to_radians())
+            .sum();
+        if turn_rad == 0.0 {
+            return false;
+        }
+        let d0 = pole.distance(&self.kin.fk(&from[..n]).axis);
+        let d1 = pole.distance(&self.kin.fk(&to[..n]).axis);
+        (d0 + d1 - turn_rad) / 2.0 <= cone
+    }
+
+    /// A block whose tool axis came `least` (radians) from the singular
+    /// direction while the free axis turned `turn_deg`: a singular passage
+    /// when inside the cone.
+    pub(crate) fn note_passage(&mut self, at: &At, least: f64, turn_deg: f64) {
+        let Some((pole, cone)) = self.singular else {
+            return;
+        };
+        if least > cone {
+            return;
+        }
+        let passages = &mut self.report.singular_passages;
+        if let Some(last) = passages.last_mut()
+            && last.last_block + 1 == at.block
+        {
+            last.last_block = at.block;
+            last.angle_deg = last.angle_deg.min(least.to_degrees());
+            last.turn_deg += turn_deg;
+            return;
+        }
+        passages.push(SingularPassage {
+            at: at.clone(),
+            last_block: at.block,
+            axis: self.axes[pole.axis].name.clone(),
+            angle_deg: least.to_degrees(),
+            cone_deg: cone.to_degrees(),
+            turn_deg,
+        });
     }
 
     /// A block's conditions for the grinding process model: the pressure
@@ -323,6 +409,9 @@ impl Replay {
             self.complete_at.get_or_insert(step.line);
             if self.cl.is_some() && !rapid {
                 self.compare(&path, &at, started);
+            }
+            if started {
+                self.singular_passage(&path, &at);
             }
             if let Some(w) = &mut self.worlds
                 && let Err(e) = w.check(&path, &at, rapid, started, self.pressure)

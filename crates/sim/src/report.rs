@@ -109,6 +109,10 @@ pub struct SimReport {
     pub collisions: Vec<Contact>,
     /// Pairs within their warning clearance (warnings).
     pub near_misses: Vec<Contact>,
+    /// Blocks that turn the tool axis through the cone around the
+    /// machine's singular direction (warnings: a rotary axis may swing
+    /// there), consecutive blocks as one.
+    pub singular_passages: Vec<SingularPassage>,
     /// Rapid blocks into the stock, in program order: a rapid that touches
     /// a stock solid of the machine file (also among `collisions`), or
     /// that removes material from `--stock` (also among
@@ -130,6 +134,25 @@ pub struct SimReport {
     /// Material removal, when the replay cut a stock.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub removal: Option<Removal>,
+}
+
+/// A passage of the tool axis near the machine's singular direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SingularPassage {
+    /// The first block of the passage.
+    #[serde(flatten)]
+    pub at: At,
+    /// Its last block.
+    pub last_block: u64,
+    /// The axis whose angle is free at the singular direction.
+    pub axis: String,
+    /// The least angle between the tool axis and the singular direction,
+    /// degrees.
+    pub angle_deg: f64,
+    /// The cone reported, degrees (the machine's `singular_cone`).
+    pub cone_deg: f64,
+    /// How far the free axis turns in the passage, degrees.
+    pub turn_deg: f64,
 }
 
 /// What the tool removed from the stock, and how the part compares with
@@ -230,6 +253,25 @@ impl SimReport {
         }
         more(&mut s, self.collisions.len(), "collisions");
         more(&mut s, self.near_misses.len(), "near misses");
+        for p in self.singular_passages.iter().take(SUMMARY_LINES) {
+            let _ = writeln!(
+                s,
+                "warning: line {}{}: the tool axis passes {:.4}° from the singular direction (within the {}° cone), where {} is free; {} turns {:.3}° in the passage{}",
+                p.at.line,
+                number(p.at.number),
+                p.angle_deg,
+                p.cone_deg,
+                p.axis,
+                p.axis,
+                p.turn_deg,
+                if p.last_block > p.at.block {
+                    format!(" (through block {})", p.last_block)
+                } else {
+                    String::new()
+                }
+            );
+        }
+        more(&mut s, self.singular_passages.len(), "singular passages");
         if let Some(r) = &self.removal {
             r.findings(&mut s);
         }

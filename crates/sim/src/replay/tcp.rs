@@ -99,6 +99,18 @@ impl Replay {
         conditions: BlockConditions,
     ) -> Result<(), SimError> {
         let pieces = joints.len() - 1;
+        if started
+            && let Some((pole, cone)) = self.singular
+            && self.may_pass_pole(&joints[0], &joints[pieces], cone)
+        {
+            // The TCP path's samples: the tool axis at each.
+            let least = joints
+                .iter()
+                .map(|q| pole.distance(&self.kin.fk(&q[..self.n]).axis))
+                .fold(f64::INFINITY, f64::min);
+            let turn_deg = (joints[pieces][pole.axis] - joints[0][pole.axis]).abs();
+            self.note_passage(at, least, turn_deg);
+        }
         if self.cl.is_some() && !rapid {
             let first = if started { 1 } else { pieces };
             for (k, q) in joints.iter().enumerate().skip(first) {

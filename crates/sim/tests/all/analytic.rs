@@ -228,3 +228,36 @@ fn cl_arcs_are_compared_as_arcs() {
     let sagitta = 10.0 * (1.0 - std::f64::consts::FRAC_1_SQRT_2);
     assert!((chord - sagitta).abs() < 1e-4, "{chord} vs {sagitta}");
 }
+
+/// The trunnion's singular direction is the C axis (A = 0: C turns the
+/// part about the tool axis). A block that tilts A through 0 passes it
+/// (least angle 0, within the machine's 0.5° cone), a warning at its
+/// line; the next block (A 10° to 20°) stays clear; consecutive passing
+/// blocks are one passage. Not a violation.
+#[test]
+fn a_tilt_through_the_singular_direction_is_a_singular_passage() {
+    let r = run(
+        "G21 G90 G94\nG0 X0 Y0 Z100 A-10 C0\nG1 A10 C30 F1000\nG1 A20\nG1 A-0.2 C40\nG1 A0.3 C50\nM2\n",
+        &trunnion(),
+    );
+    let found: Vec<(usize, u64, &str, f64)> = r
+        .singular_passages
+        .iter()
+        .map(|p| (p.at.line, p.last_block, p.axis.as_str(), p.turn_deg))
+        .collect();
+    assert_eq!(
+        found,
+        [(3, 2, "C", 30.0), (5, 5, "C", 20.0)],
+        "{:?}",
+        r.singular_passages
+    );
+    assert!(r.singular_passages[0].angle_deg < 1e-9);
+    // A -0.2° and 0.3° (blocks 4 and 5 of lines 5 and 6): one passage,
+    // its least angle 0 where A crosses 0 in line 6.
+    assert!(r.singular_passages[1].angle_deg < 1e-9);
+    assert!(!r.violated());
+    assert!(
+        r.summary()
+            .contains("warning: line 3: the tool axis passes")
+    );
+}
