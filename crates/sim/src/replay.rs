@@ -53,6 +53,11 @@ pub struct Replay {
     /// The machine's singular tool-axis direction and the cone around it
     /// (radians) within which a passage is reported.
     singular: Option<(Singularity, f64)>,
+    /// Joints and a lower bound of the tool axis's distance from the
+    /// singular direction there (radians): a block's start is the previous
+    /// block's end, and a block that turns the rotary axes by T moves the
+    /// tool axis by at most T, so most blocks need no forward kinematics.
+    last_pole: Option<(Joints, f64)>,
     scratch: Vec<f64>,
     untimed_blocks: u64,
     error: Option<SimError>,
@@ -158,6 +163,7 @@ impl Replay {
             worlds,
             cutting: None,
             singular,
+            last_pole: None,
             scratch: Vec::new(),
             untimed_blocks: 0,
             error: None,
@@ -203,7 +209,7 @@ impl Replay {
     /// direction: the axis moves by at most the sum of the rotary turns,
     /// so it cannot when its ends are farther from the pole than half that
     /// sum plus the cone.
-    pub(crate) fn may_pass_pole(&self, from: &Joints, to: &Joints, cone: f64) -> bool {
+    pub(crate) fn may_pass_pole(&mut self, from: &Joints, to: &Joints, cone: f64) -> bool {
         let Some((pole, _)) = self.singular else {
             return false;
         };
@@ -215,8 +221,18 @@ impl Replay {
         if turn_rad == 0.0 {
             return false;
         }
+        let bound = match self.last_pole {
+            Some((q, d)) if q[..n] == from[..n] => d,
+            _ => f64::NEG_INFINITY,
+        };
+        if bound - turn_rad > cone {
+            // Clear of the cone all along; the bound at the end.
+            self.last_pole = Some((*to, bound - turn_rad));
+            return false;
+        }
         let d0 = pole.distance(&self.kin.fk(&from[..n]).axis);
         let d1 = pole.distance(&self.kin.fk(&to[..n]).axis);
+        self.last_pole = Some((*to, d1));
         (d0 + d1 - turn_rad) / 2.0 <= cone
     }
 
@@ -312,6 +328,7 @@ impl Replay {
             Event::Pressure { value, .. } => {
                 self.pressure = *value;
                 self.kin.select(*value);
+                self.last_pole = None;
             }
             Event::Dwell { seconds } => self.report.duration_s += seconds,
             _ => {}
