@@ -26,6 +26,8 @@ pub struct Cutting {
     /// The block of every move id: move `k` is the `k`-th block cut.
     blocks: Vec<BlockRef>,
     rapid_cuts: Vec<At>,
+    /// Rapids whose tool enters the stock's box (warnings).
+    rapids_in_box: Vec<At>,
     /// What each block ground with the process model.
     ground: Vec<(u32, GrindStats)>,
 }
@@ -50,6 +52,7 @@ impl Cutting {
             process: None,
             blocks: Vec::new(),
             rapid_cuts: Vec::new(),
+            rapids_in_box: Vec::new(),
             ground: Vec::new(),
         }
     }
@@ -96,6 +99,7 @@ impl Cutting {
             resolution_mm: self.stock.resolution_mm(),
             removed_volume_mm3: self.stock.removed_volume_mm3(),
             rapid_cuts: self.rapid_cuts.clone(),
+            rapids_in_stock_box: self.rapids_in_box.clone(),
             design: cmp
                 .as_ref()
                 .map(|c| kinpost_stock::Report::new(stock, &self.stock, c, &self.blocks)),
@@ -130,8 +134,11 @@ impl Cutting {
         let tool_poses: Vec<ToolPose> = poses.iter().map(tool_pose).collect();
         // (Only a rapid whose sweep reaches the stock's box can cut: the
         // volume is summed before and after it then.)
-        let volume_before = (rapid && self.reaches_stock(&tool_poses).map_err(cut_error)?)
-            .then(|| self.stock.volume_mm3());
+        let in_box = rapid && self.reaches_stock(&tool_poses).map_err(cut_error)?;
+        if in_box {
+            self.rapids_in_box.push(at.clone());
+        }
+        let volume_before = in_box.then(|| self.stock.volume_mm3());
         if let Some(c) = conditions.filter(|_| !rapid)
             && let Some(grinding) = self.grinding_conditions(&tool_poses, &c, at)?
         {

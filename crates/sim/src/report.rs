@@ -169,6 +169,9 @@ pub struct Removal {
     /// Rapid blocks that removed material (errors: a rapid into the
     /// stock).
     pub rapid_cuts: Vec<At>,
+    /// Rapid blocks whose tool enters the stock's bounding box (warnings:
+    /// a rapid that close to the material, cutting or not).
+    pub rapids_in_stock_box: Vec<At>,
     /// The comparison with the design (`--design`): gouges and residuals
     /// with their blocks, regions, histogram.
     pub design: Option<kinpost_stock::Report>,
@@ -345,6 +348,21 @@ impl Removal {
             );
         }
         more(s, self.rapid_cuts.len(), "rapid cuts");
+        let cut: Vec<u64> = self.rapid_cuts.iter().map(|a| a.block).collect();
+        let boxed: Vec<&At> = self
+            .rapids_in_stock_box
+            .iter()
+            .filter(|a| !cut.contains(&a.block))
+            .collect();
+        for at in boxed.iter().take(SUMMARY_LINES) {
+            let _ = writeln!(
+                s,
+                "warning: line {}{}: a rapid enters the stock's bounding box",
+                at.line,
+                number(at.number)
+            );
+        }
+        more(s, boxed.len(), "rapids in the stock's box");
         let Some(d) = &self.design else {
             return;
         };

@@ -233,6 +233,19 @@ fn a_slot_and_a_rapid_plunge_are_cut_and_compared_with_the_design() {
     assert_eq!(rapid.len(), 1, "{r}");
     assert_eq!(rapid[0]["line"], 7);
     assert_eq!(json["rapid_into_stock"], serde_json::json!([rapid[0]]));
+    // The retracts from the slot and from the plunge start inside the
+    // stock's box: warnings, with the plunge.
+    let boxed: Vec<&serde_json::Value> = r["rapids_in_stock_box"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| &a["line"])
+        .collect();
+    assert_eq!(boxed, [5, 7, 8]);
+    assert!(
+        err.contains("warning: line 5: a rapid enters the stock's bounding box"),
+        "{err}"
+    );
     let d = &r["design"];
     assert!(
         (d["gouge_max_mm"].as_f64().unwrap() - 5.0).abs() < 1e-9,
