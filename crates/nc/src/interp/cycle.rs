@@ -6,6 +6,7 @@
 //! tool and runs the ops as moves, dwells and spindle events.
 
 use super::machine::Machine;
+use super::source::Fail;
 use super::{CycleRef, SpindleDir};
 
 /// One step of a cycle, along the tool axis.
@@ -52,8 +53,10 @@ pub(crate) struct Hole {
 
 /// Positions the tool over the hole (rapid in the plane at the current
 /// level, raised to the R plane first if it is below and the cycle asks
-/// so), rapids down to the R plane, then runs the ops.
-pub(crate) fn drill(m: &mut Machine<'_>, hole: &Hole) {
+/// so), rapids down to the R plane, then runs the ops. Fails when the
+/// canned cycles' moves exceed the run's budget ([`Machine::charge_cycle`]).
+pub(crate) fn drill(m: &mut Machine<'_>, hole: &Hole) -> Result<(), Fail> {
+    m.charge_cycle(hole.ops.len() + 2)?;
     let [a, b, n] = m.state.plane.axes();
     let saved = m.cycle;
     m.cycle = Some(hole.cycle);
@@ -109,6 +112,7 @@ pub(crate) fn drill(m: &mut Machine<'_>, hole: &Hole) {
         }
     }
     m.cycle = saved;
+    Ok(())
 }
 
 /// Pecks from `r` down to `bottom` by `q` (G83 / G73 style): each peck

@@ -88,6 +88,9 @@ pub(crate) struct Machine<'s> {
     pub cycle: Option<CycleRef>,
     /// The moves being emitted are machine coordinates (`G53`).
     pub machine_frame: bool,
+    /// Moves of canned cycles emitted so far: bounded like the blocks
+    /// executed (a cycle's repeat count and its pecks multiply its work).
+    cycle_moves: u64,
 }
 
 impl<'s> Machine<'s> {
@@ -151,6 +154,7 @@ impl<'s> Machine<'s> {
             },
             cycle: None,
             machine_frame: false,
+            cycle_moves: 0,
         }
     }
 
@@ -179,6 +183,23 @@ impl<'s> Machine<'s> {
                 format!(
                     "more than {} blocks executed (Options::max_executed_blocks): an endless \
                      loop, or raise the limit",
+                    self.options.max_executed_blocks
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// Charges `moves` moves of a canned cycle (a hole); fails past
+    /// [`Options::max_executed_blocks`], like a loop.
+    pub fn charge_cycle(&mut self, moves: usize) -> Result<(), Fail> {
+        self.cycle_moves = self.cycle_moves.saturating_add(moves as u64);
+        if self.cycle_moves > self.options.max_executed_blocks {
+            return fail(
+                0,
+                1,
+                format!(
+                    "canned cycles make more than {} moves (Options::max_executed_blocks): a repeat count or a peck depth out of proportion, or raise the limit",
                     self.options.max_executed_blocks
                 ),
             );

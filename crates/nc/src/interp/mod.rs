@@ -511,7 +511,8 @@ pub struct Options {
     /// of the machine; 0.5 mm here when not given).
     pub fanuc_peck_clearance_mm: Option<f64>,
     /// Most blocks executed (jumps and loops count every pass) before the
-    /// run stops with an error: 500 million by default.
+    /// run stops with an error, and most moves canned cycles make (their
+    /// repeat counts and pecks multiply them): 500 million by default.
     pub max_executed_blocks: u64,
     /// Deepest nesting of subprogram / macro calls: 64 by default.
     pub max_call_depth: usize,

@@ -241,3 +241,58 @@ fn block_numbers_that_would_overflow_are_an_error() {
     unique.dedup();
     assert_eq!(unique.len(), numbers.len(), "{text}");
 }
+
+/// A canned cycle's repeat count (and its pecks) multiply its moves: they
+/// are bounded by the run's block budget like loops, so a bored hole
+/// repeated 33,333,330 times (Fanuc K) under a budget of 20,000 stops at once with an
+/// error (found by fuzzing: it ran for minutes).
+#[test]
+fn canned_cycle_repeats_are_bounded_like_loops() {
+    use kinpost_nc::interp::{Family, Options, Step, run};
+    let text = "L83330M96M99g85k33333330C777777777777777777736\n";
+    let options = Options {
+        max_executed_blocks: 20_000,
+        ..Options::default()
+    };
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::endless("A"),
+        AxisSpec::linear("Y"),
+        AxisSpec::linear("Z"),
+        AxisSpec::rotary("B"),
+        AxisSpec::rotary("C"),
+    ];
+    // (Each family reads the bytes its own way; Fanuc takes K as the
+    // repeat count.)
+    let mut messages = Vec::new();
+    for family in [
+        Family::Sinumerik,
+        Family::Fanuc,
+        Family::LinuxCnc,
+        Family::Heidenhain,
+        Family::Csv,
+    ] {
+        let started = Instant::now();
+        if let Err(e) = run(text, family, &axes, &options, "cycle", &mut |_: &Step| {}) {
+            messages.push(e.message);
+        }
+        assert!(started.elapsed() < Duration::from_secs(5), "{family:?}");
+    }
+    assert!(
+        messages
+            .iter()
+            .any(|m| m.contains("canned cycles make more than 20000 moves")),
+        "{messages:?}"
+    );
+    // The same cycle repeated a few times runs.
+    let ok = "G0 X0 Y0 Z10\nG91 G85 X1 Y0 Z-2 R1 L3 F100\nM2\n";
+    run(
+        ok,
+        Family::LinuxCnc,
+        &axes,
+        &options,
+        "ok.ngc",
+        &mut |_: &Step| {},
+    )
+    .unwrap();
+}

@@ -661,7 +661,7 @@ impl Interp<'_, '_> {
             travel_level: None,
             ops,
         };
-        cycle::drill(&mut self.m, &hole);
+        cycle::drill(&mut self.m, &hole)?;
         Ok(())
     }
 

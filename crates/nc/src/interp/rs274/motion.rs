@@ -302,7 +302,7 @@ impl Interp<'_, '_> {
                     .then(|| init.max(self.m.pos[inn])),
                 ops: ops.clone(),
             };
-            cycle::drill(&mut self.m, &hole);
+            cycle::drill(&mut self.m, &hole)?;
         }
         self.cycle_initial = Some(init);
         Ok(())

@@ -997,7 +997,7 @@ impl Interp<'_, '_> {
             ops,
         };
         let _ = pn;
-        cycle::drill(&mut self.m, &hole);
+        cycle::drill(&mut self.m, &hole)?;
         Ok(())
     }
 }
