@@ -135,7 +135,7 @@ pub fn sim(args: &SimArgs) -> Result<()> {
     }
     let mut sinks = open_sim_outputs(args)?;
     let machine = load_machine(&args.machine)?;
-    let removal = RemovalSetup::load(args)?;
+    let mut removal = RemovalSetup::load(args)?;
     let family = family(args, machine.post.dialect.as_deref())?;
     let (text, file) = read_program(&args.program)?;
     let cl = match &args.cl {
@@ -166,7 +166,9 @@ pub fn sim(args: &SimArgs) -> Result<()> {
             &machine,
             &options,
             cl,
-            removal.as_ref().map(|r| r.cutting.clone()),
+            // (The stock moves into the replay and comes back cut: a
+            // stock can be gigabytes.)
+            removal.as_mut().and_then(|r| r.cutting.take()),
             &mut |s: &Step| {
                 if let Some(t) = &mut table {
                     t.step(s);
@@ -211,7 +213,8 @@ pub fn sim(args: &SimArgs) -> Result<()> {
 /// Material removal as the options ask for it: the stock and tool, and the
 /// design to compare with.
 struct RemovalSetup {
-    cutting: Cutting,
+    /// The stock and tool, until the replay takes them.
+    cutting: Option<Cutting>,
     description: String,
     design: Option<Design>,
 }
@@ -262,7 +265,7 @@ impl RemovalSetup {
             cutting = cutting.with_process(model);
         }
         Ok(Some(RemovalSetup {
-            cutting,
+            cutting: Some(cutting),
             description,
             design,
         }))
