@@ -130,6 +130,42 @@ warning_clearance = 1000
     );
 }
 
+/// Two boxes side by side, one tilted about an axis parallel to the gap:
+/// the distance is the gap whatever the tilt. parry 0.31's cuboid-cuboid
+/// `query::distance` overestimates some of these (dimforge/parry#431; it
+/// reported 27.7 mm for a 3.2 mm gap on mts1600), which the sweep test
+/// found as a near miss reported late.
+#[test]
+fn tilted_box_beside_a_box_is_the_gap_away() {
+    let m = mill(
+        r#"
+[[solid]]
+name = "cube"
+on = "tool"
+box = { size = [20, 20, 20] }
+origin = [0, 0, 10]
+[[solid]]
+name = "block"
+on = "base"
+box = { size = [100, 100, 50] }
+origin = [0, 0, -90]
+[collision]
+warning_clearance = 1000
+"#,
+    );
+    let world = World::new(&m).unwrap();
+    // The cube (its bottom face at the tool point) from y = 55 to 75, the
+    // block to y = 50: a 5 mm gap, the cube's z range overlapping the
+    // block's top at any tilt about y.
+    for tilt in [-40.0, -13.36, -2.0, 0.5, 1.0, 7.0, 13.36, 25.0, 40.0] {
+        for x in [-20.0, 0.0, 15.0] {
+            let q = joints(&m, &[("X", x), ("Y", 65.0), ("Z", -55.0), ("B", tilt)]);
+            let got = reported(&world, &q, "cube", "block").expect("reported");
+            assert!((got - 5.0).abs() < 1e-9, "B = {tilt}, X = {x}: {got}");
+        }
+    }
+}
+
 #[test]
 fn cylinder_to_plane_at_known_poses() {
     // A Ø20 × 60 cylinder standing on the tool point; a slab whose top
