@@ -19,6 +19,23 @@ pub(crate) fn coordinate_axis(v: &Vector3<f64>) -> Option<(usize, f64)> {
     (zeros == 2 && v[k].abs() == 1.0).then_some((k, v[k]))
 }
 
+/// `g²` of subproblem 2, the squared height of the intersection point
+/// `z = a·w1 + b·w2 + g·(w1 × w2)` off the plane of the axes, from
+/// `|q off w1|² / |w1 × w2|²` and `b`.
+///
+/// `z` turns onto `q` about `w1`, so its part off `w1`, `b·(w2 − (w1·w2)·w1)
+/// + g·(w1 × w2)` (two orthogonal terms, each of length `|w1 × w2|` per
+/// unit), is as long as `q`'s: `|q off w1|² = (b² + g²)·|w1 × w2|²`.
+/// Murray, Li and Sastry (§3.3.2) write `g²` from `|z|² = |p|²` instead,
+/// `(|p|² − a² − b² − 2ab·w1·w2) / |w1 × w2|²`: near the pole (`q` nearly
+/// along `w1`, `g` small) that difference of numbers near 1 loses what `g`
+/// is made of: 2.4·10⁻⁹ rad of the tool axis 1·10⁻⁶ ° from the pole;
+/// here `g²` is as accurate as `q`'s small components.
+#[inline(always)]
+fn height_squared(q_off_w1_squared_over_cross2: f64, b: f64) -> f64 {
+    q_off_w1_squared_over_cross2 - b * b
+}
+
 /// Rotation matrix about unit `w` by `theta` radians (Rodrigues' formula).
 #[inline]
 pub fn rotation(w: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
@@ -165,7 +182,6 @@ pub struct Sp2 {
     cross2: f64,
     denom: f64,
     w2p: f64,
-    p2: f64,
     /// `p` with its component along `w2` removed (subproblem 1 for `θ2`
     /// turns it), and whether that leaves nothing (`θ2` free).
     p_off_w2: Vector3<f64>,
@@ -229,7 +245,6 @@ impl Sp2 {
             cross2: cross.norm_squared(),
             denom: w12 * w12 - 1.0,
             w2p,
-            p2: p.norm_squared(),
             p_off_w2,
             p_on_w2: p_off_w2.norm_squared() < FREE_EPS * FREE_EPS,
             aligned,
@@ -253,15 +268,16 @@ impl Sp2 {
         let w1q = w1.dot(q);
         let a = (w12 * self.w2p - w1q) / self.denom;
         let b = (w12 * w1q - self.w2p) / self.denom;
-        let g2 = (self.p2 - a * a - b * b - 2.0 * a * b * w12) / self.cross2;
+        // Subproblem 1 (see `sp1_xy`) for both angles, sharing the
+        // projections that do not depend on the intersection point `z`.
+        let q_off_w1 = q - w1 * w1q;
+        let q_off2 = q_off_w1.norm_squared();
+        let q_on_w1 = q_off2 < FREE_EPS * FREE_EPS;
+        let g2 = height_squared(q_off2 / self.cross2, b);
         if g2 < -slack {
             return ([none; 2], 0);
         }
         let g = g2.max(0.0).sqrt();
-        // Subproblem 1 (see `sp1_xy`) for both angles, sharing the
-        // projections that do not depend on the intersection point `z`.
-        let q_off_w1 = q - w1 * w1q;
-        let q_on_w1 = q_off_w1.norm_squared() < FREE_EPS * FREE_EPS;
         if g == 0.0 {
             ([self.at(a, b, 0.0, &q_off_w1, q_on_w1), none], 1)
         } else {
@@ -279,7 +295,7 @@ impl Sp2 {
     /// arithmetic without the products with a zero component of `w1`, `w2`
     /// or `w1 × w2` (every sum left has one or two terms), hence the same
     /// values up to the sign of a zero result. With `w1·w2 = 0` and
-    /// `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`, `g² = |p|² − a² − b²`
+    /// `|w1 × w2| = 1`: `a = w1·q`, `b = w2·p`, `g² = q_j² + q_k² − b²`
     /// (Murray, Li, Sastry §3.3.2), `z = σ1·a·e_i + σ2·b·e_j + σ3·g·e_k`.
     #[inline(always)]
     fn solve_aligned(&self, al: &Aligned, q: &Vector3<f64>, slack: f64) -> ([Sp2Xy; 2], usize) {
@@ -289,14 +305,15 @@ impl Sp2 {
         };
         let a = al.s1 * q[al.i];
         let b = self.w2p;
-        let g2 = self.p2 - a * a - b * b;
+        // q off w1: q with its component i zero.
+        let (qj, qk) = (q[al.j], q[al.k]);
+        let q_off2 = qj * qj + qk * qk;
+        let g2 = height_squared(q_off2, b);
         if g2 < -slack {
             return ([none; 2], 0);
         }
         let g = g2.max(0.0).sqrt();
-        // q off w1: q with its component i zero.
-        let (qj, qk) = (q[al.j], q[al.k]);
-        let q_on_w1 = qj * qj + qk * qk < FREE_EPS * FREE_EPS;
+        let q_on_w1 = q_off2 < FREE_EPS * FREE_EPS;
         let (po_i, po_k) = (al.po_i, al.po_k);
         let (zb, za) = (al.s2 * b, al.s1 * a);
         let solve = |g: f64| {
@@ -332,10 +349,11 @@ impl Sp2 {
         let al = self.aligned.as_ref()?;
         let a = al.s1 * q[al.i];
         let b = self.w2p;
-        let g2 = (self.p2 - a * a - b * b).max(0.0);
         let (qj, qk) = (q[al.j], q[al.k]);
+        let q_off2 = qj * qj + qk * qk;
+        let g2 = height_squared(q_off2, b).max(0.0);
         Some([
-            ((b * b + g2) * (qj * qj + qk * qk)).sqrt(),
+            ((b * b + g2) * q_off2).sqrt(),
             ((al.po_i * al.po_i + al.po_k * al.po_k) * (a * a + g2)).sqrt(),
         ])
     }
@@ -379,8 +397,8 @@ mod tests {
     }
 
     /// Subproblem 2 as first written, solved from scratch for each `q`
-    /// (Murray, Li, Sastry §3.3.2): the precomputed [`Sp2`] must give the
-    /// same bits.
+    /// (Murray, Li, Sastry §3.3.2, with `g²` as [`height_squared`] has
+    /// it): the precomputed [`Sp2`] must give the same bits.
     fn sp2_from_scratch(
         w1: &Vector3<f64>,
         w2: &Vector3<f64>,
@@ -401,7 +419,7 @@ mod tests {
         let denom = w12 * w12 - 1.0;
         let a = (w12 * w2.dot(p) - w1.dot(q)) / denom;
         let b = (w12 * w1.dot(q) - w2.dot(p)) / denom;
-        let g2 = (p.norm_squared() - a * a - b * b - 2.0 * a * b * w12) / cross2;
+        let g2 = height_squared((q - w1 * w1.dot(q)).norm_squared() / cross2, b);
         if g2 < -slack {
             return ([none; 2], 0);
         }
