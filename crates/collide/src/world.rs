@@ -7,6 +7,7 @@ use kinpost_machine::{Body, Kinematics, Machine, Mesh, Role, Solid};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::gjk::{self, CsoPoint, GJKResult, VoronoiSimplex};
 use parry3d_f64::query::{self, ClosestPoints};
 use parry3d_f64::shape::SharedShape;
 use rayon::prelude::*;
@@ -327,11 +328,14 @@ impl World {
             }
             _ => match query::closest_points(&a.pose, sa, &b.pose, sb, margin) {
                 Ok(ClosestPoints::Intersecting) => Some(0.0),
-                // Within the margin, GJK may stop as soon as it knows so:
-                // the exact distance, for the report.
-                Ok(ClosestPoints::WithinMargin(p1, p2)) => {
-                    Some(exact_distance(&a.pose, sa, &b.pose, sb).unwrap_or((p1 - p2).length()))
-                }
+                // GJK runs to convergence within the margin (parry asks
+                // it for exact distances), so these are the closest points.
+                // Not `query::distance`: for two cuboids parry 0.31 takes
+                // its own routine, which overestimates some poses
+                // (dimforge/parry#431: 27.7 mm for a 3.2 mm gap between
+                // mts1600's arm and tailstock), and a near miss went
+                // unreported.
+                Ok(ClosestPoints::WithinMargin(p1, p2)) => Some((p1 - p2).length()),
                 Ok(ClosestPoints::Disjoint) => None,
                 // No query for these shapes (none of kinpost's): the boxes'
                 // gap is a distance the solids are not nearer than.
@@ -503,47 +507,50 @@ fn mesh_to_convex(
             return gap;
         }
         // GJK stops as soon as it proves the box farther than the best
-        // distance so far (the node is pruned); otherwise the boxes' gap
-        // stays its bound, a true lower one.
+        // distance so far (the node is pruned) or nearer (not pruned: the
+        // boxes' gap stays its bound, a true lower one); it never needs
+        // to converge on the distance itself.
         let cuboid = Cuboid::new(aabb.half_extents());
         let centre = Pose::from_translation(aabb.center());
-        match query::closest_points(&centre, &cuboid, &pose, shape, best) {
-            Ok(ClosestPoints::Disjoint) => f64::MAX,
-            _ => gap,
-        }
+        let farther = match shape.as_support_map() {
+            Some(map) => {
+                let pos12 = centre.inv_mul(&pose);
+                let dir = (-pos12.translation).try_normalize().unwrap_or(Vector::X);
+                let mut simplex = VoronoiSimplex::new();
+                simplex.reset(CsoPoint::from_shapes(&pos12, &cuboid, map, dir));
+                matches!(
+                    gjk::closest_points(&pos12, &cuboid, map, best, false, &mut simplex),
+                    GJKResult::NoIntersection(_)
+                )
+            }
+            None => matches!(
+                query::closest_points(&centre, &cuboid, &pose, shape, best),
+                Ok(ClosestPoints::Disjoint)
+            ),
+        };
+        if farther { f64::MAX } else { gap }
     };
-    let leaf = |i: u32, _best: f64| {
-        query::distance(&Pose::IDENTITY, &mesh.triangle(i), &pose, shape)
+    // A triangle is measured only when GJK cannot prove it farther than
+    // the best distance so far; then by `query::distance`, exact where
+    // parry has a closed form (a ball).
+    let leaf = |i: u32, best: f64| {
+        let triangle = mesh.triangle(i);
+        if let Some(map) = shape.as_support_map() {
+            let dir = (-pose.translation).try_normalize().unwrap_or(Vector::X);
+            let mut simplex = VoronoiSimplex::new();
+            simplex.reset(CsoPoint::from_shapes(&pose, &triangle, map, dir));
+            let far = gjk::closest_points(&pose, &triangle, map, best, false, &mut simplex);
+            if matches!(far, GJKResult::NoIntersection(_)) {
+                return None;
+            }
+        }
+        query::distance(&Pose::IDENTITY, &triangle, &pose, shape)
             .ok()
             .map(|d| d.distance)
     };
     mesh.bvh()
         .find_best(limit, node_bound, leaf)
         .map(|(_, d)| d.min(margin))
-}
-
-/// The distance between two solids, GJK run to convergence when both are
-/// convex (support maps).
-///
-/// Not `query::distance` for those: parry 0.31's dispatcher sends two
-/// cuboids to its own cuboid-cuboid routine, which overestimates the
-/// distance of some poses (dimforge/parry#431; 27.7 mm for a 3.2 mm gap
-/// between the arm and the tailstock of mts1600), so a near miss would go
-/// unreported.
-fn exact_distance(
-    pa: &Pose,
-    sa: &dyn parry3d_f64::shape::Shape,
-    pb: &Pose,
-    sb: &dyn parry3d_f64::shape::Shape,
-) -> Option<f64> {
-    match (sa.as_support_map(), sb.as_support_map()) {
-        (Some(ma), Some(mb)) => Some(query::details::distance_support_map_support_map(
-            &pa.inv_mul(pb),
-            ma,
-            mb,
-        )),
-        _ => query::distance(pa, sa, pb, sb).ok().map(|d| d.distance),
-    }
 }
 
 /// The distance between two boxes (0 when they overlap).
