@@ -72,25 +72,33 @@ fn reported(world: &World, q: &[f64], a: &str, b: &str) -> Option<f64> {
         .map(|c| c.distance_mm)
 }
 
-#[test]
-fn box_to_box_distances_at_known_poses() {
-    // A 20 mm cube on the head, its bottom face at the tool point; a
-    // 100 × 100 × 50 block on the base whose top is 40 mm below.
-    let m = mill(
+/// A 20 mm cube on the head, its bottom face `lift_mm` above the tool
+/// point; a 100 × 100 × 50 block on the base whose top is 40 mm below the
+/// tool point at home; everything within 1 m reported.
+fn cube_and_block(lift_mm: f64) -> Machine {
+    mill(&format!(
         r#"
 [[solid]]
 name = "cube"
 on = "tool"
-box = { size = [20, 20, 20] }
+box = {{ size = [20, 20, 20] }}
+origin = [0, 0, {lift_mm}]
 [[solid]]
 name = "block"
 on = "base"
-box = { size = [100, 100, 50] }
+box = {{ size = [100, 100, 50] }}
 origin = [0, 0, -90]
 [collision]
 warning_clearance = 1000
-"#,
-    );
+"#
+    ))
+}
+
+#[test]
+fn box_to_box_distances_at_known_poses() {
+    // A 20 mm cube on the head, its bottom face at the tool point; a
+    // 100 × 100 × 50 block on the base whose top is 40 mm below.
+    let m = cube_and_block(0.0);
     let world = World::new(&m).unwrap();
     let close = |got: Option<f64>, want: f64| {
         let got = got.expect("reported");
@@ -137,24 +145,9 @@ warning_clearance = 1000
 /// found as a near miss reported late.
 #[test]
 fn tilted_box_beside_a_box_is_the_gap_away() {
-    let m = mill(
-        r#"
-[[solid]]
-name = "cube"
-on = "tool"
-box = { size = [20, 20, 20] }
-origin = [0, 0, 10]
-[[solid]]
-name = "block"
-on = "base"
-box = { size = [100, 100, 50] }
-origin = [0, 0, -90]
-[collision]
-warning_clearance = 1000
-"#,
-    );
+    let m = cube_and_block(10.0);
     let world = World::new(&m).unwrap();
-    // The cube (its bottom face at the tool point) from y = 55 to 75, the
+    // The cube (its bottom face 10 mm above the tool point) from y = 55 to 75, the
     // block to y = 50: a 5 mm gap, the cube's z range overlapping the
     // block's top at any tilt about y.
     for tilt in [-40.0, -13.36, -2.0, 0.5, 1.0, 7.0, 13.36, 25.0, 40.0] {
