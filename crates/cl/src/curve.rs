@@ -395,6 +395,15 @@ pub struct Nurbs {
 }
 
 impl Nurbs {
+    /// The same curve with every control point mapped by `f` (an affine
+    /// map, a change of frame: the curve maps with its control points).
+    pub fn map_points(&self, f: impl Fn(Vec3) -> Vec3) -> Nurbs {
+        Nurbs {
+            points: self.points.iter().map(|&p| f(p)).collect(),
+            ..self.clone()
+        }
+    }
+
     /// A curve of `degree` with `knots` (`points.len() + degree + 1` of them,
     /// not decreasing), `points` and their `weights` (positive).
     pub fn new(

@@ -213,12 +213,19 @@ struct PostArgs {
     /// (SOLIDWORKS CAM writes tool and stock notes as INSERT), or nothing.
     #[arg(long, value_enum, default_value = "verbatim")]
     insert: InsertArg,
-    /// How CL CIRCLE arcs are written: native G2/G3 (Heidenhain: lines)
-    /// where the arc lies in a plane of the machine at constant rotary axes
-    /// in joint output, lines within --lintol elsewhere; or lines
-    /// everywhere.
+    /// How CL CIRCLE arcs are written: native G2/G3 (Heidenhain CC and C
+    /// in the X/Y working plane) where the arc lies in a plane of the
+    /// machine at constant rotary axes in joint output, lines within
+    /// --lintol elsewhere; or lines everywhere.
     #[arg(long, value_enum, default_value = "native")]
     arcs: ArcsArg,
+    /// The frame the points are posted in: mcs, as written in the machine
+    /// coordinate system of the CL's MSYS (the work offset locates it on
+    /// the machine; a later MSYS that moves it is an error), or absolute,
+    /// every point mapped out of the MSYS in force into the CAM model's
+    /// absolute frame (files of several setups in one program).
+    #[arg(long, value_enum, default_value = "mcs")]
+    frame: FrameArg,
     /// Grinding pressure (machines with a [pressure] axis, e.g. H1) for CL
     /// points before any PRESSURE statement. Without it and without
     /// PRESSURE, no pressure word is written and the wheel is where it is
@@ -251,6 +258,12 @@ enum FeedModeArg {
 enum ArcsArg {
     Native,
     Linear,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FrameArg {
+    Mcs,
+    Absolute,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -753,6 +766,10 @@ fn post(args: PostArgs) -> Result<()> {
             .as_deref()
             .map(|t| unit_vector(t, "default axis").map(|v| [v.x, v.y, v.z]))
             .transpose()?,
+        frame: match args.frame {
+            FrameArg::Mcs => kinpost_post::FrameMode::Mcs,
+            FrameArg::Absolute => kinpost_post::FrameMode::Absolute,
+        },
         arcs: match args.arcs {
             ArcsArg::Native => kinpost_post::ArcMode::Native,
             ArcsArg::Linear => kinpost_post::ArcMode::Linear,

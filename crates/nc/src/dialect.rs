@@ -111,8 +111,25 @@ pub struct ArcWords {
     pub planes: [String; 3],
     /// The prefixes of the centre words on X, Y, Z (`I`, `J`, `K`):
     /// the centre relative to the arc's start point, in the linear axes'
-    /// number format.
+    /// number format; absolute coordinates on a line of their own when
+    /// `centre_block` is given.
     pub centre: [String; 3],
+    /// The word of a centre line of its own before every arc line
+    /// (Heidenhain `CC X+10.000 Y+20.000`), the centre in absolute
+    /// coordinates; empty: the centre words are on the arc line, relative
+    /// to its start.
+    pub centre_block: String,
+    /// Words that give the sense after the axis words, clockwise first
+    /// (Heidenhain `DR-`, `DR+`), for dialects whose arc word is the same
+    /// both ways (`C`); empty when the arc word says it.
+    pub sense: [String; 2],
+    /// The planes the controller takes circles in, XY, ZX, YZ: a dialect
+    /// whose circles lie in the working plane of its tool call only
+    /// (Heidenhain: X/Y under `TOOL CALL … Z`) writes the others as lines.
+    pub native_planes: [bool; 3],
+    /// Whether an arc block may rise along the plane's normal (a helix);
+    /// else helices are written as lines.
+    pub helix: bool,
 }
 
 /// Layout of a block (a line).
@@ -394,6 +411,9 @@ impl Dialect {
         let motion = motion_words(raw.motion);
 
         check_separator(&raw.block, &mut err);
+        if let Some(arc) = &raw.arc {
+            check_arc(arc, &mut err);
+        }
         check_feed_mode(&raw.feed, &mut err);
         check_line_end_and_length(
             &raw.block,
@@ -432,10 +452,15 @@ impl Dialect {
             },
             motion,
             arc: raw.arc.map(|a| ArcWords {
-                clockwise: a.clockwise,
+                clockwise: a.clockwise.into_inner(),
                 counter_clockwise: a.counter_clockwise,
                 planes: a.planes,
                 centre: a.centre,
+                centre_block: a.centre_block,
+                sense: a.sense,
+                native_planes: PLANE_NAMES
+                    .map(|n| a.native_planes.iter().any(|p| p.get_ref() == n)),
+                helix: a.helix,
             }),
             numbering,
             comment: CommentSyntax {
@@ -1398,10 +1423,51 @@ enum RawInitial {
 
 #[derive(Deserialize)]
 struct RawArc {
-    clockwise: String,
+    clockwise: Spanned<String>,
     counter_clockwise: String,
     planes: [String; 3],
     centre: [String; 3],
+    #[serde(default)]
+    centre_block: String,
+    #[serde(default)]
+    sense: [String; 2],
+    #[serde(default = "all_planes")]
+    native_planes: Vec<Spanned<String>>,
+    #[serde(default = "yes")]
+    helix: bool,
+}
+
+/// The names of the planes in `[arc] native_planes`, in [`ArcPlane`] order.
+const PLANE_NAMES: [&str; 3] = ["XY", "ZX", "YZ"];
+
+fn all_planes() -> Vec<Spanned<String>> {
+    PLANE_NAMES
+        .map(|n| Spanned::new(0..0, n.to_string()))
+        .into()
+}
+
+/// `[arc]`: the planes are known ones, and the sense can be told from the
+/// words (an arc word the same both ways needs two sense words).
+fn check_arc(arc: &RawArc, err: &mut dyn FnMut(std::ops::Range<usize>, String)) {
+    for p in &arc.native_planes {
+        if !PLANE_NAMES.contains(&p.get_ref().as_str()) {
+            err(
+                p.span(),
+                format!(
+                    "unknown plane `{}`: use {}",
+                    p.get_ref(),
+                    PLANE_NAMES.join(", ")
+                ),
+            );
+        }
+    }
+    let same_word = *arc.clockwise.get_ref() == arc.counter_clockwise;
+    if same_word && (arc.sense[0].is_empty() || arc.sense[0] == arc.sense[1]) {
+        err(
+            arc.clockwise.span(),
+            "`clockwise` and `counter_clockwise` are the same word: give two different `sense` words (Heidenhain `sense = [\"DR-\", \"DR+\"]`)".to_string(),
+        );
+    }
 }
 
 #[derive(Deserialize)]

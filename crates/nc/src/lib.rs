@@ -378,6 +378,24 @@ pub enum BlockError {
         /// The dialect.
         dialect: String,
     },
+    /// An arc whose dialect writes its centre in absolute coordinates
+    /// (Heidenhain `CC`) before any block wrote the plane's axes: where it
+    /// starts is not known.
+    ArcStartUnknown {
+        /// The CL line of the block (`None`: a block the post added).
+        cl_line: Option<usize>,
+    },
+    /// An arc in a plane, or a helix, that the dialect does not write as an
+    /// arc (its `[arc]` `native_planes` and `helix`): the controller would
+    /// take it in another plane.
+    ArcNotWritable {
+        /// The dialect.
+        dialect: String,
+        /// The arc's plane.
+        plane: ArcPlane,
+        /// Whether it rises along the plane's normal.
+        helix: bool,
+    },
     /// An arc on a rapid block (circles are interpolated at a feed).
     RapidArc {
         /// The CL line of the block (`None`: a block the post added).
@@ -462,6 +480,22 @@ impl std::fmt::Display for BlockError {
                 f,
                 "dialect `{dialect}` has no [arc] words: its arcs are written as lines"
             ),
+            BlockError::ArcNotWritable {
+                dialect,
+                plane,
+                helix,
+            } => write!(
+                f,
+                "dialect `{dialect}` does not write {} in the {plane:?} plane as an arc block: write it as lines",
+                if *helix { "a helix" } else { "an arc" }
+            ),
+            BlockError::ArcStartUnknown { cl_line } => {
+                write!(f, "an arc block before any block wrote its plane's axes")?;
+                if let Some(l) = cl_line {
+                    write!(f, " (CL line {l})")?;
+                }
+                write!(f, ": its absolute centre cannot be written")
+            }
             BlockError::RapidArc { cl_line } => {
                 write!(f, "an arc block at rapid traverse")?;
                 match cl_line {

@@ -66,8 +66,17 @@ enum Token {
     RapidLiteral,
     /// `after_axes` words (`R0`): ignored.
     Ignored,
-    /// The circular motion word, clockwise (`G2`) or not (`G3`): modal.
-    Arc(bool),
+    /// The straight motion word shared by rapids and feeds (Heidenhain
+    /// `L`): ends a circular motion, the rapid-feed literal tells which.
+    Straight,
+    /// The circular motion word, clockwise (`G2`) or not (`G3`), or
+    /// either (Heidenhain `C`: the sense word tells): modal.
+    Arc(Option<bool>),
+    /// A sense word after the axis words, clockwise (`DR-`) or not.
+    Sense(bool),
+    /// The word of a centre line (`CC`): its axis words are the centre's
+    /// absolute coordinates.
+    CentreBlock,
     /// A plane selection word (`G17`): modal.
     Plane(ArcPlane),
     /// A centre word on program axis 0, 1, 2 (`I`, `J`, `K`).
@@ -91,6 +100,11 @@ struct WordsReader {
     line_end_extra: String,
     separator: String,
     n_axes: usize,
+    /// The program axis (X, Y, Z: 0, 1, 2) of each machine axis, if any.
+    program_axis: Vec<Option<usize>>,
+    /// The number format of the centre words: an absolute centre (`CC`)
+    /// minus the start is the offset as a relative centre word writes it.
+    centre_format: kinpost_number::NumberFormat,
     initial_motion: Motion,
 }
 
@@ -138,7 +152,7 @@ impl WordsReader {
         }
         if !m.feed.is_empty() {
             let t = if same {
-                Token::Ignored
+                Token::Straight
             } else {
                 Token::Motion(Motion::Feed)
             };
@@ -154,8 +168,16 @@ impl WordsReader {
             candidates.push(literal(w, Token::Ignored));
         }
         if let Some(arc) = dialect.arc_words() {
-            candidates.push(literal(&arc.clockwise, Token::Arc(true)));
-            candidates.push(literal(&arc.counter_clockwise, Token::Arc(false)));
+            if arc.clockwise == arc.counter_clockwise {
+                candidates.push(literal(&arc.clockwise, Token::Arc(None)));
+            } else {
+                candidates.push(literal(&arc.clockwise, Token::Arc(Some(true))));
+                candidates.push(literal(&arc.counter_clockwise, Token::Arc(Some(false))));
+            }
+            for (word, clockwise) in arc.sense.iter().zip([true, false]) {
+                candidates.push(literal(word, Token::Sense(clockwise)));
+            }
+            candidates.push(literal(&arc.centre_block, Token::CentreBlock));
             for (plane, word) in [ArcPlane::Xy, ArcPlane::Zx, ArcPlane::Yz]
                 .into_iter()
                 .zip(&arc.planes)
@@ -192,6 +214,15 @@ impl WordsReader {
                 .to_string(),
             separator: dialect.block.separator.trim().to_string(),
             n_axes: axes.len(),
+            centre_format: dialect.word_format(&AxisSpec::linear("X")).number,
+            program_axis: axes
+                .iter()
+                .map(|a| {
+                    ["X", "Y", "Z"]
+                        .iter()
+                        .position(|n| !a.rotary && a.name.eq_ignore_ascii_case(n))
+                })
+                .collect(),
             initial_motion,
         }
     }
@@ -204,6 +235,8 @@ impl WordsReader {
         // The circular motion in force (clockwise or not) and the plane.
         let mut circle: Option<bool> = None;
         let mut plane = ArcPlane::Xy;
+        // The absolute centre of a centre line (`CC`), for the arc after it.
+        let mut centre_point: [Option<f64>; 3] = [None; 3];
         let mut words: Vec<(Token, f64)> = Vec::new();
         for (index, raw_line) in text.lines().enumerate() {
             let line_no = index + 1;
@@ -227,9 +260,21 @@ impl WordsReader {
                 program.other_lines.push(line_no);
                 continue;
             }
+            if words.iter().any(|(t, _)| *t == Token::CentreBlock) {
+                for &(t, v) in &words {
+                    if let Token::Axis(i) = t
+                        && let Some(k) = self.program_axis[i]
+                    {
+                        centre_point[k] = Some(v);
+                    }
+                }
+                continue;
+            }
+            let start: Vec<Option<f64>> = state.clone();
             let mut block_motion = None;
             let mut has_axis = false;
             let mut centre = [0.0; 3];
+            let mut sense = None;
             for &(t, v) in &words {
                 match t {
                     Token::Axis(i) => {
@@ -243,13 +288,34 @@ impl WordsReader {
                         circle = None;
                     }
                     Token::RapidLiteral => block_motion = Some(Motion::Rapid),
-                    Token::Ignored => {}
+                    Token::Ignored | Token::CentreBlock => {}
+                    Token::Straight => {
+                        motion = Motion::Feed;
+                        circle = None;
+                    }
                     Token::Arc(clockwise) => {
                         motion = Motion::Feed;
-                        circle = Some(clockwise);
+                        circle = Some(clockwise.unwrap_or(true));
                     }
+                    Token::Sense(clockwise) => sense = Some(clockwise),
                     Token::Plane(p) => plane = p,
                     Token::Centre(k) => centre[k] = v,
+                }
+            }
+            if let Some(c) = circle.as_mut()
+                && let Some(s) = sense
+            {
+                *c = s;
+            }
+            // An absolute centre (`CC`) is the centre's offset from the
+            // arc's start, as the arc block has it.
+            if circle.is_some() && centre_point.iter().any(Option::is_some) {
+                for (i, k) in self.program_axis.iter().enumerate() {
+                    if let Some(k) = *k
+                        && let (Some(c), Some(s)) = (centre_point[k], start[i])
+                    {
+                        centre[k] = self.centre_format.quantize(c - s);
+                    }
                 }
             }
             if has_axis {

@@ -272,6 +272,16 @@ struct ArcWords {
     counter_clockwise: Text,
     planes: [Text; 3],
     centre: [Word; 3],
+    /// The word of the centre's own line (Heidenhain `CC`): the centre is
+    /// then absolute, from the last written values of the words of
+    /// `xyz` (indices into the writer's words).
+    centre_block: Option<Text>,
+    xyz: [Option<usize>; 3],
+    /// Sense words after the axis words, clockwise first (`DR-`, `DR+`).
+    sense: Option<[Text; 2]>,
+    /// The planes written as arcs (XY, ZX, YZ), and whether helices are.
+    native_planes: [bool; 3],
+    helix: bool,
     /// The plane last selected (`None`: as the header left it, unknown).
     plane: Option<crate::ArcPlane>,
 }
@@ -359,6 +369,33 @@ impl<W: Write> NcWriter<W> {
             // (and an arc block's plane, arc and centre words)
             + 2 * WORD_ROOM
             + 64;
+        let arc = dialect.arc.as_ref().filter(|_| words_kind).map(|a| {
+            let linear = dialect.word_format(&AxisSpec::linear("X"));
+            let centre = |k: usize| {
+                let wf = crate::WordFormat {
+                    prefix: a.centre[k].clone(),
+                    suffix: String::new(),
+                    ..linear.clone()
+                };
+                Word::new(usize::MAX, sep, &wf, false)
+            };
+            Box::new(ArcWords {
+                clockwise: Text::new(&a.clockwise),
+                counter_clockwise: Text::new(&a.counter_clockwise),
+                planes: [0, 1, 2].map(|k| Text::new(&a.planes[k])),
+                centre: [0, 1, 2].map(centre),
+                centre_block: (!a.centre_block.is_empty()).then(|| Text::new(&a.centre_block)),
+                xyz: ["X", "Y", "Z"].map(|n| {
+                    words.iter().position(|w| {
+                        !axes[w.index].rotary && axes[w.index].name.eq_ignore_ascii_case(n)
+                    })
+                }),
+                sense: (!a.sense[0].is_empty()).then(|| a.sense.each_ref().map(|t| Text::new(t))),
+                native_planes: a.native_planes,
+                helix: a.helix,
+                plane: None,
+            })
+        });
         let vars = ProgramInfo::default().template_vars(&dialect.name, axes);
         NcWriter {
             out,
@@ -401,24 +438,7 @@ impl<W: Write> NcWriter<W> {
             inverse_time_on: false,
             tcp_on: false,
             outside_tcp: dialect.outside_tcp.clone(),
-            arc: dialect.arc.as_ref().filter(|_| words_kind).map(|a| {
-                let linear = dialect.word_format(&AxisSpec::linear("X"));
-                let centre = |k: usize| {
-                    let wf = crate::WordFormat {
-                        prefix: a.centre[k].clone(),
-                        suffix: String::new(),
-                        ..linear.clone()
-                    };
-                    Word::new(usize::MAX, sep, &wf, false)
-                };
-                Box::new(ArcWords {
-                    clockwise: Text::new(&a.clockwise),
-                    counter_clockwise: Text::new(&a.counter_clockwise),
-                    planes: [0, 1, 2].map(|k| Text::new(&a.planes[k])),
-                    centre: [0, 1, 2].map(centre),
-                    plane: None,
-                })
-            }),
+            arc,
         }
     }
 
@@ -435,6 +455,15 @@ impl<W: Write> NcWriter<W> {
     /// Whether the dialect writes arc blocks ([`NcWriter::arc`]).
     pub fn writes_arcs(&self) -> bool {
         self.arc.is_some()
+    }
+
+    /// Whether the dialect writes an arc in `plane` as an arc block, a
+    /// helix (rising along the plane's normal) or not: its `[arc]`
+    /// `native_planes` and `helix`. Other arcs are written as lines.
+    pub fn writes_arc(&self, plane: crate::ArcPlane, helix: bool) -> bool {
+        self.arc
+            .as_ref()
+            .is_some_and(|a| a.native_planes[plane.index()] && (a.helix || !helix))
     }
 
     /// Writes a circular block ([`NcWriter::block`] with an arc): the
@@ -475,11 +504,31 @@ impl<W: Write> NcWriter<W> {
             self.units[k] = w.units(v).map_err(|e| self.bad_value(w.index, v, e))?;
         }
         // The centre words in the order I, J, K.
-        let [a, b, _] = circle.plane.axes();
+        let [a, b, normal] = circle.plane.axes();
+        let helix = arc.xyz[normal].is_some_and(|j| {
+            let w = &self.words[j];
+            w.known && w.last != self.units[j]
+        });
+        if !arc.native_planes[circle.plane.index()] || (helix && !arc.helix) {
+            return Err(BlockError::ArcNotWritable {
+                dialect: self.dialect_name.clone(),
+                plane: circle.plane,
+                helix,
+            });
+        }
         let (a, b) = (a.min(b), a.max(b));
         let mut centre = [0i64; 2];
         for (c, axis) in centre.iter_mut().zip([a, b]) {
-            let v = circle.centre_offset[axis];
+            let mut v = circle.centre_offset[axis];
+            if arc.centre_block.is_some() {
+                let start = arc.xyz[axis]
+                    .map(|j| &self.words[j])
+                    .filter(|w| w.known)
+                    .ok_or(BlockError::ArcStartUnknown {
+                        cl_line: block.cl_line,
+                    })?;
+                v += start.fmt.value(start.last);
+            }
             *c = arc.centre[axis]
                 .fmt
                 .units(v)
@@ -500,6 +549,9 @@ impl<W: Write> NcWriter<W> {
             if !(self.feed.modal && self.last_feed == Some(n)) {
                 feed_units = Some(n);
             }
+        }
+        if let Some(cc) = &arc.centre_block {
+            self.centre_line(cc, &arc.centre, [a, b], centre, block.cl_line)?;
         }
         self.start_line()?;
         let line = &mut self.line;
@@ -531,9 +583,14 @@ impl<W: Write> NcWriter<W> {
             line.put_word(w, n, first);
             first = false;
         }
-        for (c, axis) in centre.into_iter().zip([a, b]) {
-            line.put_word(&arc.centre[axis], c, first);
-            first = false;
+        if arc.centre_block.is_none() {
+            for (c, axis) in centre.into_iter().zip([a, b]) {
+                line.put_word(&arc.centre[axis], c, first);
+                first = false;
+            }
+        }
+        if let Some(sense) = &arc.sense {
+            put(line, &sense[usize::from(!circle.clockwise)], &mut first);
         }
         if !self.after_axes.is_empty() {
             line.put(&self.sep);
@@ -551,6 +608,28 @@ impl<W: Write> NcWriter<W> {
             return Err(self.too_long(block.cl_line));
         }
         self.blocks += 1;
+        Ok(self.out.write_all(self.line.as_slice())?)
+    }
+
+    /// The centre line of its own before an arc line (Heidenhain `CC X+…
+    /// Y+…`): the word `cc` and the plane's two centre words (absolute).
+    fn centre_line(
+        &mut self,
+        cc: &Text,
+        words: &[Word; 3],
+        axes: [usize; 2],
+        centre: [i64; 2],
+        cl_line: Option<usize>,
+    ) -> Result<(), BlockError> {
+        self.start_line()?;
+        self.line.put(cc);
+        for (c, axis) in centre.into_iter().zip(axes) {
+            self.line.put_word(&words[axis], c, false);
+        }
+        self.line.put(&self.eol);
+        if self.line.len > self.max_line {
+            return Err(self.too_long(cl_line));
+        }
         Ok(self.out.write_all(self.line.as_slice())?)
     }
 

@@ -205,6 +205,13 @@ impl NumberFormat {
 }
 
 impl Formatter {
+    /// The value of `units` (units of `10^-decimals`, as
+    /// [`Formatter::units`] gives them).
+    #[inline]
+    pub fn value(&self, units: i64) -> f64 {
+        units as f64 / self.scale
+    }
+
     /// The value in units of `10^-decimals`, modulo applied.
     #[inline]
     pub fn units(&self, value: f64) -> Result<i64, NumberError> {

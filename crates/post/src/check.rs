@@ -47,6 +47,13 @@ pub trait BlockSink {
         false
     }
 
+    /// Whether this sink writes an arc in `plane` (a helix when `helix`)
+    /// as a circular block; the others go on as lines.
+    fn writes_arc(&self, plane: kinpost_nc::ArcPlane, helix: bool) -> bool {
+        let _ = (plane, helix);
+        self.writes_arcs()
+    }
+
     /// An arc block's centre offset (program X, Y, Z) as this sink writes
     /// it.
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
@@ -482,6 +489,11 @@ impl<S: BlockSink> Check<S> {
         let start = &g.start[..n];
         let mut native = native_arc::fit(kin, axes, &g.arc, start)?;
         if g.xy_only && native.plane != kinpost_nc::ArcPlane::Xy {
+            return None;
+        }
+        let normal = axes.xyz[native.plane.axes()[2]];
+        let helix = last.written[normal].to_bits() != g.start[normal].to_bits();
+        if !self.sink.writes_arc(native.plane, helix) {
             return None;
         }
         native.centre_offset = self.sink.round_centre(native.centre_offset);

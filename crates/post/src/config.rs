@@ -36,6 +36,8 @@ pub struct PostOptions {
     pub insert: InsertMode,
     /// How a CL `CIRCLE`'s arc is written (`--arcs`).
     pub arcs: ArcMode,
+    /// The frame the points are posted in (`--frame`).
+    pub frame: FrameMode,
     /// Joint or tool-centre-point output; default: the machine's (`[post]
     /// output`), else joint.
     pub output: Option<OutputMode>,
@@ -105,6 +107,24 @@ pub enum ArcMode {
     Linear,
 }
 
+/// The frame the CL's points are posted in: what an NX `MSYS` means for
+/// the program (ICAM's MSYS vocabulary: the `GOTO`s that follow are given
+/// in the machine coordinate system it places in the part's absolute
+/// frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FrameMode {
+    /// As written, in the MCS: the machine file's part frame is the MCS,
+    /// which the shop's work offset (G54…) locates on the machine. A
+    /// later `MSYS` that moves the MCS is an error (a program per setup).
+    #[default]
+    Mcs,
+    /// In the CAM model's absolute frame: every point, axis and circle
+    /// after an `MSYS` is mapped out of its MCS, so that a file of several
+    /// setups posts in one frame (the machine file's part frame is then the
+    /// absolute one).
+    Absolute,
+}
+
 /// What the feed word of a feed block means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FeedMode {
@@ -154,6 +174,8 @@ pub struct Config {
     pub insert: InsertMode,
     /// How arcs are written.
     pub arcs: ArcMode,
+    /// The frame the points are posted in.
+    pub frame: FrameMode,
     /// Joint or tool-centre-point output.
     pub output: OutputMode,
     /// What the feed words mean.
@@ -244,6 +266,7 @@ impl Config {
             units: options.units,
             insert: options.insert,
             arcs: options.arcs,
+            frame: options.frame,
             output: options.output.or(machine.post.output).unwrap_or_default(),
             feed_mode: options
                 .feed_mode

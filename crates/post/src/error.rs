@@ -179,14 +179,22 @@ pub enum ProgramError {
     ReferenceMismatch(bool),
     /// A later `MSYS` changes the machine coordinate system of the first.
     #[error(
-        "MSYS changes the machine coordinate system of line {first_line}: kinpost posts every point \
-         in the part frame of the machine file; post the operations of each coordinate system as a \
-         program of their own"
+        "MSYS changes the machine coordinate system of line {first_line}: with --frame mcs (the \
+         default) every point is posted in the MCS as written; post the operations of each \
+         coordinate system as a program of their own, or give --frame absolute to post them all \
+         in the absolute frame"
     )]
     MachineSystemChanged {
         /// The line of the first `MSYS`.
         first_line: usize,
     },
+    /// An `MSYS` with an axis but not both, under `--frame absolute`: its
+    /// points cannot be placed in the absolute frame.
+    #[error(
+        "MSYS gives no complete frame (origin, X and Y axes): --frame absolute cannot place the \
+         points that follow"
+    )]
+    MachineSystemIncomplete,
     /// A statement the reader understands and the post does not act on yet.
     #[error("{what}: kinpost reads it but does not post it yet")]
     NotPosted {

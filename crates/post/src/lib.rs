@@ -73,7 +73,9 @@ use kinpost_machine::Machine;
 use kinpost_nc::{Dialect, NcWriter};
 
 pub use command::{Command, Pending};
-pub use config::{ArcMode, Config, FeedMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions};
+pub use config::{
+    ArcMode, Config, FeedMode, FrameMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions,
+};
 pub use error::{
     CheckError, ConfigError, LinearizationFailure, MotionError, MotionWarning, PointError,
     PostError, PressureError, PressureWarning, ProgramError, SetupError,

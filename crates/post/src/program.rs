@@ -16,11 +16,12 @@ use kinpost_plan::PathPoint;
 use nalgebra::Vector3;
 
 use crate::command::{Command, Pending};
-use crate::config::Config;
+use crate::config::{Config, FrameMode};
 use crate::error::{PointError, PostError, ProgramError};
 use crate::pressure::check_pressure;
 
 mod events;
+mod frame;
 
 use events::Modal;
 
@@ -86,6 +87,9 @@ pub struct Program<'a> {
     /// every point is posted in the machine file's part frame, so a later
     /// `MSYS` must not change it.
     msys: Option<([f64; 9], usize)>,
+    /// `--frame absolute`: the frame of the `MSYS` in force, when it is
+    /// not the identity (every point and axis is mapped out of it).
+    frame: Option<Box<kinpost_cl::Frame>>,
     /// An arc waiting for its end point, a canned cycle on (`None`: the
     /// `GOTO`s are plain moves, the fast path).
     modal: Option<Box<Modal>>,
@@ -153,6 +157,7 @@ impl<'a> Program<'a> {
             tool_loaded: false,
             spindle_tool: None,
             msys: None,
+            frame: None,
             modal: None,
             spindle_ccw: false,
             tool_diameter_mm: None,
@@ -189,6 +194,9 @@ impl<'a> Program<'a> {
         loop {
             match reader.next_move(&mut goto)? {
                 Next::Move => {
+                    if let Some(f) = &self.frame {
+                        frame::move_out(f, &mut goto);
+                    }
                     if self.modal.is_none() {
                         self.goto(&goto, reader, sink)?
                     } else {
@@ -236,7 +244,11 @@ impl<'a> Program<'a> {
         sink: &mut S,
     ) -> Result<bool, PostError> {
         let line = statement.line;
-        match statement.event {
+        let event = match &self.frame {
+            Some(f) => frame::event_out(f, statement.event),
+            None => statement.event,
+        };
+        match event {
             ClEvent::Goto {
                 point,
                 axis,
@@ -318,8 +330,17 @@ impl<'a> Program<'a> {
                 }
             }
             ClEvent::Multax(_) => {}
-            ClEvent::MachineSystem { origin, x, y, .. } => {
-                self.machine_system(origin, x, y, line, reader)?
+            ClEvent::MachineSystem {
+                origin,
+                x,
+                y,
+                frame,
+            } => {
+                if self.config.frame == FrameMode::Absolute {
+                    self.absolute_frame(origin, x, y, frame, reader)?
+                } else {
+                    self.machine_system(origin, x, y, line, reader)?
+                }
             }
             ClEvent::CoordinateSystem(frame) if frame.is_identity(1e-9) => {}
             // Informational: the CAM system's post name, names, setups, marks.
@@ -360,6 +381,29 @@ impl<'a> Program<'a> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// `MSYS` under `--frame absolute`: the frame the points that follow
+    /// are mapped out of (an origin alone moves them; the identity maps
+    /// nothing).
+    fn absolute_frame<R: BufRead>(
+        &mut self,
+        origin: [f64; 3],
+        x: Option<[f64; 3]>,
+        y: Option<[f64; 3]>,
+        frame: Option<Box<kinpost_cl::Frame>>,
+        reader: &ClReader<R>,
+    ) -> Result<(), PostError> {
+        let frame = match (frame, x, y) {
+            (Some(f), _, _) => f,
+            (None, None, None) => Box::new(kinpost_cl::Frame {
+                origin,
+                ..kinpost_cl::Frame::IDENTITY
+            }),
+            _ => return Err(locate(reader, ProgramError::MachineSystemIncomplete).into()),
+        };
+        self.frame = (!frame.is_identity(0.0)).then_some(frame);
         Ok(())
     }
 

@@ -186,6 +186,10 @@ impl<W: Write> BlockSink for ReadBack<W> {
         self.writer.writes_arcs()
     }
 
+    fn writes_arc(&self, plane: kinpost_nc::ArcPlane, helix: bool) -> bool {
+        self.writer.writes_arc(plane, helix)
+    }
+
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         self.writer.round_centre(offset)
     }

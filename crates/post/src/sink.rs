@@ -54,6 +54,10 @@ impl<W: Write> BlockSink for NcWriter<W> {
         NcWriter::writes_arcs(self)
     }
 
+    fn writes_arc(&self, plane: kinpost_nc::ArcPlane, helix: bool) -> bool {
+        NcWriter::writes_arc(self, plane, helix)
+    }
+
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         [0, 1, 2].map(|k| self.quantized_centre(k, offset[k]))
     }

@@ -507,3 +507,59 @@ fn the_process_model_grinds_prestons_depth() {
     let gouge = r["design"]["gouge_max_mm"].as_f64().unwrap();
     assert!((gouge - h).abs() < 1e-3 * h, "{gouge} against {h}");
 }
+
+/// Heidenhain's native arcs (CC, C with DR±) posted by kinpost and replayed
+/// by its Heidenhain interpreter follow the CL's circles: the deviation
+/// along the path, sampled inside every arc, is the output rounding, and
+/// with the senses swapped it is not.
+#[test]
+fn heidenhain_arcs_replay_on_their_cl_circles() {
+    let dir = temp_dir("heidenhain-arcs");
+    let cl = "PARTNO/ARCS\nLOAD/TOOL,1\nRAPID\nGOTO/10,0,5,0,0,1\nFEDRAT/MMPM,300\n\
+              CIRCLE/0,0,5,0,0,1,10\nGOTO/0,10,5\nCIRCLE/0,0,5,0,0,-1,10\nGOTO/10,0,5\n\
+              CIRCLE/5,0,5,0,0,1,5\nGOTO/0,0,5\nGOTO/10,0,8\nFINI\n";
+    std::fs::write(dir.join("arcs.cls"), cl).unwrap();
+    let o = run_in(
+        &dir,
+        &[
+            "post",
+            "arcs.cls",
+            "--machine",
+            &free3(),
+            "--dialect",
+            "heidenhain",
+            "-o",
+            "arcs.h",
+        ],
+    );
+    assert_exit(&o, 0);
+    let program = std::fs::read_to_string(dir.join("arcs.h")).unwrap();
+    assert_eq!(program.matches(" CC ").count(), 3, "{program}");
+    let sim = |file: &str| {
+        let o = run_in(
+            &dir,
+            &[
+                "sim",
+                file,
+                "--machine",
+                &free3(),
+                "--cl",
+                "arcs.cls",
+                "--json",
+                "r.json",
+            ],
+        );
+        assert_exit(&o, 0);
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+        json["max_position_error_mm"].as_f64().unwrap()
+    };
+    assert!(sim("arcs.h") < 0.001);
+    let swapped = program
+        .replace("DR+", "DR?")
+        .replace("DR-", "DR+")
+        .replace("DR?", "DR-");
+    std::fs::write(dir.join("swapped.h"), swapped).unwrap();
+    assert!(sim("swapped.h") > 1.0);
+    std::fs::remove_dir_all(&dir).ok();
+}

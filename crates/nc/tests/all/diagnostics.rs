@@ -222,3 +222,18 @@ fn max_line_length_too_small() {
     .unwrap();
     assert_eq!(d.block_format().max_line_length, Some(4));
 }
+
+#[test]
+fn an_arc_word_the_same_both_ways_needs_two_sense_words() {
+    let src = "name = \"x\"\nextension = \"nc\"\n[arc]\nclockwise = \"C\"\ncounter_clockwise = \"C\"\nplanes = [\"\", \"\", \"\"]\ncentre = [\"X\", \"Y\", \"Z\"]\nnative_planes = [\"XY\", \"XZ\"]\n";
+    let e = Dialect::from_toml(src, "arc.toml").unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("arc.toml:4:13"), "{text}");
+    assert!(text.contains("two different `sense` words"), "{text}");
+    assert!(text.contains("arc.toml:8:24"), "{text}");
+    assert!(text.contains("unknown plane `XZ`"), "{text}");
+    let ok = src
+        .replace("native_planes", "sense = [\"DR-\", \"DR+\"]\nnative_planes")
+        .replace("\"XZ\"", "\"ZX\"");
+    Dialect::from_toml(&ok, "arc.toml").unwrap();
+}

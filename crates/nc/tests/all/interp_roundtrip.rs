@@ -170,7 +170,15 @@ fn round_trip(name: &str, input: &[Input], tcp: bool, inverse: bool) -> Result<(
         }
         let motion = if b.rapid { Motion::Rapid } else { Motion::Feed };
         let mut arc = None;
-        if let Some(a) = b.arc.filter(|_| !b.rapid && w.writes_arcs()) {
+        let plane_of = |a: &(u8, bool, f64, f64, f64, f64)| {
+            [ArcPlane::Xy, ArcPlane::Zx, ArcPlane::Yz][usize::from(a.0)]
+        };
+        if let Some(a) = b
+            .arc
+            // (No arc before a first block: an absolute centre, Heidenhain's
+            // CC, needs a start.)
+            .filter(|a| !b.rapid && w.blocks_written() > 0 && w.writes_arc(plane_of(a), a.5 != 0.0))
+        {
             // From the point written last, rotary axes standing.
             let (circle, end) = circle(XYZ.map(|i| state[i]), a);
             for (k, &i) in XYZ.iter().enumerate() {

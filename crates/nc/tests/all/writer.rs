@@ -1288,7 +1288,7 @@ fn arc_blocks_write_plane_arc_and_centre_words() {
 #[test]
 fn a_dialect_without_arc_words_refuses_arc_blocks() {
     use kinpost_nc::{ArcMotion, ArcPlane, BlockError};
-    let dialect = Dialect::builtin("heidenhain").unwrap();
+    let dialect = Dialect::builtin("csv").unwrap();
     assert!(dialect.arc_words().is_none());
     let axes = [
         AxisSpec::linear("X"),
@@ -1318,6 +1318,75 @@ fn a_dialect_without_arc_words_refuses_arc_blocks() {
         })
         .unwrap_err();
     assert!(matches!(e, BlockError::RapidArc { .. }), "{e}");
+}
+
+/// Heidenhain: the centre on a `CC` line of its own in absolute
+/// coordinates (the start plus the offset), then `C` with the sense word;
+/// arcs the TNC would take in another plane, helices, and an arc with no
+/// start written yet are refused with nothing written.
+#[test]
+fn heidenhain_writes_an_absolute_centre_line_and_refuses_other_planes() {
+    use kinpost_nc::{ArcMotion, ArcPlane, BlockError};
+    let dialect = Dialect::builtin("heidenhain").unwrap();
+    let axes = [
+        AxisSpec::linear("X"),
+        AxisSpec::linear("Y"),
+        AxisSpec::linear("Z"),
+    ];
+    let arc = |plane, clockwise, centre_offset| {
+        Some(ArcMotion {
+            plane,
+            clockwise,
+            centre_offset,
+        })
+    };
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let e = w
+        .block(&Block {
+            arc: arc(ArcPlane::Xy, true, [1.0, 0.0, 0.0]),
+            ..Block::feed(&[2.0, 0.0, 0.0], 100.0)
+        })
+        .unwrap_err();
+    assert!(matches!(e, BlockError::ArcStartUnknown { .. }), "{e}");
+    w.block(&Block::feed(&[10.0, 5.0, -2.0], 100.0)).unwrap();
+    // A quarter circle about (10, 15), counter-clockwise to (0, 15).
+    w.block(&Block {
+        arc: arc(ArcPlane::Xy, false, [0.0, 10.0, 0.0]),
+        ..Block::feed(&[0.0, 15.0, -2.0], 100.0)
+    })
+    .unwrap();
+    w.block(&Block {
+        arc: arc(ArcPlane::Xy, true, [0.0, -10.0, 0.0]),
+        ..Block::feed(&[10.0, 5.0, -2.0], 100.0)
+    })
+    .unwrap();
+    for (plane, end, centre) in [
+        (ArcPlane::Zx, [10.0, 5.0, 8.0], [0.0, 0.0, 5.0]),
+        (ArcPlane::Yz, [10.0, 15.0, -2.0], [0.0, 5.0, 0.0]),
+        // A helix: the end 1 mm lower.
+        (ArcPlane::Xy, [10.0, 5.0, -3.0], [-5.0, 0.0, 0.0]),
+    ] {
+        let e = w
+            .block(&Block {
+                arc: arc(plane, false, centre),
+                ..Block::feed(&end, 100.0)
+            })
+            .unwrap_err();
+        assert!(matches!(e, BlockError::ArcNotWritable { .. }), "{e}");
+    }
+    let text = String::from_utf8(w.finish().unwrap()).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines,
+        [
+            "0 L X+10.000 Y+5.000 Z-2.000 R0 F100",
+            "1 CC X+10.000 Y+15.000",
+            "2 C X+0.000 Y+15.000 DR+ R0",
+            "3 CC X+0.000 Y+5.000",
+            "4 C X+10.000 Y+5.000 DR- R0",
+        ],
+        "{text}"
+    );
 }
 
 #[test]

@@ -51,13 +51,22 @@ impl ProgramSink for Collect {
 
 /// The program stage's output of `cl` (lintol `lintol_mm`), or its error.
 fn run_with(cl: &str, lintol_mm: f64) -> Result<(Vec<Out>, Vec<String>), PostError> {
+    run_options(cl, |o| o.lintol_mm = Some(lintol_mm))
+}
+
+/// The program stage's output of `cl` with the options `set` makes.
+fn run_options(
+    cl: &str,
+    set: impl FnOnce(&mut PostOptions),
+) -> Result<(Vec<Out>, Vec<String>), PostError> {
     let machine = builtin::load("mts1600").unwrap().unwrap();
     let dialect = Dialect::builtin("linuxcnc").unwrap();
-    let options = PostOptions {
+    let mut options = PostOptions {
         cl_file: "t.cls".into(),
-        lintol_mm: Some(lintol_mm),
+        lintol_mm: Some(0.01),
         ..Default::default()
     };
+    set(&mut options);
     let config = Config::resolve(&options, &machine, &dialect).unwrap();
     let program = Program::new(&machine, &dialect, &config, Vec::new());
     let mut reader = ClReader::new(cl.as_bytes(), "t.cls");
@@ -477,4 +486,49 @@ fn inserts_that_move_are_warned_about() {
         let (_, warnings) = run_with(&format!("{line}\n"), 0.01).unwrap();
         assert!(warnings.is_empty(), "{line}: {warnings:?}");
     }
+}
+
+/// Two setups: the second `MSYS` turns the MCS 90° about Z and moves it
+/// to (100, 0, 50). `--frame mcs` posts points as written and stops at the
+/// second `MSYS`, naming `--frame absolute`; `--frame absolute` maps the
+/// points, axes and circles of each setup into the absolute frame (an
+/// origin-only `MSYS` moves them; one with a single axis is an error).
+#[test]
+fn frame_absolute_posts_every_setup_in_the_absolute_frame() {
+    let cl = "MSYS/0,0,0,1,0,0,0,1,0\nRAPID\nGOTO/10,0,5,0,0,1\n\
+              MSYS/100,0,50,0,1,0,-1,0,0\nRAPID\nGOTO/10,0,5,0,0,1\nFEDRAT/MMPM,200\n\
+              GOTO/10,0,0\nCIRCLE/0,0,0,0,0,1,10\nGOTO/0,10,0\n\
+              MSYS/-5,0,0\nGOTO/20,0,0,0,0.6,0.8\nFINI\n";
+    let e = run_options(cl, |_| {}).unwrap_err().to_string();
+    assert!(e.contains("--frame absolute"), "{e}");
+    let (out, _) = run_options(cl, |o| o.frame = kinpost_post::FrameMode::Absolute).unwrap();
+    let pts = points(&out);
+    assert!(close(pts[0].0, [10.0, 0.0, 5.0]), "{pts:?}");
+    // (10, 0, 5) in the turned MCS: x along absolute Y.
+    assert!(close(pts[1].0, [100.0, 10.0, 55.0]), "{pts:?}");
+    assert!(close(pts[2].0, [100.0, 10.0, 50.0]), "{pts:?}");
+    // The arc about the MCS origin, (100, 0, 50), from its X to its Y
+    // (absolute Y to absolute −X): on the circle all the way.
+    let arc: Vec<[f64; 3]> = pts[3..pts.len() - 1].iter().map(|p| p.0).collect();
+    for p in &arc {
+        let r = (p[0] - 100.0).hypot(p[1]);
+        assert!(
+            (r - 10.0).abs() < 0.011 && (p[2] - 50.0).abs() < 1e-9,
+            "{p:?}"
+        );
+    }
+    assert!(close(*arc.last().unwrap(), [90.0, 0.0, 50.0]), "{arc:?}");
+    // An origin alone: moved, not turned; the axis as written.
+    let Some(Out::Point { p, axis, .. }) = out.last() else {
+        panic!()
+    };
+    assert!(
+        close(*p, [15.0, 0.0, 0.0]) && close(*axis, [0.0, 0.6, 0.8]),
+        "{p:?} {axis:?}"
+    );
+    let half = "MSYS/0,0,0,1,0,0\nGOTO/1,2,3,0,0,1\nFINI\n";
+    let e = run_options(half, |o| o.frame = kinpost_post::FrameMode::Absolute)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no complete frame"), "{e}");
 }

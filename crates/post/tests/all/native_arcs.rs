@@ -439,10 +439,47 @@ fn fanuc_and_sinumerik_write_the_arc_words_of_their_dialects() {
         sinumerik.contains("G3 X=0.000 Y=10.000 Z5.000 I=-10.000 J=0.000"),
         "{sinumerik}"
     );
-    // Heidenhain has no [arc] words here: lines, as with --arcs linear.
+}
+
+/// Heidenhain: the centre CC on a line of its own (absolute), then C with
+/// DR- or DR+, in the X/Y working plane only; the Z/X and Y/Z arcs and
+/// the helix of `PLANES` stay lines, as with `--arcs linear`.
+#[test]
+fn heidenhain_writes_cc_and_c_in_the_working_plane() {
+    let machine = test_machine("free3");
     let native = post_cl(PLANES, &machine, "heidenhain", ArcMode::Native);
+    let body: Vec<&str> = native
+        .lines()
+        .map(|l| l.split_once(' ').map_or(l, |(_, rest)| rest))
+        .collect();
+    let at = body
+        .iter()
+        .position(|l| l.starts_with("CC "))
+        .expect(&native);
+    assert_eq!(
+        &body[at..at + 6],
+        &[
+            "CC X+0.000 Y+0.000",
+            "C X+0.000 Y+10.000 DR+ R0 F300",
+            "CC X+0.000 Y+0.000",
+            "C X+10.000 Y+0.000 DR- R0",
+            // The full circle in two halves (Y, unchanged, is modal).
+            "CC X+0.000 Y+0.000",
+            "C X-10.000 DR+ R0",
+        ],
+        "{native}"
+    );
+    let arcs = body.iter().filter(|l| l.starts_with("C ")).count();
+    assert_eq!(arcs, 4, "{native}");
+    assert_eq!(body.iter().filter(|l| l.starts_with("CC ")).count(), 4);
+    // The rest is the linear program's: with no arc native, the same text.
     let linear = post_cl(PLANES, &machine, "heidenhain", ArcMode::Linear);
-    assert_eq!(native, linear);
+    assert!(
+        linear
+            .lines()
+            .all(|l| !l.contains(" C ") && !l.contains(" CC "))
+    );
+    assert!(native.lines().count() < linear.lines().count());
 }
 
 #[test]
