@@ -270,7 +270,14 @@ impl WordsReader {
                 }
                 continue;
             }
-            let start: Vec<Option<f64>> = state.clone();
+            // Where the block starts, on the program's X, Y, Z (for an
+            // absolute centre).
+            let mut start = [None; 3];
+            for (i, k) in self.program_axis.iter().enumerate() {
+                if let Some(k) = *k {
+                    start[k] = state[i];
+                }
+            }
             let mut block_motion = None;
             let mut has_axis = false;
             let mut centre = [0.0; 3];
@@ -309,12 +316,10 @@ impl WordsReader {
             }
             // An absolute centre (`CC`) is the centre's offset from the
             // arc's start, as the arc block has it.
-            if circle.is_some() && centre_point.iter().any(Option::is_some) {
-                for (i, k) in self.program_axis.iter().enumerate() {
-                    if let Some(k) = *k
-                        && let (Some(c), Some(s)) = (centre_point[k], start[i])
-                    {
-                        centre[k] = self.centre_format.quantize(c - s);
+            if circle.is_some() {
+                for ((offset, c), s) in centre.iter_mut().zip(centre_point).zip(start) {
+                    if let (Some(c), Some(s)) = (c, s) {
+                        *offset = self.centre_format.quantize(c - s);
                     }
                 }
             }
