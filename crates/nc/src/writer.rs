@@ -284,6 +284,10 @@ struct ArcWords {
     helix: bool,
     /// The plane last selected (`None`: as the header left it, unknown).
     plane: Option<crate::ArcPlane>,
+    /// The centre line last written (its plane and two words, units): the
+    /// controller keeps it (Heidenhain's CC is modal), so the same centre
+    /// is not written again.
+    centre_in_force: Option<(crate::ArcPlane, [i64; 2])>,
 }
 
 /// The pressure word: its format and state (modal), and whether the
@@ -394,6 +398,7 @@ impl<W: Write> NcWriter<W> {
                 native_planes: a.native_planes,
                 helix: a.helix,
                 plane: None,
+                centre_in_force: None,
             })
         });
         let vars = ProgramInfo::default().template_vars(&dialect.name, axes);
@@ -550,8 +555,11 @@ impl<W: Write> NcWriter<W> {
                 feed_units = Some(n);
             }
         }
-        if let Some(cc) = &arc.centre_block {
+        if let Some(cc) = &arc.centre_block
+            && arc.centre_in_force != Some((circle.plane, centre))
+        {
             self.centre_line(cc, &arc.centre, [a, b], centre, block.cl_line)?;
+            arc.centre_in_force = Some((circle.plane, centre));
         }
         self.start_line()?;
         let line = &mut self.line;

@@ -1321,7 +1321,8 @@ fn a_dialect_without_arc_words_refuses_arc_blocks() {
 }
 
 /// Heidenhain: the centre on a `CC` line of its own in absolute
-/// coordinates (the start plus the offset), then `C` with the sense word;
+/// coordinates (the start plus the offset; not again while it is in
+/// force), then `C` with the sense word;
 /// arcs the TNC would take in another plane, helices, and an arc with no
 /// start written yet are refused with nothing written.
 #[test]
@@ -1360,6 +1361,12 @@ fn heidenhain_writes_an_absolute_centre_line_and_refuses_other_planes() {
         ..Block::feed(&[10.0, 5.0, -2.0], 100.0)
     })
     .unwrap();
+    // About the same centre: the CC in force is not written again.
+    w.block(&Block {
+        arc: arc(ArcPlane::Xy, false, [-10.0, 0.0, 0.0]),
+        ..Block::feed(&[-10.0, 5.0, -2.0], 100.0)
+    })
+    .unwrap();
     for (plane, end, centre) in [
         (ArcPlane::Zx, [10.0, 5.0, 8.0], [0.0, 0.0, 5.0]),
         (ArcPlane::Yz, [10.0, 15.0, -2.0], [0.0, 5.0, 0.0]),
@@ -1384,6 +1391,7 @@ fn heidenhain_writes_an_absolute_centre_line_and_refuses_other_planes() {
             "2 C X+0.000 Y+15.000 DR+ R0",
             "3 CC X+0.000 Y+5.000",
             "4 C X+10.000 Y+5.000 DR- R0",
+            "5 C X-10.000 DR+ R0",
         ],
         "{text}"
     );

@@ -441,9 +441,10 @@ fn fanuc_and_sinumerik_write_the_arc_words_of_their_dialects() {
     );
 }
 
-/// Heidenhain: the centre CC on a line of its own (absolute), then C with
-/// DR- or DR+, in the X/Y working plane only; the Z/X and Y/Z arcs and
-/// the helix of `PLANES` stay lines, as with `--arcs linear`.
+/// Heidenhain: the centre CC on a line of its own (absolute, written when
+/// it changes: the TNC keeps it), then C with DR- or DR+, in the X/Y
+/// working plane only; the Z/X and Y/Z arcs and the helix of `PLANES`
+/// stay lines, as with `--arcs linear`.
 #[test]
 fn heidenhain_writes_cc_and_c_in_the_working_plane() {
     let machine = test_machine("free3");
@@ -457,21 +458,20 @@ fn heidenhain_writes_cc_and_c_in_the_working_plane() {
         .position(|l| l.starts_with("CC "))
         .expect(&native);
     assert_eq!(
-        &body[at..at + 6],
+        &body[at..at + 5],
         &[
             "CC X+0.000 Y+0.000",
             "C X+0.000 Y+10.000 DR+ R0 F300",
-            "CC X+0.000 Y+0.000",
             "C X+10.000 Y+0.000 DR- R0",
             // The full circle in two halves (Y, unchanged, is modal).
-            "CC X+0.000 Y+0.000",
             "C X-10.000 DR+ R0",
+            "C X+10.000 DR+ R0",
         ],
         "{native}"
     );
     let arcs = body.iter().filter(|l| l.starts_with("C ")).count();
     assert_eq!(arcs, 4, "{native}");
-    assert_eq!(body.iter().filter(|l| l.starts_with("CC ")).count(), 4);
+    assert_eq!(body.iter().filter(|l| l.starts_with("CC ")).count(), 1);
     // The rest is the linear program's: with no arc native, the same text.
     let linear = post_cl(PLANES, &machine, "heidenhain", ArcMode::Linear);
     assert!(
