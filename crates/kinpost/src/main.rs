@@ -219,6 +219,13 @@ struct PostArgs {
     /// --lintol elsewhere; or lines everywhere.
     #[arg(long, value_enum, default_value = "native")]
     arcs: ArcsArg,
+    /// How the holes of CL CYCLE statements are written: native, as the
+    /// dialect's canned cycle (G81…G89 with G98/G99, Sinumerik MCALL
+    /// CYCLE81…, Heidenhain CYCL DEF 200…) where the checked moves of a
+    /// hole are exactly the cycle's on the program's Z; or expand, the
+    /// moves of every hole.
+    #[arg(long, value_enum, default_value = "native")]
+    cycles: CyclesArg,
     /// The frame the points are posted in: mcs, as written in the machine
     /// coordinate system of the CL's MSYS (the work offset locates it on
     /// the machine; a later MSYS that moves it is an error), or absolute,
@@ -258,6 +265,12 @@ enum FeedModeArg {
 enum ArcsArg {
     Native,
     Linear,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum CyclesArg {
+    Native,
+    Expand,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -773,6 +786,10 @@ fn post(args: PostArgs) -> Result<()> {
         arcs: match args.arcs {
             ArcsArg::Native => kinpost_post::ArcMode::Native,
             ArcsArg::Linear => kinpost_post::ArcMode::Linear,
+        },
+        cycles: match args.cycles {
+            CyclesArg::Native => kinpost_post::CycleMode::Native,
+            CyclesArg::Expand => kinpost_post::CycleMode::Expand,
         },
         insert: match args.insert {
             InsertArg::Verbatim => kinpost_post::InsertMode::Verbatim,

@@ -148,3 +148,76 @@ impl<A> Block<A> {
         }
     }
 }
+
+/// What the tool does in the hole of a canned drilling cycle, as the
+/// controls of ISO 6983-1 name their cycles (LinuxCNC's G-code reference:
+/// G81/G82, G83, G73, G84, G85/G89).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum HoleKind {
+    /// Feed to depth, rapid out (`G81`; `G82` with a dwell).
+    Drill,
+    /// Pecks of one length, out to the feed start after each (`G83`).
+    Peck,
+    /// Pecks with a short back-off after each (`G73`).
+    ChipBreak,
+    /// Tapping: feed in, spindle reversed, feed out (`G84`).
+    Tap,
+    /// Feed in, feed out (`G85`; `G89` with a dwell).
+    Bore,
+}
+
+impl HoleKind {
+    /// The name a dialect's `[cycle] kinds` and its `cycle` template use:
+    /// `drill`, `peck`, `chip_break`, `tap`, `bore`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            HoleKind::Drill => "drill",
+            HoleKind::Peck => "peck",
+            HoleKind::ChipBreak => "chip_break",
+            HoleKind::Tap => "tap",
+            HoleKind::Bore => "bore",
+        }
+    }
+
+    /// Every kind, in the order of [`HoleKind::as_str`]'s list.
+    pub const ALL: [HoleKind; 5] = [
+        HoleKind::Drill,
+        HoleKind::Peck,
+        HoleKind::ChipBreak,
+        HoleKind::Tap,
+        HoleKind::Bore,
+    ];
+}
+
+/// One hole of a canned drilling cycle on the program's X, Y, Z words, the
+/// hole axis along −Z: the tool, standing at `start_z` (at or above the
+/// feed start `r`), moves across to `x`, `y`, down to `r` in rapid, cuts
+/// down to `bottom` as its kind says, and ends at `retract`. Values are in
+/// mm as written (already rounded as the dialect writes them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hole {
+    /// What the tool does in the hole.
+    pub kind: HoleKind,
+    /// The hole's X.
+    pub x: f64,
+    /// The hole's Y.
+    pub y: f64,
+    /// Z of the top of the hole (the CL's hole point).
+    pub top: f64,
+    /// Z of the feed start (the R plane).
+    pub r: f64,
+    /// Z of the bottom.
+    pub bottom: f64,
+    /// Z the tool leaves the hole to.
+    pub retract: f64,
+    /// Z of the tool before the hole.
+    pub start_z: f64,
+    /// Peck length of a peck or chip-breaking cycle, mm (0 for the others).
+    pub peck: f64,
+    /// Dwell at the bottom, seconds (0: none).
+    pub dwell: f64,
+    /// Feed of the cutting moves, mm/min.
+    pub feed: f64,
+    /// Spindle speed in force, rpm (0: unknown or off).
+    pub rpm: f64,
+}

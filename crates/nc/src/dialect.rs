@@ -232,11 +232,64 @@ pub enum TemplateKind {
     CutcomOn,
     /// Cutter radius compensation off (CL `CUTCOM/OFF`).
     CutcomOff,
+    /// One hole of a canned drilling cycle (see [`crate::Hole`] and
+    /// `[cycle]`).
+    Cycle,
+    /// The end of a series of holes (`G80`).
+    CycleOff,
+}
+
+/// The variables of the `cycle` template besides the program's (see
+/// docs/dialects.md, "Canned cycles").
+pub const CYCLE_VARIABLES: &[&str] = &[
+    "cycle",
+    "first",
+    "changed",
+    "x",
+    "y",
+    "top",
+    "r",
+    "bottom",
+    "retract",
+    "return_to_r",
+    "depth",
+    "clearance",
+    "retract_height",
+    "peck",
+    "dwell",
+    "dwell_ms",
+    "feed",
+    "rpm",
+];
+
+/// How a dialect's cycles leave a hole (`[cycle] retract`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CycleRetract {
+    /// To the feed start (`G99`) or to where the tool stood when the
+    /// series of cycles began (`G98`): ISO 6983-1 controls (Fanuc,
+    /// LinuxCNC). A hole whose retract is neither is written as moves.
+    InitialOrR,
+    /// To any height the cycle names (Sinumerik `RTP`, Heidenhain `Q204`).
+    Any,
+}
+
+/// The canned cycles a dialect writes (`[cycle]`): which kinds, and how
+/// they retract. A dialect without it gets every hole as moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleWords {
+    /// The kinds written as cycles, by [`crate::HoleKind::as_str`].
+    pub kinds: Vec<crate::HoleKind>,
+    /// The kinds whose cycles can dwell at the bottom (`G82`, `G89`): a
+    /// hole of another kind with a dwell is written as moves.
+    pub dwell: Vec<crate::HoleKind>,
+    /// How a hole is left.
+    pub retract: CycleRetract,
 }
 
 impl TemplateKind {
     /// All kinds, in file order.
-    pub const ALL: [TemplateKind; 17] = [
+    pub const ALL: [TemplateKind; 19] = [
         TemplateKind::Header,
         TemplateKind::Footer,
         TemplateKind::ToolChange,
@@ -254,6 +307,8 @@ impl TemplateKind {
         TemplateKind::Dwell,
         TemplateKind::CutcomOn,
         TemplateKind::CutcomOff,
+        TemplateKind::Cycle,
+        TemplateKind::CycleOff,
     ];
 
     /// The variables this template gets besides the program's
@@ -266,6 +321,7 @@ impl TemplateKind {
             TemplateKind::Pressure => &["pressure", "pressure_word"],
             TemplateKind::Dwell => &["seconds", "milliseconds"],
             TemplateKind::CutcomOn => &["side", "register"],
+            TemplateKind::Cycle => CYCLE_VARIABLES,
             _ => &[],
         }
     }
@@ -310,6 +366,8 @@ impl TemplateKind {
             TemplateKind::Dwell => "dwell",
             TemplateKind::CutcomOn => "cutcom_on",
             TemplateKind::CutcomOff => "cutcom_off",
+            TemplateKind::Cycle => "cycle",
+            TemplateKind::CycleOff => "cycle_off",
         }
     }
 }
@@ -336,6 +394,7 @@ pub struct Dialect {
     pub(crate) feed: FeedFormat,
     pub(crate) motion: MotionWords,
     pub(crate) arc: Option<ArcWords>,
+    pub(crate) cycle: Option<CycleWords>,
     pub(crate) numbering: Numbering,
     pub(crate) comment: CommentSyntax,
     templates: BTreeMap<TemplateKind, String>,
@@ -414,6 +473,16 @@ impl Dialect {
         if let Some(arc) = &raw.arc {
             check_arc(arc, &mut err);
         }
+        let cycle = raw
+            .cycle
+            .as_ref()
+            .and_then(|c| check_cycle(c, raw.templates.cycle.is_some(), &mut err));
+        if let (None, Some(t)) = (&raw.cycle, &raw.templates.cycle) {
+            err(
+                t.span(),
+                "template `cycle` without a `[cycle]` table: say which kinds it writes (`kinds`) and how they retract (`retract`)".into(),
+            );
+        }
         check_feed_mode(&raw.feed, &mut err);
         check_line_end_and_length(
             &raw.block,
@@ -462,6 +531,7 @@ impl Dialect {
                     .map(|n| a.native_planes.iter().any(|p| p.get_ref() == n)),
                 helix: a.helix,
             }),
+            cycle,
             numbering,
             comment: CommentSyntax {
                 enabled: raw.comment.enabled,
@@ -515,6 +585,11 @@ impl Dialect {
     /// Motion words.
     pub fn motion_words(&self) -> &MotionWords {
         &self.motion
+    }
+
+    /// The canned cycles (`[cycle]`), if the dialect writes them.
+    pub fn cycle_words(&self) -> Option<&CycleWords> {
+        self.cycle.as_ref()
     }
 
     /// The circular interpolation words (`[arc]`), if the dialect writes
@@ -1296,6 +1371,11 @@ fn unknown_names(source: &str, file: &str) -> Vec<Diagnostic> {
             &[("initial", names::<RawInitial>())],
         ),
         ("arc", names::<RawArc>(), &[]),
+        (
+            "cycle",
+            names::<RawCycle>(),
+            &[("retract", names::<CycleRetract>())],
+        ),
         ("numbering", names::<RawNumbering>(), &[]),
         ("comment", names::<RawComment>(), &[]),
         ("templates", names::<RawTemplates>(), &[]),
@@ -1331,6 +1411,7 @@ struct RawDialect {
     #[serde(default)]
     motion: RawMotion,
     arc: Option<RawArc>,
+    cycle: Option<Spanned<RawCycle>>,
     #[serde(default)]
     numbering: RawNumbering,
     #[serde(default)]
@@ -1419,6 +1500,54 @@ enum RawInitial {
     None,
     Rapid,
     Feed,
+}
+
+#[derive(Deserialize)]
+struct RawCycle {
+    kinds: Vec<Spanned<String>>,
+    #[serde(default)]
+    dwell: Vec<Spanned<String>>,
+    retract: CycleRetract,
+}
+
+/// `[cycle]`: known kinds, and a `cycle` template to write them with.
+fn check_cycle(
+    raw: &Spanned<RawCycle>,
+    has_template: bool,
+    err: &mut dyn FnMut(std::ops::Range<usize>, String),
+) -> Option<CycleWords> {
+    if !has_template {
+        err(
+            raw.span(),
+            "`[cycle]` needs a `cycle` template in `[templates]` to write the holes with".into(),
+        );
+    }
+    let mut kinds_of = |key: &str, names: &[Spanned<String>]| {
+        let mut kinds = Vec::new();
+        for k in names {
+            match crate::HoleKind::ALL
+                .into_iter()
+                .find(|h| h.as_str() == k.get_ref())
+            {
+                Some(h) => kinds.push(h),
+                None => err(
+                    k.span(),
+                    format!(
+                        "`[cycle] {key}`: `{}` is not a cycle kind (one of {})",
+                        k.get_ref(),
+                        crate::HoleKind::ALL.map(crate::HoleKind::as_str).join(", ")
+                    ),
+                ),
+            }
+        }
+        kinds
+    };
+    let raw = raw.get_ref();
+    Some(CycleWords {
+        kinds: kinds_of("kinds", &raw.kinds),
+        dwell: kinds_of("dwell", &raw.dwell),
+        retract: raw.retract,
+    })
 }
 
 #[derive(Deserialize)]
@@ -1605,6 +1734,8 @@ struct RawTemplates {
     dwell: Option<Spanned<String>>,
     cutcom_on: Option<Spanned<String>>,
     cutcom_off: Option<Spanned<String>>,
+    cycle: Option<Spanned<String>>,
+    cycle_off: Option<Spanned<String>>,
     outside_tcp: Option<Vec<Spanned<String>>>,
 }
 
@@ -1628,6 +1759,8 @@ impl RawTemplates {
             TemplateKind::Dwell => self.dwell.as_ref(),
             TemplateKind::CutcomOn => self.cutcom_on.as_ref(),
             TemplateKind::CutcomOff => self.cutcom_off.as_ref(),
+            TemplateKind::Cycle => self.cycle.as_ref(),
+            TemplateKind::CycleOff => self.cycle_off.as_ref(),
         }
     }
 }

@@ -35,10 +35,11 @@ mod sanitize;
 mod template;
 mod writer;
 
-pub use block::{ArcMotion, ArcPlane, Block, Motion};
+pub use block::{ArcMotion, ArcPlane, Block, Hole, HoleKind, Motion};
 pub use dialect::{
-    ArcWords, BlockFormat, CommentSyntax, Dialect, DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES,
-    MotionWords, Numbering, TemplateKind, WordFormat, check_template,
+    ArcWords, BlockFormat, CYCLE_VARIABLES, CommentSyntax, CycleRetract, CycleWords, Dialect,
+    DialectKind, FeedFormat, MAX_DIALECT_FILE_BYTES, MotionWords, Numbering, TemplateKind,
+    WordFormat, check_template,
 };
 pub use kinpost_diag::{Diagnostic, Diagnostics, Severity};
 pub use kinpost_number::{FormatError, MAX_DECIMALS, NumberError, NumberFormat, TrailingZeros};

@@ -90,7 +90,10 @@ fn name(value: &str) -> String {
 
 /// `{{ value | num }}`, `{{ value | num(1) }}`: a number with at most that many
 /// decimals (default 3), trailing zeros and a bare point removed, no `-0`.
-fn num(value: f64, decimals: Option<u32>) -> String {
+/// `{{ value | num(3, true) }}` keeps the point of a whole number (`10.`):
+/// a Fanuc control without decimal-point programming reads `X10` as
+/// 10 µm.
+fn num(value: f64, decimals: Option<u32>, point: Option<bool>) -> String {
     let d = decimals.unwrap_or(3).min(9) as usize;
     let mut s = format!("{value:.d$}");
     if s.contains('.') {
@@ -103,6 +106,9 @@ fn num(value: f64, decimals: Option<u32>) -> String {
     }
     if s == "-0" {
         s.remove(0);
+    }
+    if point == Some(true) && !s.contains('.') {
+        s.push('.');
     }
     s
 }
@@ -211,6 +217,11 @@ pub(crate) fn sample_vars(dialect: &str, extra_names: &[&str]) -> BTreeMap<Strin
             "milliseconds" => Value::from(1500),
             "side" => Value::from("left"),
             "register" => Value::from(1),
+            "cycle" => Value::from("drill"),
+            "first" | "changed" | "return_to_r" => Value::from(true),
+            "x" | "y" | "top" | "r" | "bottom" | "retract" | "depth" | "clearance"
+            | "retract_height" | "peck" | "dwell" | "feed" | "rpm" => Value::from(1.0),
+            "dwell_ms" => Value::from(1000),
             _ => Value::from(""),
         };
         vars.insert((*name).to_string(), v);
@@ -444,10 +455,13 @@ mod tests {
 
     #[test]
     fn num_filter() {
-        assert_eq!(num(3000.0, None), "3000");
-        assert_eq!(num(2.5, None), "2.5");
-        assert_eq!(num(-0.0001, None), "0");
-        assert_eq!(num(1.23456, Some(2)), "1.23");
+        assert_eq!(num(3000.0, None, None), "3000");
+        assert_eq!(num(2.5, None, None), "2.5");
+        assert_eq!(num(-0.0001, None, None), "0");
+        assert_eq!(num(1.23456, Some(2), None), "1.23");
+        assert_eq!(num(10.0, Some(3), Some(true)), "10.");
+        assert_eq!(num(-0.0001, Some(3), Some(true)), "0.");
+        assert_eq!(num(2.5, Some(3), Some(true)), "2.5");
     }
 
     #[test]

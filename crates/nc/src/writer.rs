@@ -10,7 +10,9 @@ use crate::dialect::{
     CommentSyntax, Dialect, DialectKind, MAX_LEAD, MAX_SUFFIX, Numbering, TemplateKind,
 };
 use crate::template;
-use crate::{ArcMotion, AxisSpec, Block, BlockError, Motion, NcError, NumbersRunOut, ProgramInfo};
+use crate::{
+    ArcMotion, AxisSpec, Block, BlockError, Hole, Motion, NcError, NumbersRunOut, ProgramInfo,
+};
 use kinpost_number::{ENCODE_MAX, Formatter, encode_u64, write_u64};
 
 /// Spindle state for [`NcWriter::spindle`].
@@ -263,6 +265,19 @@ pub struct NcWriter<W: Write> {
     outside_tcp: Vec<TemplateKind>,
     /// The arc words, when the dialect writes arcs.
     arc: Option<Box<ArcWords>>,
+    /// The canned cycles the dialect writes (`[cycle]`).
+    cycle: Option<crate::CycleWords>,
+    /// The series of cycle holes written last, until something else is
+    /// written (then `cycle_off` ends it).
+    series: Option<Series>,
+}
+
+/// A series of canned-cycle holes in force: where the tool stood when it
+/// began (the initial level `G98` returns to) and its last hole.
+#[derive(Debug, Clone, Copy)]
+struct Series {
+    initial_z: f64,
+    last: Hole,
 }
 
 /// The arc words of a writer: motion and plane words, the centre words in
@@ -444,6 +459,8 @@ impl<W: Write> NcWriter<W> {
             tcp_on: false,
             outside_tcp: dialect.outside_tcp.clone(),
             arc,
+            cycle: dialect.cycle.clone().filter(|_| words_kind),
+            series: None,
         }
     }
 
@@ -723,6 +740,7 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
+        self.end_cycle_series()?;
         self.template_lines(
             TemplateKind::Footer,
             override_template,
@@ -879,6 +897,119 @@ impl<W: Write> NcWriter<W> {
         }
     }
 
+    /// Whether the dialect writes canned cycles (`[cycle]`).
+    pub fn writes_cycles(&self) -> bool {
+        self.cycle.is_some()
+    }
+
+    /// One hole of a canned cycle, written with the dialect's `cycle`
+    /// template (see docs/dialects.md, "Canned cycles"); `Ok(false)`, with
+    /// nothing written, when the dialect cannot write it as a cycle: no
+    /// `[cycle]` or not this kind, inverse-time feed on (a cycle's F is per
+    /// minute), a tap with no spindle speed, a dwell the kind's cycle cannot
+    /// make (`[cycle] dwell`), the tool below the feed start or the bottom
+    /// not below it, a retract below the feed start, or, for a dialect
+    /// whose cycles return to the feed start or the initial level only
+    /// (`G99`/`G98`), a retract to neither. The caller then writes the hole's moves. A hole after
+    /// the first of a series gets `first` false, and `changed` false when
+    /// only its X and Y differ from the hole before; anything else written
+    /// ends the series with `cycle_off` (`G80`).
+    pub fn hole(&mut self, hole: &Hole) -> Result<bool, NcError> {
+        let Some(words) = &self.cycle else {
+            return Ok(false);
+        };
+        let finite = [hole.x, hole.y, hole.top, hole.r, hole.bottom, hole.retract]
+            .iter()
+            .chain([
+                &hole.start_z,
+                &hole.peck,
+                &hole.dwell,
+                &hole.feed,
+                &hole.rpm,
+            ])
+            .all(|v| v.is_finite());
+        if self.inverse_time_on
+            || !finite
+            || !words.kinds.contains(&hole.kind)
+            || (hole.dwell > 0.0 && !words.dwell.contains(&hole.kind))
+            || !(hole.bottom < hole.r && hole.r <= hole.start_z && hole.r <= hole.retract)
+            || hole.feed <= 0.0
+            // (A tap's pitch is its feed over the speed.)
+            || (hole.kind == crate::HoleKind::Tap && hole.rpm <= 0.0)
+        {
+            return Ok(false);
+        }
+        let return_to_r = hole.retract == hole.r;
+        let mut continues = self.series.is_some();
+        if !return_to_r && words.retract == crate::CycleRetract::InitialOrR {
+            // G98 goes back to where the series began.
+            match self.series {
+                Some(s) if s.initial_z == hole.retract => {}
+                _ if hole.start_z == hole.retract => continues = false,
+                _ => return Ok(false),
+            }
+        }
+        if !continues {
+            self.end_cycle_series()?;
+        }
+        // The cycles drill along Z of the XY plane: select it again after
+        // an arc in another plane.
+        if let Some(a) = self.arc.as_mut()
+            && a.plane.is_some_and(|p| p != crate::ArcPlane::Xy)
+        {
+            a.plane = Some(crate::ArcPlane::Xy);
+            let word = String::from_utf8_lossy(&a.planes[0]).into_owned();
+            self.insert(&word)?;
+        }
+        let changed = self.series.is_none_or(|s| {
+            let last = s.last;
+            (last.kind, last.top, last.r, last.bottom, last.retract)
+                != (hole.kind, hole.top, hole.r, hole.bottom, hole.retract)
+                || (last.peck, last.dwell, last.feed, last.rpm)
+                    != (hole.peck, hole.dwell, hole.feed, hole.rpm)
+        });
+        let vars = vec![
+            ("cycle", Value::from(hole.kind.as_str())),
+            ("first", Value::from(self.series.is_none())),
+            ("changed", Value::from(changed)),
+            ("x", Value::from(hole.x)),
+            ("y", Value::from(hole.y)),
+            ("top", Value::from(hole.top)),
+            ("r", Value::from(hole.r)),
+            ("bottom", Value::from(hole.bottom)),
+            ("retract", Value::from(hole.retract)),
+            ("return_to_r", Value::from(return_to_r)),
+            ("depth", Value::from(hole.top - hole.bottom)),
+            ("clearance", Value::from(hole.r - hole.top)),
+            ("retract_height", Value::from(hole.retract - hole.top)),
+            ("peck", Value::from(hole.peck)),
+            ("dwell", Value::from(hole.dwell)),
+            (
+                "dwell_ms",
+                Value::from((hole.dwell * 1000.0).round() as u64),
+            ),
+            ("feed", Value::from(hole.feed)),
+            ("rpm", Value::from(hole.rpm)),
+        ];
+        self.command(TemplateKind::Cycle, vars)?;
+        let initial_z = self.series.map_or(hole.start_z, |s| s.initial_z);
+        self.series = Some(Series {
+            initial_z,
+            last: *hole,
+        });
+        // The cycle leaves the tool at the retract, in another motion mode.
+        self.forget_modal_state();
+        Ok(true)
+    }
+
+    /// Ends the series of cycle holes in force, if any (`cycle_off`).
+    fn end_cycle_series(&mut self) -> Result<(), NcError> {
+        if self.series.take().is_some() {
+            self.command(TemplateKind::CycleOff, Vec::new())?;
+        }
+        Ok(())
+    }
+
     /// A command the program asks for (a stop, a dwell): a dialect without
     /// its template cannot write it, an error rather than a silent drop.
     fn required_command(
@@ -950,6 +1081,7 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
+        self.end_cycle_series()?;
         let mut all = self.vars.clone();
         all.extend(
             vars.iter()
@@ -964,6 +1096,9 @@ impl<W: Write> NcWriter<W> {
     fn command(&mut self, kind: TemplateKind, extra: Vec<(&str, Value)>) -> Result<(), NcError> {
         if self.kind == DialectKind::Csv {
             return Ok(());
+        }
+        if !matches!(kind, TemplateKind::Cycle | TemplateKind::CycleOff) {
+            self.end_cycle_series()?;
         }
         if self.tcp_on
             && self.outside_tcp.contains(&kind)
@@ -1043,6 +1178,8 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv || !self.comment.enabled {
             return Ok(());
         }
+        // (A comment belongs to what comes next, after the cycles.)
+        self.end_cycle_series()?;
         self.buf.clear();
         if self.numbering.enabled && self.numbering.comments {
             self.push_number()?;
@@ -1071,6 +1208,7 @@ impl<W: Write> NcWriter<W> {
         if self.kind == DialectKind::Csv {
             return Ok(());
         }
+        self.end_cycle_series()?;
         let text = text.replace(['\r', '\n'], " ");
         let length = text.len() + self.eol.len();
         if length > self.max_line {
@@ -1174,6 +1312,12 @@ impl<W: Write> NcWriter<W> {
     #[inline(always)]
     pub fn block<A: AsRef<[f64]>>(&mut self, block: &Block<A>) -> Result<(), BlockError> {
         let block = block.map_axes(|a| a.as_ref());
+        if self.series.is_some() {
+            self.end_cycle_series().map_err(|e| match e {
+                NcError::Io(e) => BlockError::Io(e),
+                other => BlockError::Template(other),
+            })?;
+        }
         if block.axes.len() != self.formats.len() {
             return Err(BlockError::AxisCount {
                 got: block.axes.len(),

@@ -17,6 +17,7 @@ use crate::command::{Command, Pending};
 use crate::error::{CheckError, PostError};
 use crate::motion::{MotionBlock, MotionSink};
 use crate::native_arc::{self, ProgramAxes};
+use crate::native_cycle;
 use kinpost_diag::{Diagnostic, Located};
 use kinpost_machine::tolerance::NATIVE_ARC_MIN_SAMPLES;
 
@@ -58,6 +59,19 @@ pub trait BlockSink {
     /// it.
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         offset
+    }
+
+    /// Whether this sink may write canned cycles; without, the check hands
+    /// every hole on as its moves.
+    fn writes_cycles(&self) -> bool {
+        false
+    }
+
+    /// One hole as a canned cycle: `Ok(false)`, with nothing written, when
+    /// the sink cannot write it as one (the check then hands on its moves).
+    fn hole(&mut self, hole: &kinpost_nc::Hole) -> Result<bool, kinpost_nc::NcError> {
+        let _ = hole;
+        Ok(false)
     }
 }
 
@@ -237,6 +251,8 @@ pub struct CheckReport {
     /// CL arcs written as circular blocks (pieces of a full circle or
     /// helix counted one by one).
     pub native_arcs: u64,
+    /// Holes of CL canned cycles written as the dialect's cycles.
+    pub native_cycles: u64,
 }
 
 /// How the check is set up.
@@ -273,7 +289,30 @@ pub struct Check<S> {
     program_axes: Option<ProgramAxes>,
     /// The blocks of an arc being gathered (see [`Command::ArcBegin`]).
     arc: Option<Box<Gathered>>,
+    /// The program's X, Y, Z axes, when the sink writes canned cycles and
+    /// the machine has them (and no pressure axis).
+    cycle_axes: Option<ProgramAxes>,
+    /// The blocks and commands of a hole being gathered (see
+    /// [`Command::HoleBegin`]).
+    hole: Option<Box<GatheredHole>>,
     report: CheckReport,
+}
+
+/// The moves of a hole of a canned cycle, checked and held back until its
+/// end.
+struct GatheredHole {
+    cycle: Box<crate::cycle::HoleCycle>,
+    rpm: Option<f64>,
+    /// The values written before the hole.
+    start: Joints,
+    items: Vec<HeldItem>,
+}
+
+/// What a hole holds back, in order.
+enum HeldItem {
+    Block(HeldBlock),
+    Command(Pending),
+    InverseTime(bool),
 }
 
 /// The blocks of a CL arc, checked and held back until its end.
@@ -321,7 +360,14 @@ impl<S: BlockSink> Check<S> {
                 max_beyond_reach_rad: 0.0,
                 first_beyond_reach_line: None,
                 native_arcs: 0,
+                native_cycles: 0,
             },
+            cycle_axes: if sink.writes_cycles() && machine.pressure.is_none() {
+                ProgramAxes::of(machine)
+            } else {
+                None
+            },
+            hole: None,
             program_axes: if sink.writes_arcs() && settings.tcp.is_none() {
                 ProgramAxes::of(machine)
             } else {
@@ -389,6 +435,16 @@ impl<S: BlockSink> Check<S> {
     #[cold]
     #[inline(never)]
     fn hold(&mut self, kin: &Kinematics, b: &MotionBlock<'_>, row: &[f64; MAX_AXES + 1]) {
+        if let Some(h) = &mut self.hole {
+            h.items.push(HeldItem::Block(HeldBlock {
+                row: *row,
+                written: self.written,
+                motion: b.motion,
+                cl_line: b.cl_line,
+                feed: b.feed,
+            }));
+            return;
+        }
         if let Some(g) = &mut self.arc {
             if g.kin.is_none() {
                 g.kin = Some(kin.clone());
@@ -457,6 +513,105 @@ impl<S: BlockSink> Check<S> {
                 .map_err(locate)?;
         }
         Ok(())
+    }
+
+    /// The end of a gathered hole: the dialect's cycle when the hole's
+    /// moves are exactly the cycle's (see [`crate::native_cycle`]) and the
+    /// sink writes it, otherwise its blocks and commands as they are (each
+    /// block passed the check already). `at`: the CL statement, for an
+    /// error of the writer.
+    fn end_hole(&mut self, at: &Diagnostic) -> Result<(), PostError> {
+        let Some(g) = self.hole.take() else {
+            return Ok(());
+        };
+        let mut items = g.items.into_iter();
+        if let Some((prefix, hole)) = self.native_hole(&g.cycle, g.rpm, &g.start, items.as_slice())
+        {
+            for item in items.by_ref().take(prefix) {
+                self.release(item, at)?;
+            }
+            let written = self.sink.hole(&hole).map_err(|e| {
+                PostError::from(Located {
+                    diagnostic: Box::new(Diagnostic {
+                        message: e.to_string(),
+                        ..at.clone()
+                    }),
+                    error: e,
+                })
+            })?;
+            if written {
+                self.report.native_cycles += 1;
+                return Ok(());
+            }
+        }
+        for item in items {
+            self.release(item, at)?;
+        }
+        Ok(())
+    }
+
+    /// The hole of a gathered hole's items and how many blocks come before
+    /// it, if the sink may write it as a cycle: only blocks, dwells and
+    /// spindle changes, and the blocks exactly the cycle's moves.
+    fn native_hole(
+        &mut self,
+        cycle: &crate::cycle::HoleCycle,
+        rpm: Option<f64>,
+        start: &Joints,
+        items: &[HeldItem],
+    ) -> Option<(usize, kinpost_nc::Hole)> {
+        let axes = self.cycle_axes.as_ref()?;
+        let n = self.n;
+        let mut blocks = Vec::with_capacity(items.len());
+        for item in items {
+            match item {
+                HeldItem::Block(b) => blocks.push(native_cycle::HoleBlock {
+                    exact: &b.row[..n],
+                    written: &b.written[..n],
+                    motion: b.motion,
+                    feed: b.feed,
+                }),
+                HeldItem::Command(Pending {
+                    command: Command::Dwell(_) | Command::Spindle(_),
+                    ..
+                }) => {}
+                _ => return None,
+            }
+        }
+        let sink = &mut self.sink;
+        native_cycle::fit(cycle, axes, &start[..n], &blocks, rpm, |v, w| {
+            sink.round(v, w)
+        })
+    }
+
+    /// Hands one held item of a hole on to the sink.
+    fn release(&mut self, item: HeldItem, at: &Diagnostic) -> Result<(), PostError> {
+        match item {
+            HeldItem::Block(held) => {
+                let n = self.n + usize::from(self.has_pressure);
+                self.sink
+                    .block(&Block {
+                        cl_line: held.cl_line,
+                        line: None,
+                        number: None,
+                        motion: held.motion,
+                        axes: &held.row[..n],
+                        feed: held.feed,
+                        arc: None,
+                    })
+                    .map_err(|e| {
+                        PostError::from(Located {
+                            diagnostic: Box::new(Diagnostic {
+                                message: e.to_string(),
+                                ..at.clone()
+                            }),
+                            error: e,
+                        })
+                    })
+            }
+            HeldItem::Command(p) => self.sink.command(p),
+            HeldItem::InverseTime(on) => self.sink.inverse_time(on),
+        }
     }
 
     /// The circular block of a gathered arc and its largest distance from
@@ -573,7 +728,7 @@ impl<S: BlockSink> MotionSink for Check<S> {
         row[..MAX_AXES].copy_from_slice(b.values);
         row[n] = b.pressure;
         self.started = true;
-        if self.arc.is_some() {
+        if self.arc.is_some() || self.hole.is_some() {
             self.hold(kin, b, &row);
             return Ok(lever);
         }
@@ -607,7 +762,25 @@ impl<S: BlockSink> MotionSink for Check<S> {
                 Ok(())
             }
             Command::ArcEnd => self.end_arc(&pending.at),
+            Command::HoleBegin { cycle, rpm } => {
+                self.end_arc(&pending.at)?;
+                self.end_hole(&pending.at)?;
+                if self.cycle_axes.is_some() && self.started {
+                    self.hole = Some(Box::new(GatheredHole {
+                        cycle,
+                        rpm,
+                        start: self.written,
+                        items: Vec::new(),
+                    }));
+                }
+                Ok(())
+            }
+            Command::HoleEnd => self.end_hole(&pending.at),
             _ => {
+                if let Some(h) = &mut self.hole {
+                    h.items.push(HeldItem::Command(pending));
+                    return Ok(());
+                }
                 self.end_arc(&pending.at)?;
                 self.sink.command(pending)
             }
@@ -615,6 +788,10 @@ impl<S: BlockSink> MotionSink for Check<S> {
     }
 
     fn inverse_time(&mut self, on: bool) -> Result<(), PostError> {
+        if let Some(h) = &mut self.hole {
+            h.items.push(HeldItem::InverseTime(on));
+            return Ok(());
+        }
         self.sink.inverse_time(on)
     }
 

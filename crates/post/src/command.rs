@@ -44,6 +44,19 @@ pub enum Command {
     },
     /// The end of the blocks of a [`Command::ArcBegin`].
     ArcEnd,
+    /// The blocks and commands up to the next [`Command::HoleEnd`] are the
+    /// moves of one hole of this canned cycle: the closed-loop check
+    /// writes them as the dialect's cycle where they are exactly its moves
+    /// (see [`crate::native_cycle`]), else as they are. Never written
+    /// itself.
+    HoleBegin {
+        /// The cycle, resolved.
+        cycle: Box<crate::cycle::HoleCycle>,
+        /// The spindle speed in force, rpm.
+        rpm: Option<f64>,
+    },
+    /// The end of the blocks of a [`Command::HoleBegin`].
+    HoleEnd,
 }
 
 /// A command with its CL statement: it is written after the reader has

@@ -36,6 +36,8 @@ pub struct PostOptions {
     pub insert: InsertMode,
     /// How a CL `CIRCLE`'s arc is written (`--arcs`).
     pub arcs: ArcMode,
+    /// How the holes of a CL `CYCLE` are written (`--cycles`).
+    pub cycles: CycleMode,
     /// The frame the points are posted in (`--frame`).
     pub frame: FrameMode,
     /// Joint or tool-centre-point output; default: the machine's (`[post]
@@ -107,6 +109,19 @@ pub enum ArcMode {
     Linear,
 }
 
+/// How the holes of a CL `CYCLE` are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CycleMode {
+    /// The dialect's canned cycle (`G81`…, `MCALL CYCLE81`, `CYCL DEF
+    /// 200`) where the checked moves of a hole are exactly what the cycle
+    /// does on the program's Z (see [`crate::native_cycle`]) and the
+    /// dialect writes the kind (`[cycle]`); the moves elsewhere.
+    #[default]
+    Native,
+    /// The moves of every hole (rapids, feeds, dwells, spindle reversals).
+    Expand,
+}
+
 /// The frame the CL's points are posted in: what an NX `MSYS` means for
 /// the program (ICAM's MSYS vocabulary: the `GOTO`s that follow are given
 /// in the machine coordinate system it places in the part's absolute
@@ -174,6 +189,8 @@ pub struct Config {
     pub insert: InsertMode,
     /// How arcs are written.
     pub arcs: ArcMode,
+    /// How the holes of canned cycles are written.
+    pub cycles: CycleMode,
     /// The frame the points are posted in.
     pub frame: FrameMode,
     /// Joint or tool-centre-point output.
@@ -266,6 +283,7 @@ impl Config {
             units: options.units,
             insert: options.insert,
             arcs: options.arcs,
+            cycles: options.cycles,
             frame: options.frame,
             output: options.output.or(machine.post.output).unwrap_or_default(),
             feed_mode: options

@@ -36,9 +36,6 @@ pub enum CycleError {
     /// No depth (`FEDTO`, `DEPTH`).
     #[error("CYCLE has no depth (FEDTO or DEPTH): how deep to drill is not known")]
     NoDepth,
-    /// A peck cycle without its peck.
-    #[error("CYCLE/{0} has no peck depth (STEP, INCR or 1STPECK)")]
-    NoPeck(&'static str),
     /// A distance that is not a positive finite number.
     #[error("CYCLE {what} is {value} mm: it must be a finite number above 0")]
     Distance {
@@ -147,6 +144,12 @@ fn positive(what: &'static str, value: f64) -> Result<f64, CycleError> {
 }
 
 impl HoleCycle {
+    /// Whether `cycle` is a peck or chip-breaking cycle that gives no peck
+    /// length: it is drilled in one peck, and the post says so.
+    pub fn single_peck(cycle: &Cycle) -> bool {
+        matches!(cycle.kind, CycleKind::Deep | CycleKind::BreakChip) && cycle.peck_mm.is_none()
+    }
+
     /// The cycle of a `CYCLE` statement with the feed (mm/min) and spindle
     /// speed (rpm) in force.
     pub fn resolve(
@@ -154,7 +157,16 @@ impl HoleCycle {
         feed_mm_min: Option<f64>,
         rpm: Option<f64>,
     ) -> Result<HoleCycle, CycleError> {
-        let depth_mm = positive("depth", cycle.depth_mm.ok_or(CycleError::NoDepth)?)?;
+        // A depth of 0 (NX writes `FEDTO,0` when the hole point is the
+        // bottom, as for a spot or countersink at the point) feeds from the
+        // feed start down to the hole point.
+        let depth_mm = cycle.depth_mm.ok_or(CycleError::NoDepth)?;
+        if !(depth_mm.is_finite() && depth_mm >= 0.0) {
+            return Err(CycleError::Distance {
+                what: "depth",
+                value: depth_mm,
+            });
+        }
         // No RAPTO/CLEAR: the feed starts at the hole point.
         let feed_start_mm = cycle.feed_start_mm.unwrap_or(0.0);
         if !feed_start_mm.is_finite() {
@@ -181,8 +193,14 @@ impl HoleCycle {
             Some(Dwell::Seconds(s)) => s,
             Some(Dwell::Revolutions(n)) => n * 60.0 / per_rev("dwell")?,
         };
-        let peck = |word| -> Result<(f64, f64), CycleError> {
-            let first = positive("peck", cycle.peck_mm.ok_or(CycleError::NoPeck(word))?)?;
+        // No peck given (NX "Drill, Deep" with no increment): one peck,
+        // the whole feed (see [`HoleCycle::single_peck`]).
+        let whole = depth_mm + feed_start_mm.max(0.0);
+        let peck = || -> Result<(f64, f64), CycleError> {
+            let Some(first) = cycle.peck_mm else {
+                return Ok((whole.max(f64::MIN_POSITIVE), whole.max(f64::MIN_POSITIVE)));
+            };
+            let first = positive("peck", first)?;
             let next = positive("later peck", cycle.next_peck_mm.unwrap_or(first))?;
             let pecks = (depth_mm + feed_start_mm.max(0.0)) / first.min(next);
             if pecks > MAX_PECKS as f64 {
@@ -199,11 +217,11 @@ impl HoleCycle {
                 HoleMotion::Drill
             }
             CycleKind::Deep => {
-                let (first_mm, next_mm) = peck("DEEP")?;
+                let (first_mm, next_mm) = peck()?;
                 HoleMotion::Peck { first_mm, next_mm }
             }
             CycleKind::BreakChip => {
-                let (first_mm, next_mm) = peck("BRKCHP")?;
+                let (first_mm, next_mm) = peck()?;
                 HoleMotion::ChipBreak {
                     first_mm,
                     next_mm,
@@ -247,18 +265,38 @@ impl HoleCycle {
     /// in rapid, the cycle, out to the retract height. The last step leaves
     /// the tool at `hole + retract · axis`.
     pub fn expand(&self, hole: [f64; 3], axis: [f64; 3], from: [f64; 3]) -> Vec<HoleStep> {
+        self.steps(hole, axis, Some(from))
+    }
+
+    /// The steps of the first hole of a program, where the tool is not
+    /// known to be anywhere yet: a rapid to the hole axis at the retract
+    /// height (or the feed start, if higher), down to the feed start, the
+    /// cycle, out (see [`HoleCycle::expand`]).
+    pub fn expand_from_unknown(&self, hole: [f64; 3], axis: [f64; 3]) -> Vec<HoleStep> {
+        self.steps(hole, axis, None)
+    }
+
+    fn steps(&self, hole: [f64; 3], axis: [f64; 3], from: Option<[f64; 3]>) -> Vec<HoleStep> {
         let at = |h: f64| [0, 1, 2].map(|i| hole[i] + h * axis[i]);
+        let r = self.feed_start_mm;
         let mut steps = Steps {
             out: Vec::new(),
-            at: from,
+            at: from.unwrap_or([f64::NAN; 3]),
         };
-        let r = self.feed_start_mm;
-        let height = (0..3).map(|i| (from[i] - hole[i]) * axis[i]).sum::<f64>();
-        if height < r {
-            steps.rapid([0, 1, 2].map(|i| from[i] + (r - height) * axis[i]));
+        match from {
+            Some(from) => {
+                let height = (0..3).map(|i| (from[i] - hole[i]) * axis[i]).sum::<f64>();
+                if height < r {
+                    steps.rapid([0, 1, 2].map(|i| from[i] + (r - height) * axis[i]));
+                }
+                steps.rapid(at(height.max(r)));
+            }
+            None => {
+                let clear = self.retract_mm.max(r);
+                steps.out.push(HoleStep::Rapid(at(clear)));
+                steps.at = at(clear);
+            }
         }
-        let clear = height.max(r);
-        steps.rapid(at(clear));
         steps.rapid(at(r));
         let bottom = -self.depth_mm;
         match self.motion {

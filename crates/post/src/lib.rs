@@ -27,7 +27,9 @@
 //!    kinematics and compared with its target; only a block that passes is
 //!    handed on. The blocks of a CL arc are held back and written as one
 //!    circular block where the machine can and the block as written lies on
-//!    the CL arc ([`native_arc`], `--arcs`), else as they are.
+//!    the CL arc ([`native_arc`], `--arcs`), else as they are; so are the
+//!    blocks of a hole of a canned cycle, written as the dialect's cycle
+//!    where they are exactly its moves ([`native_cycle`], `--cycles`).
 //! 6. **Block sink**: the NC writer of a dialect ([`nc`]), or a
 //!    [`Recorded`] list in tests; [`ReadBack`] re-reads what a writer wrote
 //!    and compares it with what it was given.
@@ -57,6 +59,7 @@ mod error;
 mod machine_templates;
 pub mod motion;
 pub mod native_arc;
+pub mod native_cycle;
 mod pressure;
 pub mod program;
 mod readback;
@@ -74,7 +77,8 @@ use kinpost_nc::{Dialect, NcWriter};
 
 pub use command::{Command, Pending};
 pub use config::{
-    ArcMode, Config, FeedMode, FrameMode, InsertMode, PLANNER_LAG, PlannerMode, PostOptions,
+    ArcMode, Config, CycleMode, FeedMode, FrameMode, InsertMode, PLANNER_LAG, PlannerMode,
+    PostOptions,
 };
 pub use error::{
     CheckError, ConfigError, LinearizationFailure, MotionError, MotionWarning, PointError,

@@ -101,6 +101,8 @@ pub struct Program<'a> {
     cutcom_on: bool,
     /// A `CSYS` with a rotation or offset was remarked on.
     csys_remarked: bool,
+    /// A `FROM` gave the tool's start.
+    position_known: bool,
     remarked: Remarked,
     report: ProgramReport,
 }
@@ -163,6 +165,7 @@ impl<'a> Program<'a> {
             tool_diameter_mm: None,
             cutcom_on: false,
             csys_remarked: false,
+            position_known: false,
             remarked: Remarked::default(),
             report: ProgramReport {
                 warnings,

@@ -193,6 +193,14 @@ impl<W: Write> BlockSink for ReadBack<W> {
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         self.writer.round_centre(offset)
     }
+
+    fn writes_cycles(&self) -> bool {
+        self.writer.writes_cycles()
+    }
+
+    fn hole(&mut self, hole: &kinpost_nc::Hole) -> Result<bool, kinpost_nc::NcError> {
+        self.writer.hole(hole)
+    }
 }
 
 impl<W: Write> ProgramWriter for ReadBack<W> {

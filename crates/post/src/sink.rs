@@ -36,7 +36,10 @@ impl<W: Write> BlockSink for NcWriter<W> {
             Command::Dwell(seconds) => self.dwell(*seconds),
             Command::CutterCompensation(on) => self.cutter_compensation(*on),
             // The closed-loop check acts on these; nothing to write.
-            Command::ArcBegin { .. } | Command::ArcEnd => Ok(()),
+            Command::ArcBegin { .. }
+            | Command::ArcEnd
+            | Command::HoleBegin { .. }
+            | Command::HoleEnd => Ok(()),
         };
         written.map_err(|e| p.locate(e).into())
     }
@@ -60,6 +63,14 @@ impl<W: Write> BlockSink for NcWriter<W> {
 
     fn round_centre(&self, offset: [f64; 3]) -> [f64; 3] {
         [0, 1, 2].map(|k| self.quantized_centre(k, offset[k]))
+    }
+
+    fn writes_cycles(&self) -> bool {
+        NcWriter::writes_cycles(self)
+    }
+
+    fn hole(&mut self, hole: &kinpost_nc::Hole) -> Result<bool, kinpost_nc::NcError> {
+        NcWriter::hole(self, hole)
     }
 }
 

@@ -87,6 +87,10 @@ pub struct Planning {
     /// circular blocks (`--arcs native`); left out of the JSON when 0.
     #[serde(skip_serializing_if = "is_zero")]
     pub native_arcs: u64,
+    /// Holes of CL canned cycles written as the dialect's cycles
+    /// (`--cycles native`); left out of the JSON when 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub native_cycles: u64,
 }
 
 impl Planning {
@@ -111,6 +115,7 @@ impl Planning {
             max_beyond_reach_rad: c.max_beyond_reach_rad,
             first_beyond_reach_line: c.first_beyond_reach_line,
             native_arcs: c.native_arcs,
+            native_cycles: c.native_cycles,
         }
     }
 }
@@ -225,6 +230,9 @@ impl Summary {
         }
         if p.native_arcs > 0 {
             planning += &format!("; {} arc(s) written as circular blocks", p.native_arcs);
+        }
+        if p.native_cycles > 0 {
+            planning += &format!("; {} hole(s) written as canned cycles", p.native_cycles);
         }
         if p.feed_clamp_count > 0 {
             planning += &format!("; {} feed block(s) clamped", p.feed_clamp_count);

@@ -4,6 +4,7 @@
 use std::io::BufRead;
 
 use kinpost_cl::{Circle, ClEvent, ClReader, Move, Next};
+use kinpost_post::cycle::{HoleCycle, HoleStep};
 use nalgebra::Vector3;
 
 use crate::SimError;
@@ -53,15 +54,18 @@ pub struct Measured {
 }
 
 impl ClPath {
-    /// The path of a CL file: its `GOTO`s, and the arcs of its `CIRCLE`s
-    /// as chords within [`ARC_CHORD_MM`] (the tool axis interpolated
-    /// linearly along them). Other statements do not move the tool; a CL
-    /// without any `GOTO` is an error, and so are the motions the polyline
-    /// cannot hold (`NURBS`, canned cycles): they are not compared.
+    /// The path of a CL file: its `GOTO`s, the arcs of its `CIRCLE`s as
+    /// chords within [`ARC_CHORD_MM`] (the tool axis interpolated linearly
+    /// along them), and the holes of its canned cycles as the post expands
+    /// them (see [`kinpost_post::cycle`]: the moves along the hole axis a
+    /// control's cycle makes). Other statements do not move the tool; a CL
+    /// without any `GOTO` is an error, and so is a `NURBS` curve, which the
+    /// polyline does not hold: it is not compared.
     pub fn read<R: BufRead>(input: R, file: &str) -> Result<ClPath, SimError> {
         let mut reader = ClReader::new(input, file);
         let mut points: Vec<ClPoint> = Vec::new();
         let mut circle: Option<(Box<Circle>, usize)> = None;
+        let mut cycle: Option<HoleCycle> = None;
         let mut m = Move::default();
         loop {
             let (point, axis, line) = match reader.next_move(&mut m).map_err(SimError::Cl)? {
@@ -73,7 +77,22 @@ impl ClPath {
                         continue;
                     }
                     ClEvent::Nurbs(_) => return Err(not_compared(s.line, "a NURBS curve")),
-                    ClEvent::Cycle(_) => return Err(not_compared(s.line, "a canned cycle")),
+                    ClEvent::Cycle(c) => {
+                        // Only the geometry counts here: any feed and speed.
+                        let hole =
+                            HoleCycle::resolve(&c, Some(1.0), Some(1.0)).map_err(|source| {
+                                SimError::ClCycle {
+                                    line: s.line,
+                                    source,
+                                }
+                            })?;
+                        cycle = Some(hole);
+                        continue;
+                    }
+                    ClEvent::CycleOff => {
+                        cycle = None;
+                        continue;
+                    }
                     _ => continue,
                 },
                 Next::End => break,
@@ -83,6 +102,21 @@ impl ClPath {
                 axis: Vector3::from(axis),
                 line,
             };
+            if let Some(hole) = &cycle {
+                let steps = match points.last() {
+                    Some(at) => hole.expand(point, axis, at.point.into()),
+                    None => hole.expand_from_unknown(point, axis),
+                };
+                for step in steps {
+                    if let HoleStep::Rapid(p) | HoleStep::Feed(p) = step {
+                        points.push(ClPoint {
+                            point: Vector3::from(p),
+                            ..goto
+                        });
+                    }
+                }
+                continue;
+            }
             if let (Some((c, circle_line)), Some(prev)) = (circle.take(), points.last().copied()) {
                 let arc = c
                     .arc(prev.point.into(), point)

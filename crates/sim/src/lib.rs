@@ -85,10 +85,18 @@ pub enum SimError {
         /// Why.
         source: kinpost_cl::SampleError,
     },
+    /// A canned cycle of the CL whose holes cannot be expanded.
+    #[error("CL line {line}: {source}")]
+    ClCycle {
+        /// CL line of the `CYCLE`.
+        line: usize,
+        /// Why.
+        source: kinpost_post::cycle::CycleError,
+    },
     /// A CL motion the comparison cannot follow (it would compare the
     /// program with a wrong path).
     #[error(
-        "CL line {line}: {what}: the comparison with the CL follows GOTOs and CIRCLEs only (run without --cl to check travel and collisions)"
+        "CL line {line}: {what}: the comparison with the CL follows GOTOs, CIRCLEs and canned cycles only (run without --cl to check travel and collisions)"
     )]
     ClNotCompared {
         /// CL line.

@@ -163,6 +163,7 @@ fn the_post_stages_import_only_upstream() {
         "cycle",
         "error",
         "native_arc",
+        "native_cycle",
         "command",
         "config",
         "pressure",

@@ -564,3 +564,72 @@ fn heidenhain_arcs_replay_on_their_cl_circles() {
     assert!(sim("swapped.h") > 1.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Native canned cycles of every dialect that writes them (G81…G89,
+/// Sinumerik MCALL CYCLE8x, Heidenhain CYCL DEF 200/201/207), posted by
+/// kinpost from a CL with every kind of cycle and replayed by its own
+/// interpreters, follow the CL's holes; with the depth of one cycle
+/// changed, they do not.
+#[test]
+fn native_cycles_replay_on_their_cl_holes() {
+    let dir = temp_dir("native-cycles");
+    let cl =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../post/tests/cl/every-cycle.cls");
+    std::fs::copy(cl, dir.join("holes.cls")).unwrap();
+    for (dialect, marker, deeper) in [
+        ("linuxcnc", "G81", ("Z-5 R2", "Z-6 R2")),
+        ("fanuc", "G81", ("Z-5. R2.", "Z-6. R2.")),
+        ("sinumerik", "MCALL CYCLE81", ("2, -5)", "2, -6)")),
+        ("heidenhain", "CYCL DEF 200", ("Q201=-5 ", "Q201=-6 ")),
+    ] {
+        let o = run_in(
+            &dir,
+            &[
+                "post",
+                "holes.cls",
+                "--machine",
+                &free3(),
+                "--dialect",
+                dialect,
+                "-o",
+                "holes.nc",
+            ],
+        );
+        assert_exit(&o, 0);
+        let program = std::fs::read_to_string(dir.join("holes.nc")).unwrap();
+        assert!(program.contains(marker), "{dialect}:\n{program}");
+        let sim = |file: &str| {
+            let o = run_in(
+                &dir,
+                &[
+                    "sim",
+                    file,
+                    "--machine",
+                    &free3(),
+                    "--dialect",
+                    dialect,
+                    "--cl",
+                    "holes.cls",
+                    "--json",
+                    "r.json",
+                ],
+            );
+            assert_exit(&o, 0);
+            let json: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap())
+                    .unwrap();
+            json["max_position_error_mm"].as_f64().unwrap()
+        };
+        let error = sim("holes.nc");
+        assert!(error < 0.001, "{dialect}: {error} mm\n{program}");
+        assert!(program.contains(deeper.0), "{dialect}:\n{program}");
+        std::fs::write(
+            dir.join("deeper.nc"),
+            program.replacen(deeper.0, deeper.1, 1),
+        )
+        .unwrap();
+        let error = sim("deeper.nc");
+        assert!(error > 0.9, "{dialect}: {error} mm");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

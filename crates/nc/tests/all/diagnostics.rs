@@ -96,7 +96,7 @@ fn every_unknown_key_and_value_at_once() {
         [
             (
                 3,
-                "unknown key `colour`, expected one of `name`, `extension`, `description`, `kind`, `block`, `linear`, `rotary`, `endless`, `axis`, `pressure`, `feed`, `motion`, `arc`, `numbering`, `comment`, `templates`"
+                "unknown key `colour`, expected one of `name`, `extension`, `description`, `kind`, `block`, `linear`, `rotary`, `endless`, `axis`, `pressure`, `feed`, `motion`, `arc`, `cycle`, `numbering`, `comment`, `templates`"
             ),
             (5, &format!("unknown key `prefx`, {word}")[..]),
             (7, &format!("unknown key `decimal`, {word}")[..]),
@@ -110,7 +110,7 @@ fn every_unknown_key_and_value_at_once() {
             ),
             (
                 12,
-                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`, `stop`, `optional_stop`, `dwell`, `cutcom_on`, `cutcom_off`, `outside_tcp`"
+                "unknown key `headr`, expected one of `header`, `footer`, `tool_change`, `spindle_on`, `spindle_off`, `coolant_on`, `coolant_off`, `pressure`, `tcp_on`, `tcp_off`, `inverse_time_on`, `inverse_time_off`, `stop`, `optional_stop`, `dwell`, `cutcom_on`, `cutcom_off`, `cycle`, `cycle_off`, `outside_tcp`"
             ),
         ]
     );

@@ -1095,6 +1095,7 @@ fn every_template_gets_the_variables_the_loader_accepts() {
             .collect();
         src.push_str(&format!("{} = \"{}\"\n", kind.key(), vars.join(" ")));
     }
+    src.push_str("[cycle]\nkinds = [\"drill\"]\nretract = \"any\"\n");
     let dialect = Dialect::from_toml(&src, "all.toml").unwrap_or_else(|e| panic!("{e}"));
     let axes = mts_axes_with_pressure();
     let mut w = NcWriter::new(&dialect, &axes, Vec::new());
@@ -1114,6 +1115,21 @@ fn every_template_gets_the_variables_the_loader_accepts() {
     w.dwell(1.0).unwrap();
     w.cutter_compensation(Some((true, 1))).unwrap();
     w.cutter_compensation(None).unwrap();
+    let hole = kinpost_nc::Hole {
+        kind: kinpost_nc::HoleKind::Drill,
+        x: 1.0,
+        y: 2.0,
+        top: 0.0,
+        r: 2.0,
+        bottom: -5.0,
+        retract: 10.0,
+        start_z: 10.0,
+        peck: 0.0,
+        dwell: 0.0,
+        feed: 100.0,
+        rpm: 1000.0,
+    };
+    assert!(w.hole(&hole).unwrap());
     pressure_block(&mut w, 1.0, 3000.0);
     w.footer(&info, None).unwrap();
     let out = text(w);

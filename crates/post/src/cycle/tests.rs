@@ -105,9 +105,16 @@ fn raw(kind: CycleKind) -> Cycle {
 /// What cannot be expanded is an error naming what is missing.
 #[test]
 fn resolve_errors() {
+    // No peck: one, the whole feed from the feed start to the bottom.
+    let single = HoleCycle::resolve(&raw(CycleKind::Deep), Some(100.0), None).unwrap();
+    assert!(HoleCycle::single_peck(&raw(CycleKind::Deep)));
     assert_eq!(
-        HoleCycle::resolve(&raw(CycleKind::Deep), Some(100.0), None),
-        Err(CycleError::NoPeck("DEEP"))
+        single.expand([0.0; 3], Z, z(10.0)),
+        [
+            HoleStep::Rapid(z(single.feed_start_mm)),
+            HoleStep::Feed(z(-single.depth_mm)),
+            HoleStep::Rapid(z(single.retract_mm)),
+        ]
     );
     assert_eq!(
         HoleCycle::resolve(&raw(CycleKind::Drill), None, None),

@@ -20,7 +20,7 @@ use kinpost_nc::Spindle;
 
 use super::{Program, ProgramSink, locate};
 use crate::command::Command;
-use crate::config::{ArcMode, FeedMode, InsertMode};
+use crate::config::{ArcMode, CycleMode, FeedMode, InsertMode};
 use crate::cycle::{CycleError, HoleCycle, HoleStep};
 use crate::error::{PostError, ProgramError};
 
@@ -47,8 +47,9 @@ struct PendingArc {
 #[derive(Debug)]
 struct ActiveCycle {
     hole: HoleCycle,
-    /// The tool's point: where the last hole left it.
-    at: Vec3,
+    /// The tool's point: where the last hole left it (`None`: nowhere
+    /// known yet, the cycle opens the program).
+    at: Option<Vec3>,
 }
 
 /// The axis a fraction `t` of the way from `a` to `b` (normalized linear
@@ -299,8 +300,19 @@ impl Program<'_> {
         let Some(cycle) = self.modal.as_ref().and_then(|m| m.cycle.as_ref()) else {
             return self.goto(goto, reader, sink);
         };
-        let steps = cycle.hole.expand(goto.point, goto.axis, cycle.at);
+        let steps = match cycle.at {
+            Some(from) => cycle.hole.expand(goto.point, goto.axis, from),
+            None => cycle.hole.expand_from_unknown(goto.point, goto.axis),
+        };
         let feed = Some(cycle.hole.feed_mm_min);
+        let native = self.config.cycles == CycleMode::Native;
+        if native {
+            let begin = Command::HoleBegin {
+                cycle: Box::new(cycle.hole.clone()),
+                rpm: self.rpm,
+            };
+            self.command(begin, reader, sink)?;
+        }
         let saved = std::mem::replace(&mut self.feed, feed);
         let mut m = *goto;
         let mut at = None;
@@ -333,12 +345,15 @@ impl Program<'_> {
             }
         }
         self.feed = saved;
+        if native {
+            self.command(Command::HoleEnd, reader, sink)?;
+        }
         // The summary counts the CL's points: the hole is its GOTO.
         self.report.cl_points = counted + 1;
         if let Some(p) = at
             && let Some(c) = self.modal.as_mut().and_then(|m| m.cycle.as_mut())
         {
-            c.at = p;
+            c.at = Some(p);
         }
         Ok(())
     }
@@ -355,7 +370,9 @@ impl Program<'_> {
         reader: &ClReader<R>,
     ) {
         if let Some(c) = self.modal.as_mut().and_then(|m| m.cycle.take()) {
-            last.point = c.at;
+            if let Some(p) = c.at {
+                last.point = p;
+            }
             self.report.warnings.push(reader.statement_diagnostic(
                 Severity::Warning,
                 "the tool change ends the canned cycle on (the CL gives no CYCLE/OFF): the GOTOs after it are plain moves",
@@ -458,20 +475,30 @@ impl Program<'_> {
             ClEvent::Cycle(cycle) => {
                 let hole = HoleCycle::resolve(&cycle, self.feed, self.rpm)
                     .map_err(|e| PostError::from(locate(reader, ProgramError::Cycle(e))))?;
+                if HoleCycle::single_peck(&cycle) {
+                    self.report.warnings.push(reader.statement_diagnostic(
+                        Severity::Warning,
+                        "this peck cycle gives no peck length (STEP, INCR): each hole is drilled in one peck",
+                    ));
+                }
                 let at = match self.modal.as_ref().and_then(|m| m.cycle.as_ref()) {
                     Some(c) => c.at,
-                    None => last.point,
+                    None if last.line == 0 && !self.position_known => None,
+                    None => Some(last.point),
                 };
                 self.modal_mut().cycle = Some(ActiveCycle { hole, at });
             }
             ClEvent::CycleOff => {
                 if let Some(c) = self.modal.as_mut().and_then(|m| m.cycle.take()) {
                     // The tool is where the last hole left it.
-                    last.point = c.at;
+                    if let Some(p) = c.at {
+                        last.point = p;
+                    }
                 }
                 self.settle_modal();
             }
             ClEvent::From { point, axis } => {
+                self.position_known = true;
                 last.point = point;
                 if let Some(a) = axis {
                     last.axis = a;

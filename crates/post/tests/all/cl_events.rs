@@ -90,9 +90,12 @@ fn points(out: &[Out]) -> Vec<([f64; 3], Motion)> {
         .collect()
 }
 
+/// The commands the program stage hands on, without the markers of the
+/// holes of a canned cycle (for the check, never written).
 fn commands(out: &[Out]) -> Vec<Command> {
     out.iter()
         .filter_map(|o| match o {
+            Out::Command(Command::HoleBegin { .. } | Command::HoleEnd) => None,
             Out::Command(c) => Some(c.clone()),
             Out::Point { .. } => None,
         })

@@ -10,6 +10,7 @@ mod common;
 mod corpus;
 mod golden;
 mod native_arcs;
+mod native_cycles;
 mod nc_output;
 mod planning;
 mod pressure;

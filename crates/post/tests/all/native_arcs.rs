@@ -21,7 +21,7 @@ const LINTOL_MM: f64 = 0.002;
 /// How close the two programs' paths must be, mm.
 const SAME_PATH_MM: f64 = 1e-4;
 
-fn test_machine(name: &str) -> Machine {
+pub(crate) fn test_machine(name: &str) -> Machine {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/machines/{name}.toml"));
     let text = std::fs::read_to_string(&path).unwrap();
     machine_from_toml(&text, &path.display().to_string()).unwrap_or_else(|e| panic!("{e}"))
@@ -44,7 +44,7 @@ fn post_cl(cl: &str, machine: &Machine, dialect: &str, arcs: ArcMode) -> String 
     String::from_utf8(out).unwrap()
 }
 
-fn rs274() -> Option<PathBuf> {
+pub(crate) fn rs274() -> Option<PathBuf> {
     let found = ["/usr/bin/rs274"]
         .into_iter()
         .map(PathBuf::from)
@@ -59,7 +59,7 @@ fn rs274() -> Option<PathBuf> {
 
 /// A move as LinuxCNC's interpreter reports it, in X, Y, Z.
 #[derive(Debug, Clone)]
-enum Move {
+pub(crate) enum Move {
     Line {
         from: [f64; 3],
         to: [f64; 3],
@@ -88,7 +88,7 @@ fn numbers(call: &str) -> Vec<f64> {
 }
 
 /// The moves of `program` as `rs274 -g` reports them.
-fn trace(rs274: &Path, program: &str) -> Vec<Move> {
+pub(crate) fn trace(rs274: &Path, program: &str) -> Vec<Move> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("p.ngc");
     std::fs::write(&path, program).unwrap();
@@ -152,7 +152,7 @@ fn trace(rs274: &Path, program: &str) -> Vec<Move> {
     moves
 }
 
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 

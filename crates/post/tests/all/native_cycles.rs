@@ -1,0 +1,125 @@
+//! Native canned cycles (`--cycles native`) against their moves
+//! (`--cycles expand`), through LinuxCNC's own interpreter: `rs274 -g`
+//! runs the G81…G89 of the native program into the moves it makes, and
+//! they must be the moves of the expanded program, one for one, rapid for
+//! rapid, within 1e-4 mm. On the real CL files of `data/cl` with cycles,
+//! on the machines of tests/all/corpus.rs, and on a CL written here for
+//! every kind of cycle (peck, chip break, tap, bore, dwell, G98 and G99).
+//! Every program is also read back through the read-back stage.
+
+use kinpost_post::nc::Dialect;
+use kinpost_post::{ArcMode, CycleMode, InsertMode, PostOptions, post_read_back};
+
+use crate::native_arcs::{Move, dist, rs274, test_machine, trace};
+
+/// How close the two programs' moves must be, mm.
+const SAME_PATH_MM: f64 = 1e-4;
+
+fn post(cl: &[u8], file: &str, machine_name: &str, cycles: CycleMode) -> (String, u64) {
+    let options = PostOptions {
+        cl_file: file.into(),
+        lintol_mm: Some(0.01),
+        default_axis: Some([0.0, 0.0, 1.0]),
+        insert: InsertMode::Comment,
+        arcs: ArcMode::Linear,
+        cycles,
+        ..Default::default()
+    };
+    let dialect = Dialect::builtin("linuxcnc").unwrap();
+    let (out, summary) = post_read_back(
+        cl,
+        &test_machine(machine_name),
+        &dialect,
+        Vec::new(),
+        &options,
+    )
+    .unwrap_or_else(|e| panic!("{file}: {e}"));
+    assert!(
+        summary.max_position_error_mm <= summary.tolerance_mm,
+        "{file}"
+    );
+    let out = out.unwrap_or_else(|e| panic!("{file}: {e}"));
+    (
+        String::from_utf8(out).unwrap(),
+        summary.planning.native_cycles,
+    )
+}
+
+/// The end point and kind of every straight move that moves (LinuxCNC's
+/// G85 ends with a rapid to the R plane it is at).
+fn lines(moves: &[Move]) -> Vec<([f64; 3], bool)> {
+    moves
+        .iter()
+        .filter_map(|m| match m {
+            Move::Line { from, to, feed } => (from != to).then_some((*to, *feed)),
+            Move::Arc { .. } => panic!("an arc with --arcs linear"),
+        })
+        .collect()
+}
+
+/// Both programs of `cl` make the same moves in LinuxCNC; the number of
+/// holes written as cycles.
+fn same_moves(rs274: &std::path::Path, cl: &[u8], file: &str, machine_name: &str) -> u64 {
+    let (native, holes) = post(cl, file, machine_name, CycleMode::Native);
+    let (expanded, none) = post(cl, file, machine_name, CycleMode::Expand);
+    assert_eq!(none, 0, "{file}");
+    let a = lines(&trace(rs274, &native));
+    let b = lines(&trace(rs274, &expanded));
+    assert_eq!(a.len(), b.len(), "{file}: moves\n{native}");
+    for (k, ((p, pf), (q, qf))) in a.iter().zip(&b).enumerate() {
+        assert!(
+            pf == qf && dist(*p, *q) <= SAME_PATH_MM,
+            "{file}: move {k}: {p:?} {pf} against {q:?} {qf}"
+        );
+    }
+    holes
+}
+
+#[test]
+fn the_corpus_cycles_move_as_their_expansion_in_linuxcnc() {
+    let Some(rs274) = rs274() else {
+        return;
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/cl");
+    // The holes left as moves: SOLIDWORKS CAM's pecks of 5 then 2 mm
+    // (`DEEP2,…,1STPECK,5.,SUBPECK,2.`), which no G83 makes, and the
+    // tilted holes of the 3+2 files on the head-head machine.
+    let files = [
+        ("creo/bohren_1.ncl.8", "free3", 2),
+        ("solidworks/Dem-target1.apt", "free3", 0),
+        ("solidworks/Guincho_LLbar-left.apt", "free3", 2),
+        ("solidworks/Leg-holder-thin.apt", "free3", 0),
+        ("solidworks/RotateThin.apt", "free3", 5),
+        ("solidworks/Sacrifice-Board.apt", "free5", 6),
+        ("solidworks/SlewMachine.apt", "free3", 6),
+        ("solidworks/SupPetriLED.apt", "free3", 12),
+        ("solidworks/Suporte-parede-side-drill.apt", "free3", 0),
+        ("solidworks/Teflon-gasket.apt", "free3", 1),
+        ("solidworks/Telemecanique-Tilt-Support1.apt", "free5", 0),
+        ("solidworks/manufacture3-top.apt", "free3", 0),
+        ("solidworks/shimemcunha.apt", "free5", 0),
+    ];
+    for (file, machine_name, want) in files {
+        let cl = std::fs::read(root.join(file)).unwrap();
+        let holes = same_moves(&rs274, &cl, file, machine_name);
+        eprintln!("{file}: {holes} holes as cycles");
+        assert_eq!(holes, want, "{file}");
+    }
+}
+
+/// `tests/cl/every-cycle.cls`: every kind of cycle on a three-axis mill,
+/// holes at two heights, G99 and G98 (RTRCTO above RAPTO), pecks, chip
+/// breaking, tapping, boring with and without a dwell, a dwell on a drill.
+fn every_kind() -> Vec<u8> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/cl/every-cycle.cls");
+    std::fs::read(path).unwrap()
+}
+
+#[test]
+fn every_kind_of_cycle_moves_as_its_expansion_in_linuxcnc() {
+    let Some(rs274) = rs274() else {
+        return;
+    };
+    let holes = same_moves(&rs274, &every_kind(), "every-cycle.cls", "free3");
+    assert_eq!(holes, 10);
+}
