@@ -19,6 +19,22 @@ const WINDOW: usize = 64;
 /// output rounding.
 pub const ARC_CHORD_MM: f64 = 1e-5;
 
+/// The most points of a CL's path (48 bytes each: 800 MB): a CL whose arcs
+/// or holes make more (a million holes of ten thousand pecks) is refused,
+/// not held in memory.
+pub const MAX_CL_PATH_POINTS: usize = 1 << 24;
+
+/// [`MAX_CL_PATH_POINTS`] holds for `points`, made up to CL line `line`.
+fn within_bound(points: &[ClPoint], line: usize) -> Result<(), SimError> {
+    if points.len() > MAX_CL_PATH_POINTS {
+        return Err(SimError::ClTooLong {
+            line,
+            max: MAX_CL_PATH_POINTS,
+        });
+    }
+    Ok(())
+}
+
 /// A CL motion the polyline cannot hold.
 fn not_compared(line: usize, what: &'static str) -> SimError {
     SimError::ClNotCompared { line, what }
@@ -115,6 +131,7 @@ impl ClPath {
                         });
                     }
                 }
+                within_bound(&points, line)?;
                 continue;
             }
             if let (Some((c, circle_line)), Some(prev)) = (circle.take(), points.last().copied()) {
@@ -141,6 +158,7 @@ impl ClPath {
                 }
             }
             points.push(goto);
+            within_bound(&points, line)?;
         }
         ClPath::new(points).ok_or_else(|| SimError::EmptyCl(file.to_string()))
     }
@@ -220,6 +238,43 @@ mod tests {
             point: Vector3::new(x, y, 0.0),
             axis: Vector3::z(),
             line,
+        }
+    }
+
+    /// The holes of a canned cycle are on the path as the post expands
+    /// them: down to R, feed to the bottom, back out.
+    #[test]
+    fn a_hole_is_its_moves() {
+        let cl = "GOTO/0,0,10,0,0,1\nCYCLE/DRILL,FEDTO,5,RAPTO,2,MMPM,100\nGOTO/5,0,0\nCYCLE/OFF\n";
+        let path = ClPath::read(cl.as_bytes(), "h.cls").unwrap();
+        let z: Vec<[f64; 3]> = path.points.iter().map(|p| p.point.into()).collect();
+        assert_eq!(
+            z,
+            [
+                [0.0, 0.0, 10.0],
+                [5.0, 0.0, 10.0],
+                [5.0, 0.0, 2.0],
+                [5.0, 0.0, -5.0],
+                [5.0, 0.0, 2.0]
+            ]
+        );
+    }
+
+    /// Holes of ten thousand pecks each make a path too long to hold: an
+    /// error at the hole that passes the bound, not memory without end.
+    #[test]
+    fn a_path_too_long_is_refused() {
+        let mut cl =
+            String::from("GOTO/0,0,10,0,0,1\nCYCLE/DEEP,FEDTO,999,RAPTO,1,STEP,0.1,MMPM,100\n");
+        for k in 0..900 {
+            cl.push_str(&format!("GOTO/{k},0,0\n"));
+        }
+        match ClPath::read(cl.as_bytes(), "h.cls") {
+            Err(SimError::ClTooLong { line, max }) => {
+                assert_eq!(max, MAX_CL_PATH_POINTS);
+                assert!((100..903).contains(&line), "{line}");
+            }
+            other => panic!("{:?}", other.map(|p| p.len())),
         }
     }
 

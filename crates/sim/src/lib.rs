@@ -107,6 +107,17 @@ pub enum SimError {
     /// The CL file has no `GOTO`.
     #[error("the CL file {0} has no GOTO to compare the program with")]
     EmptyCl(String),
+    /// The CL's path (its points, arcs as chords, holes as moves) is
+    /// longer than the comparison holds in memory.
+    #[error(
+        "CL line {line}: the CL's path has more than {max} points (arcs as chords of 1e-5 mm, holes as their moves): too long to compare with"
+    )]
+    ClTooLong {
+        /// The CL line that went past it.
+        line: usize,
+        /// [`cl::MAX_CL_PATH_POINTS`].
+        max: usize,
+    },
     /// The machine's solids cannot be built.
     #[error("the machine's solids: {0}")]
     Solids(#[from] kinpost_collide::BuildError),
