@@ -467,15 +467,7 @@ impl<S: BlockSink> Check<S> {
         let Some(g) = self.arc.take() else {
             return Ok(());
         };
-        let locate = |e: BlockError| {
-            PostError::from(Located {
-                diagnostic: Box::new(Diagnostic {
-                    message: e.to_string(),
-                    ..at.clone()
-                }),
-                error: e,
-            })
-        };
+        let locate = |e: BlockError| PostError::from(at_statement(at, e));
         if let Some((block, deviation)) = self.native_block(&g) {
             let held = g.blocks.last().expect("a native arc has blocks");
             let n = self.n;
@@ -498,19 +490,8 @@ impl<S: BlockSink> Check<S> {
             self.report.native_arcs += 1;
             return Ok(());
         }
-        let n = self.n + usize::from(self.has_pressure);
         for held in &g.blocks {
-            self.sink
-                .block(&Block {
-                    cl_line: held.cl_line,
-                    line: None,
-                    number: None,
-                    motion: held.motion,
-                    axes: &held.row[..n],
-                    feed: held.feed,
-                    arc: None,
-                })
-                .map_err(locate)?;
+            self.write_held(held, at)?;
         }
         Ok(())
     }
@@ -530,15 +511,10 @@ impl<S: BlockSink> Check<S> {
             for item in items.by_ref().take(prefix) {
                 self.release(item, at)?;
             }
-            let written = self.sink.hole(&hole).map_err(|e| {
-                PostError::from(Located {
-                    diagnostic: Box::new(Diagnostic {
-                        message: e.to_string(),
-                        ..at.clone()
-                    }),
-                    error: e,
-                })
-            })?;
+            let written = self
+                .sink
+                .hole(&hole)
+                .map_err(|e| PostError::from(at_statement(at, e)))?;
             if written {
                 self.report.native_cycles += 1;
                 return Ok(());
@@ -587,31 +563,26 @@ impl<S: BlockSink> Check<S> {
     /// Hands one held item of a hole on to the sink.
     fn release(&mut self, item: HeldItem, at: &Diagnostic) -> Result<(), PostError> {
         match item {
-            HeldItem::Block(held) => {
-                let n = self.n + usize::from(self.has_pressure);
-                self.sink
-                    .block(&Block {
-                        cl_line: held.cl_line,
-                        line: None,
-                        number: None,
-                        motion: held.motion,
-                        axes: &held.row[..n],
-                        feed: held.feed,
-                        arc: None,
-                    })
-                    .map_err(|e| {
-                        PostError::from(Located {
-                            diagnostic: Box::new(Diagnostic {
-                                message: e.to_string(),
-                                ..at.clone()
-                            }),
-                            error: e,
-                        })
-                    })
-            }
+            HeldItem::Block(held) => self.write_held(&held, at),
             HeldItem::Command(p) => self.sink.command(p),
             HeldItem::InverseTime(on) => self.sink.inverse_time(on),
         }
+    }
+
+    /// A held block (of an arc or a hole) as a straight block, as checked.
+    fn write_held(&mut self, held: &HeldBlock, at: &Diagnostic) -> Result<(), PostError> {
+        let n = self.n + usize::from(self.has_pressure);
+        self.sink
+            .block(&Block {
+                cl_line: held.cl_line,
+                line: None,
+                number: None,
+                motion: held.motion,
+                axes: &held.row[..n],
+                feed: held.feed,
+                arc: None,
+            })
+            .map_err(|e| PostError::from(at_statement(at, e)))
     }
 
     /// The circular block of a gathered arc and its largest distance from
@@ -685,6 +656,17 @@ impl<S: BlockSink> Check<S> {
         t.position_mm = t.position_mm.max(p);
         t.axis_rad = t.axis_rad.max(a);
         true
+    }
+}
+
+/// `error` of writing what the CL statement `at` asked for, located there.
+fn at_statement<E: std::fmt::Display>(at: &Diagnostic, error: E) -> Located<E> {
+    Located {
+        diagnostic: Box::new(Diagnostic {
+            message: error.to_string(),
+            ..at.clone()
+        }),
+        error,
     }
 }
 

@@ -3,7 +3,7 @@
 //! 1 bad input, 2 usage, 3 violated), the summary, the JSON report and the
 //! block table, and that the outputs are written all or nothing.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::common::{self, root, run_in};
@@ -508,6 +508,30 @@ fn the_process_model_grinds_prestons_depth() {
     assert!((gouge - h).abs() < 1e-3 * h, "{gouge} against {h}");
 }
 
+/// The largest deviation from the CL `cl` of `program` in `dialect`,
+/// replayed on `free3` (`sim --cl`, which must find nothing else).
+fn cl_deviation(dir: &Path, program: &str, cl: &str, dialect: &str) -> f64 {
+    let o = run_in(
+        dir,
+        &[
+            "sim",
+            program,
+            "--machine",
+            &free3(),
+            "--dialect",
+            dialect,
+            "--cl",
+            cl,
+            "--json",
+            "r.json",
+        ],
+    );
+    assert_exit(&o, 0);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+    json["max_position_error_mm"].as_f64().unwrap()
+}
+
 /// Heidenhain's native arcs (CC, C with DR±) posted by kinpost and replayed
 /// by its Heidenhain interpreter follow the CL's circles: the deviation
 /// along the path, sampled inside every arc, is the output rounding, and
@@ -536,25 +560,7 @@ fn heidenhain_arcs_replay_on_their_cl_circles() {
     let program = std::fs::read_to_string(dir.join("arcs.h")).unwrap();
     // Two centres: (0, 0) for the first two arcs, (5, 0) for the third.
     assert_eq!(program.matches(" CC ").count(), 2, "{program}");
-    let sim = |file: &str| {
-        let o = run_in(
-            &dir,
-            &[
-                "sim",
-                file,
-                "--machine",
-                &free3(),
-                "--cl",
-                "arcs.cls",
-                "--json",
-                "r.json",
-            ],
-        );
-        assert_exit(&o, 0);
-        let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
-        json["max_position_error_mm"].as_f64().unwrap()
-    };
+    let sim = |file: &str| cl_deviation(&dir, file, "arcs.cls", "heidenhain");
     assert!(sim("arcs.h") < 0.001);
     let swapped = program
         .replace("DR+", "DR?")
@@ -598,28 +604,7 @@ fn native_cycles_replay_on_their_cl_holes() {
         assert_exit(&o, 0);
         let program = std::fs::read_to_string(dir.join("holes.nc")).unwrap();
         assert!(program.contains(marker), "{dialect}:\n{program}");
-        let sim = |file: &str| {
-            let o = run_in(
-                &dir,
-                &[
-                    "sim",
-                    file,
-                    "--machine",
-                    &free3(),
-                    "--dialect",
-                    dialect,
-                    "--cl",
-                    "holes.cls",
-                    "--json",
-                    "r.json",
-                ],
-            );
-            assert_exit(&o, 0);
-            let json: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap())
-                    .unwrap();
-            json["max_position_error_mm"].as_f64().unwrap()
-        };
+        let sim = |file: &str| cl_deviation(&dir, file, "holes.cls", dialect);
         let error = sim("holes.nc");
         assert!(error < 0.001, "{dialect}: {error} mm\n{program}");
         assert!(program.contains(deeper.0), "{dialect}:\n{program}");
