@@ -467,21 +467,9 @@ impl<S: BlockSink> Check<S> {
         let Some(g) = self.arc.take() else {
             return Ok(());
         };
-        let locate = |e: BlockError| PostError::from(at_statement(at, e));
         if let Some((block, deviation)) = self.native_block(&g) {
             let held = g.blocks.last().expect("a native arc has blocks");
-            let n = self.n;
-            self.sink
-                .block(&Block {
-                    cl_line: held.cl_line,
-                    line: None,
-                    number: None,
-                    motion: held.motion,
-                    axes: &held.row[..n + usize::from(self.has_pressure)],
-                    feed: held.feed,
-                    arc: Some(block),
-                })
-                .map_err(locate)?;
+            self.write_held(held, Some(block), at)?;
             let stats = &mut self.report.stats;
             if deviation > stats.max_position_error_mm {
                 stats.max_position_error_mm = deviation;
@@ -491,7 +479,7 @@ impl<S: BlockSink> Check<S> {
             return Ok(());
         }
         for held in &g.blocks {
-            self.write_held(held, at)?;
+            self.write_held(held, None, at)?;
         }
         Ok(())
     }
@@ -563,14 +551,20 @@ impl<S: BlockSink> Check<S> {
     /// Hands one held item of a hole on to the sink.
     fn release(&mut self, item: HeldItem, at: &Diagnostic) -> Result<(), PostError> {
         match item {
-            HeldItem::Block(held) => self.write_held(&held, at),
+            HeldItem::Block(held) => self.write_held(&held, None, at),
             HeldItem::Command(p) => self.sink.command(p),
             HeldItem::InverseTime(on) => self.sink.inverse_time(on),
         }
     }
 
-    /// A held block (of an arc or a hole) as a straight block, as checked.
-    fn write_held(&mut self, held: &HeldBlock, at: &Diagnostic) -> Result<(), PostError> {
+    /// A held block (of an arc or a hole) as checked, straight or along
+    /// `arc`.
+    fn write_held(
+        &mut self,
+        held: &HeldBlock,
+        arc: Option<ArcMotion>,
+        at: &Diagnostic,
+    ) -> Result<(), PostError> {
         let n = self.n + usize::from(self.has_pressure);
         self.sink
             .block(&Block {
@@ -580,7 +574,7 @@ impl<S: BlockSink> Check<S> {
                 motion: held.motion,
                 axes: &held.row[..n],
                 feed: held.feed,
-                arc: None,
+                arc,
             })
             .map_err(|e| PostError::from(at_statement(at, e)))
     }
