@@ -146,3 +146,40 @@ fn resolve_errors() {
         0.5
     );
 }
+
+/// NX's `FEDTO,0`: the hole point is the bottom, fed to from R.
+#[test]
+fn a_depth_of_zero_feeds_to_the_hole_point() {
+    let mut c = raw(CycleKind::Drill);
+    c.depth_mm = Some(0.0);
+    let hole = HoleCycle::resolve(&c, Some(100.0), None).unwrap();
+    assert_eq!(
+        hole.expand([0.0; 3], Z, z(10.0)),
+        [
+            HoleStep::Rapid(z(1.0)),
+            HoleStep::Feed(z(0.0)),
+            HoleStep::Rapid(z(1.0))
+        ]
+    );
+    c.depth_mm = Some(-1.0);
+    assert!(matches!(
+        HoleCycle::resolve(&c, Some(100.0), None),
+        Err(CycleError::Distance { what: "depth", .. })
+    ));
+}
+
+/// A cycle that opens the program (no point before it): the first hole is
+/// reached at the retract height, not from an assumed origin.
+#[test]
+fn the_first_hole_of_a_program_is_reached_at_the_retract_height() {
+    let c = cycle(HoleMotion::Drill, 0.0);
+    assert_eq!(
+        c.expand_from_unknown([3.0, 4.0, 0.0], Z),
+        [
+            HoleStep::Rapid([3.0, 4.0, 5.0]),
+            HoleStep::Rapid([3.0, 4.0, 1.0]),
+            HoleStep::Feed([3.0, 4.0, -4.0]),
+            HoleStep::Rapid([3.0, 4.0, 5.0]),
+        ]
+    );
+}
