@@ -7,6 +7,7 @@
 //! every kind of cycle (peck, chip break, tap, bore, dwell, G98 and G99).
 //! Every program is also read back through the read-back stage.
 
+use kinpost_post::machine::{Machine, builtin};
 use kinpost_post::nc::Dialect;
 use kinpost_post::{ArcMode, CycleMode, InsertMode, PostOptions, post_read_back};
 
@@ -15,7 +16,7 @@ use crate::native_arcs::{Move, dist, rs274, test_machine, trace};
 /// How close the two programs' moves must be, mm.
 const SAME_PATH_MM: f64 = 1e-4;
 
-fn post(cl: &[u8], file: &str, machine_name: &str, cycles: CycleMode) -> (String, u64) {
+fn post(cl: &[u8], file: &str, machine: &Machine, cycles: CycleMode) -> (String, u64) {
     let options = PostOptions {
         cl_file: file.into(),
         lintol_mm: Some(0.01),
@@ -26,14 +27,8 @@ fn post(cl: &[u8], file: &str, machine_name: &str, cycles: CycleMode) -> (String
         ..Default::default()
     };
     let dialect = Dialect::builtin("linuxcnc").unwrap();
-    let (out, summary) = post_read_back(
-        cl,
-        &test_machine(machine_name),
-        &dialect,
-        Vec::new(),
-        &options,
-    )
-    .unwrap_or_else(|e| panic!("{file}: {e}"));
+    let (out, summary) = post_read_back(cl, machine, &dialect, Vec::new(), &options)
+        .unwrap_or_else(|e| panic!("{file}: {e}"));
     assert!(
         summary.max_position_error_mm <= summary.tolerance_mm,
         "{file}"
@@ -59,9 +54,9 @@ fn lines(moves: &[Move]) -> Vec<([f64; 3], bool)> {
 
 /// Both programs of `cl` make the same moves in LinuxCNC; the number of
 /// holes written as cycles.
-fn same_moves(rs274: &std::path::Path, cl: &[u8], file: &str, machine_name: &str) -> u64 {
-    let (native, holes) = post(cl, file, machine_name, CycleMode::Native);
-    let (expanded, none) = post(cl, file, machine_name, CycleMode::Expand);
+fn same_moves(rs274: &std::path::Path, cl: &[u8], file: &str, machine: &Machine) -> u64 {
+    let (native, holes) = post(cl, file, machine, CycleMode::Native);
+    let (expanded, none) = post(cl, file, machine, CycleMode::Expand);
     assert_eq!(none, 0, "{file}");
     let a = lines(&trace(rs274, &native));
     let b = lines(&trace(rs274, &expanded));
@@ -101,7 +96,7 @@ fn the_corpus_cycles_move_as_their_expansion_in_linuxcnc() {
     ];
     for (file, machine_name, want) in files {
         let cl = std::fs::read(root.join(file)).unwrap();
-        let holes = same_moves(&rs274, &cl, file, machine_name);
+        let holes = same_moves(&rs274, &cl, file, &test_machine(machine_name));
         eprintln!("{file}: {holes} holes as cycles");
         assert_eq!(holes, want, "{file}");
     }
@@ -120,6 +115,27 @@ fn every_kind_of_cycle_moves_as_its_expansion_in_linuxcnc() {
     let Some(rs274) = rs274() else {
         return;
     };
-    let holes = same_moves(&rs274, &every_kind(), "every-cycle.cls", "free3");
+    let holes = same_moves(
+        &rs274,
+        &every_kind(),
+        "every-cycle.cls",
+        &test_machine("free3"),
+    );
     assert_eq!(holes, 10);
+}
+
+/// 3+2 holes on a table/table machine in joint output: the table tilts
+/// the part, the tool stays along the Z axis, and the holes are cycles in
+/// machine coordinates at the tilted A.
+#[test]
+fn tilted_holes_on_a_trunnion_are_cycles_in_machine_z() {
+    let Some(rs274) = rs274() else {
+        return;
+    };
+    let cl = "FEDRAT/MMPM,500\nRAPID\nGOTO/0,-20,60,0,-0.5,0.8660254\n\
+              CYCLE/DRILL,FEDTO,5,RAPTO,2,MMPM,100\nGOTO/10,0,0\nGOTO/20,0,0\nCYCLE/OFF\n\
+              GOTO/0,-20,60\n";
+    let machine = builtin::load("trunnion-ac").unwrap().unwrap();
+    let holes = same_moves(&rs274, cl.as_bytes(), "tilted.cls", &machine);
+    assert_eq!(holes, 2);
 }
