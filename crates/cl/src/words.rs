@@ -45,6 +45,9 @@ const KNOWN: &[&str] = &[
     "KNOT",
     "CNTRL",
     "SETUP",
+    "TPRINT",
+    "TOOLNO",
+    "REWIND",
 ];
 
 /// The known word closest to `word` (case-insensitive), if it is close enough

@@ -817,7 +817,7 @@ impl<R: BufRead> ClReader<R> {
             1,
             String::from_utf8_lossy(bytes),
             format!(
-                "invalid UTF-8 (byte 0x{:02X}); CL files must be UTF-8 text (convert it, e.g. with `iconv -f GBK -t UTF-8`)",
+                "invalid UTF-8 (byte 0x{:02X}); CL files must be UTF-8 text (convert it, e.g. with `iconv -f GBK -t UTF-8`, or `-f LATIN1` for the ISO 8859-1 accented comments CATIA V5 writes)",
                 bytes[valid]
             ),
         )
@@ -965,9 +965,15 @@ impl<R: BufRead> ClReader<R> {
             b"INSERT" => Ok(Some(ClEvent::Insert(
                 self.text()[args.0..].trim_end().to_string(),
             ))),
-            b"PPRINT" => Ok(Some(ClEvent::Comment(
+            // CATIA V5's tool print (the tool's description, "TPRINT/T1
+            // PointeurD10") is an operator message like PPRINT.
+            b"PPRINT" | b"TPRINT" => Ok(Some(ClEvent::Comment(
                 self.text()[args.0..].trim().to_string(),
             ))),
+            b"TOOLNO" => self.toolno(word, args),
+            // CATIA V5 writes `REWIND/0` before `END`: rewind the tape. The
+            // program's end (the dialect's footer, M2 or M30) does that.
+            b"REWIND" => Ok(None),
             b"END-OF-PATH" => {
                 self.no_pending_circle(word)?;
                 Ok(Some(ClEvent::EndOfPath))
@@ -1763,6 +1769,7 @@ fn takes_slash_arguments(key: &[u8]) -> bool {
             | b"GODLTA"
             | b"LOADTL"
             | b"OPNAME"
+            | b"TOOLNO"
     )
 }
 

@@ -78,8 +78,40 @@ impl<R: BufRead> ClReader<R> {
             return Err(self.error(word, "expected `LOADTL/n`"));
         }
         let number = self.whole(0, "tool number")?;
+        // CATIA V5 writes `LOADTL/n,m`, m the tool's compensation number
+        // (its PP table: `LOADTL/%MFG_TL_NUMBER,%MFG_TOOL_COMP`).
+        if self.fields.len() == 2 && !self.is_word(self.fields[1]) {
+            let m = self.whole(1, "compensation number")?;
+            return Ok(ClEvent::LoadTool {
+                number,
+                adjust: Some(m),
+            });
+        }
         let adjust = self.adjust(1, args)?;
         Ok(ClEvent::LoadTool { number, adjust })
+    }
+
+    /// CATIA V5's `TOOLNO/n,d` (its tool change: the number `LOADTL`
+    /// loads next, the nominal diameter), as the tool's data; the lathe's
+    /// `TOOLNO/n,TURN` (and any further words) gives no diameter.
+    pub(super) fn toolno(&mut self, word: Span, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
+        self.split(args);
+        if self.fields.is_empty() {
+            return Err(self.error(word, "expected `TOOLNO/n[,diameter]`"));
+        }
+        self.whole(0, "tool number")?;
+        if self.fields.get(1).is_none_or(|&f| self.is_word(f)) {
+            return Ok(None);
+        }
+        let value = self.numbers(1..2)?[0];
+        Ok(Some(ClEvent::ToolData(Box::new(ToolData {
+            kind: "TOOLNO".into(),
+            words: Vec::new(),
+            values: vec![value],
+            diameter_mm: Some(self.mm(value)),
+            corner_radius_mm: None,
+            length_mm: None,
+        }))))
     }
 
     /// `ADJUST,m` at field `k` (split already), if there; anything else

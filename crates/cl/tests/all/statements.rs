@@ -633,3 +633,32 @@ fn units_given_or_declared() {
     let c = &circles(&e)[0];
     assert_eq!((c.centre, c.radius_mm), ([0., 0., 0.], 25.4));
 }
+
+/// CATIA V5's tool change (`TOOLNO`, `TPRINT`, `LOADTL/n,m` with its
+/// compensation number) and its `REWIND` before `END`.
+#[test]
+fn catia_tool_change_and_rewind() {
+    let got = events(
+        "TOOLNO/2,   10.000000\nTPRINT/T1 PointeurD10\nLOADTL/2\nLOADTL/2,1\nTOOLNO/1,TURN\nREWIND/0\nEND\n",
+    );
+    assert_eq!(got.len(), 5, "{got:?}");
+    match &got[0] {
+        ClEvent::ToolData(t) => assert_eq!(t.diameter_mm, Some(10.0)),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        got[1..],
+        [
+            ClEvent::Comment("T1 PointeurD10".into()),
+            ClEvent::LoadTool {
+                number: 2,
+                adjust: None
+            },
+            ClEvent::LoadTool {
+                number: 2,
+                adjust: Some(1)
+            },
+            ClEvent::End,
+        ]
+    );
+}
