@@ -147,6 +147,11 @@ pub struct BlockFormat {
     /// Literal words written after the axis words of every motion block
     /// (Heidenhain `R0`); empty for none.
     pub after_axes: String,
+    /// The words that stand for `after_axes` while cutter radius
+    /// compensation is on, left then right (Heidenhain `["RL", "RR"]`: its
+    /// compensation is a word of the motion blocks); empty for a dialect
+    /// that switches it with the `cutcom_on` template (`G41`).
+    pub compensated: Vec<String>,
     /// Longest line the controller reads, in bytes, `line_end` included:
     /// longer comments are shortened, other longer lines are errors.
     pub max_line_length: Option<usize>,
@@ -470,6 +475,19 @@ impl Dialect {
         let motion = motion_words(raw.motion);
 
         check_separator(&raw.block, &mut err);
+        if let Some(c) = &raw.block.compensated {
+            let words = c.get_ref();
+            if words.len() != 2
+                || words
+                    .iter()
+                    .any(|w| w.trim().is_empty() || w.contains(['\n', '\r']))
+            {
+                err(
+                    c.span(),
+                    "`block.compensated`: two words, left then right (`[\"RL\", \"RR\"]`), each on one line".into(),
+                );
+            }
+        }
         if let Some(arc) = &raw.arc {
             check_arc(arc, &mut err);
         }
@@ -1195,6 +1213,7 @@ fn block_format(b: RawBlock, kind: DialectKind) -> BlockFormat {
             }),
         line_end: b.line_end.get_ref().clone(),
         after_axes: b.after_axes,
+        compensated: b.compensated.map(Spanned::into_inner).unwrap_or_default(),
         max_line_length: b.max_line_length.as_ref().map(|m| *m.get_ref()),
     }
 }
@@ -1473,6 +1492,8 @@ struct RawBlock {
     line_end: Spanned<String>,
     #[serde(default)]
     after_axes: String,
+    #[serde(default)]
+    compensated: Option<Spanned<Vec<String>>>,
     max_line_length: Option<Spanned<usize>>,
 }
 
@@ -1484,6 +1505,7 @@ impl Default for RawBlock {
             separator: None,
             line_end: newline(),
             after_axes: String::new(),
+            compensated: None,
             max_line_length: None,
         }
     }

@@ -164,7 +164,13 @@ impl WordsReader {
         for a in &m.feed_aliases {
             candidates.push(literal(a, Token::Motion(Motion::Feed)));
         }
-        for w in dialect.block.after_axes.split_whitespace() {
+        for w in dialect.block.after_axes.split_whitespace().chain(
+            dialect
+                .block
+                .compensated
+                .iter()
+                .flat_map(|c| c.split_whitespace()),
+        ) {
             candidates.push(literal(w, Token::Ignored));
         }
         if let Some(arc) = dialect.arc_words() {

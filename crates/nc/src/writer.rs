@@ -105,6 +105,7 @@ const SHORT_TEXT: usize = 16;
 
 /// A fixed piece of a block (motion word, separator, line end): padded for
 /// a fixed-size copy when it is short.
+#[derive(Clone)]
 struct Text {
     padded: [u8; SHORT_TEXT],
     full: Box<[u8]>,
@@ -237,6 +238,10 @@ pub struct NcWriter<W: Write> {
     motion_modal: bool,
     motion_state: Option<Motion>,
     after_axes: Text,
+    /// `after_axes` while compensation is off, and the words for it while
+    /// it is on, left then right (`[block] compensated`).
+    after_axes_plain: Text,
+    compensated: Option<[Text; 2]>,
     sep: Text,
     eol: Text,
     /// `max_line_length` (`usize::MAX` for none), line end included.
@@ -378,7 +383,12 @@ impl<W: Write> NcWriter<W> {
             + m.rapid.len().max(m.feed.len())
             + (words.len() + 1) * WORD_ROOM
             + 2 * sep.len()
-            + dialect.block.after_axes.len()
+            + dialect
+                .block
+                .compensated
+                .iter()
+                .map(String::len)
+                .fold(dialect.block.after_axes.len(), usize::max)
             + dialect.feed.rapid.len()
             + dialect.block.line_end.len()
             // (and a CSV `feed_mode` field)
@@ -442,6 +452,11 @@ impl<W: Write> NcWriter<W> {
             motion_modal: m.modal,
             motion_state: m.initial,
             after_axes: Text::new(&dialect.block.after_axes),
+            after_axes_plain: Text::new(&dialect.block.after_axes),
+            compensated: match dialect.block.compensated.as_slice() {
+                [l, r] if words_kind => Some([Text::new(l), Text::new(r)]),
+                _ => None,
+            },
             sep: Text::new(sep),
             eol: Text::new(&dialect.block.line_end),
             max_line: dialect.block.max_line_length.unwrap_or(usize::MAX),
@@ -874,6 +889,34 @@ impl<W: Write> NcWriter<W> {
     /// `right` and `register`), or off (`None`, template `cutcom_off`). A
     /// dialect without the template is an error.
     pub fn cutter_compensation(&mut self, on: Option<(bool, u32)>) -> Result<(), NcError> {
+        // A dialect whose compensation is a word of the motion blocks
+        // (Heidenhain RL/RR for R0) writes it there; its templates, if
+        // any, are written as well.
+        if let Some([left_word, right_word]) = &self.compensated {
+            let vars = match on {
+                None => {
+                    self.after_axes = self.after_axes_plain.clone();
+                    Vec::new()
+                }
+                Some((left, register)) => {
+                    self.after_axes = if left {
+                        left_word.clone()
+                    } else {
+                        right_word.clone()
+                    };
+                    vec![
+                        ("side", Value::from(if left { "left" } else { "right" })),
+                        ("register", Value::from(register)),
+                    ]
+                }
+            };
+            let kind = if on.is_some() {
+                TemplateKind::CutcomOn
+            } else {
+                TemplateKind::CutcomOff
+            };
+            return self.command(kind, vars);
+        }
         match on {
             None => self.required_command(TemplateKind::CutcomOff, Vec::new()),
             Some((left, register)) => {

@@ -1422,3 +1422,30 @@ fn an_arc_table_needs_all_its_words() {
     .unwrap_err();
     assert!(e.to_string().contains("counter_clockwise"), "{e}");
 }
+
+/// Heidenhain's radius compensation is a word of the motion blocks: RL or
+/// RR for R0 from CUTCOM/LEFT or RIGHT to CUTCOM/OFF, and the reader reads
+/// the blocks back with it.
+#[test]
+fn heidenhain_compensation_is_rl_or_rr_on_the_blocks() {
+    let dialect = Dialect::builtin("heidenhain").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    z_block(&mut w, Motion::Feed, 380.0);
+    w.cutter_compensation(Some((true, 1))).unwrap();
+    z_block(&mut w, Motion::Feed, 381.0);
+    z_block(&mut w, Motion::Feed, 382.0);
+    w.cutter_compensation(None).unwrap();
+    w.cutter_compensation(Some((false, 1))).unwrap();
+    z_block(&mut w, Motion::Rapid, 383.0);
+    w.cutter_compensation(None).unwrap();
+    z_block(&mut w, Motion::Feed, 384.0);
+    let out = text(w);
+    let words: Vec<&str> = out
+        .lines()
+        .map(|l| l.split(' ').find(|w| w.starts_with('R')).unwrap())
+        .collect();
+    assert_eq!(words, ["R0", "RL", "RL", "RR", "R0"], "{out}");
+    let read = kinpost_nc::read_program(&dialect, &axes, "h.h", &out).unwrap();
+    assert_eq!(read.len(), 5, "{out}");
+}
