@@ -53,7 +53,9 @@ fn cutter_compensation_where_the_dialect_has_it() {
     assert_eq!(lines("fanuc", cutcom), "G41 D3\nG42 D12\nG40\n");
     assert_eq!(lines("linuxcnc", cutcom), "G41 D3\nG42 D12\nG40\n");
     assert_eq!(lines("sinumerik", cutcom), "G41\nG42\nG40\n");
-    let d = Dialect::builtin("heidenhain").unwrap();
+    // Heidenhain's is RL/RR on the motion blocks: no line of its own.
+    assert_eq!(lines("heidenhain", cutcom), "");
+    let d = Dialect::from_toml("name = \"bare\"\nextension = \"nc\"\n", "bare.toml").unwrap();
     let mut w = NcWriter::new(&d, &[AxisSpec::linear("X")], Vec::new());
     let e = w.cutter_compensation(Some((true, 1))).unwrap_err();
     assert!(matches!(
@@ -63,7 +65,7 @@ fn cutter_compensation_where_the_dialect_has_it() {
             ..
         }
     ));
-    assert!(e.to_string().contains("heidenhain"), "{e}");
+    assert!(e.to_string().contains("bare"), "{e}");
 }
 
 #[test]
