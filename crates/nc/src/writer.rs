@@ -310,6 +310,32 @@ struct ArcWords {
     centre_in_force: Option<(crate::ArcPlane, [i64; 2])>,
 }
 
+/// Room for the longest motion block of `dialect` with `words` axis words.
+fn line_room(dialect: &Dialect, words: usize) -> usize {
+    let (m, sep) = (&dialect.motion, &dialect.block.separator);
+    dialect.numbering.prefix.len()
+        + 24
+        + sep.len()
+        + m.rapid.len().max(m.feed.len())
+        + (words + 1) * WORD_ROOM
+        + 2 * sep.len()
+        + dialect
+            .block
+            .compensated
+            .iter()
+            .map(String::len)
+            .fold(dialect.block.after_axes.len(), usize::max)
+        + dialect.feed.rapid.len()
+        + dialect.block.line_end.len()
+        // (and a CSV `feed_mode` field)
+        + sep.len()
+        + 16
+        + 64
+        // (and an arc block's plane, arc and centre words)
+        + 2 * WORD_ROOM
+        + 64
+}
+
 /// The pressure word: its format and state (modal), and whether the
 /// dialect can write it at all.
 struct PressureWord {
@@ -376,28 +402,7 @@ impl<W: Write> NcWriter<W> {
             dialect.feed.word.modal && words_kind,
         );
         let m = &dialect.motion;
-        // Room for the longest block.
-        let room = dialect.numbering.prefix.len()
-            + 24
-            + sep.len()
-            + m.rapid.len().max(m.feed.len())
-            + (words.len() + 1) * WORD_ROOM
-            + 2 * sep.len()
-            + dialect
-                .block
-                .compensated
-                .iter()
-                .map(String::len)
-                .fold(dialect.block.after_axes.len(), usize::max)
-            + dialect.feed.rapid.len()
-            + dialect.block.line_end.len()
-            // (and a CSV `feed_mode` field)
-            + sep.len()
-            + 16
-            + 64
-            // (and an arc block's plane, arc and centre words)
-            + 2 * WORD_ROOM
-            + 64;
+        let room = line_room(dialect, words.len());
         let arc = dialect.arc.as_ref().filter(|_| words_kind).map(|a| {
             let linear = dialect.word_format(&AxisSpec::linear("X"));
             let centre = |k: usize| {

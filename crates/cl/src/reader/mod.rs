@@ -988,8 +988,7 @@ impl<R: BufRead> ClReader<R> {
                 self.no_pending_circle(word)?;
                 self.bare(word, args, ClEvent::Fini)
             }
-            b"STOP" => self.bare(word, args, ClEvent::Stop),
-            b"OPSTOP" => self.bare(word, args, ClEvent::OptionalStop),
+            b"STOP" | b"OPSTOP" => self.stop(key == b"OPSTOP", args),
             b"END" => self.bare(word, args, ClEvent::End),
             b"TMARK" => Ok(Some(ClEvent::TapeMark)),
             b"DELAY" | b"DWELL" => self.delay(word, args).map(Some),
@@ -1019,6 +1018,31 @@ impl<R: BufRead> ClReader<R> {
                 Ok(None)
             }
         }
+    }
+
+    /// `STOP` or `OPSTOP`, bare or with the operator's instruction (CATIA
+    /// V5: `STOP/(INSTALL TEST STRIP LARGE END UP)`): the instruction comes
+    /// first as a comment, the stop next.
+    fn stop(&mut self, optional: bool, args: Span) -> Result<Option<ClEvent>, Diagnostic> {
+        let event = if optional {
+            ClEvent::OptionalStop
+        } else {
+            ClEvent::Stop
+        };
+        let text = self.text()[args.0..args.1].trim();
+        if text.is_empty() {
+            return Ok(Some(event));
+        }
+        let message = text
+            .strip_prefix('(')
+            .and_then(|t| t.strip_suffix(')'))
+            .unwrap_or(text)
+            .trim()
+            .to_string();
+        let line = self.segments[0].line;
+        self.held = Some(Box::new(Statement { line, event }));
+        self.update_slow();
+        Ok(Some(ClEvent::Comment(message)))
     }
 
     /// A statement that takes no arguments.

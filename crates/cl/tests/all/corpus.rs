@@ -29,6 +29,9 @@ struct Case {
     path: &'static str,
     default_axis: bool,
     units: Option<Units>,
+    /// The post-processor words of the file's own machine, which the
+    /// reader rightly warns about as unknown statements (and nothing else).
+    machine_words: &'static [&'static str],
 }
 
 const fn case(path: &'static str, default_axis: bool, units: Option<Units>) -> Case {
@@ -36,12 +39,24 @@ const fn case(path: &'static str, default_axis: bool, units: Option<Units>) -> C
         path,
         default_axis,
         units,
+        machine_words: &[],
     }
 }
 
 const INCH: Option<Units> = Some(Units::Inch);
 
 const CASES: &[Case] = &[
+    // CATIA V5 for a shot-peening machine: its own words (glass beads,
+    // air, recipes, feed overrides) are not a mill's.
+    Case {
+        path: "catia/peening.aptsource",
+        default_axis: false,
+        units: None,
+        machine_words: &[
+            "AIR", "FEEDOVER", "GLASS", "INITIAL", "RECIPE", "SATUTEST", "SAVERE", "SPINDLE",
+            "STANDOFF", "SUBPROG", "SURFACE",
+        ],
+    },
     case("nx/APT_Project2.txt", false, INCH),
     case("nx/APT_SimpleMillPlane.txt", false, None),
     case("nx/APT_SimpleMillPlane_ZIG.txt", false, None),
@@ -94,7 +109,14 @@ fn statements(case: &Case) -> Vec<Statement> {
     loop {
         let result = reader.next_statement();
         let warnings = reader.take_warnings();
-        assert!(warnings.is_empty(), "{}: {warnings:#?}", case.path);
+        assert!(
+            warnings.iter().all(|w| case
+                .machine_words
+                .iter()
+                .any(|m| w.message.starts_with(&format!("unknown statement `{m}`")))),
+            "{}: {warnings:#?}",
+            case.path
+        );
         match result {
             Ok(Some(s)) => out.push(s),
             Ok(None) => return out,

@@ -372,7 +372,19 @@ fn from_gohome_and_program_stops() {
             axis: None
         }]
     );
-    assert!(error("STOP/1\n").message.contains("takes no arguments"));
+    // A stop with the operator's instruction (CATIA V5): the instruction
+    // as a comment, then the stop.
+    assert_eq!(
+        events("STOP/(INSTALL TEST STRIP)\nOPSTOP/CHECK\nSTOP\n"),
+        [
+            ClEvent::Comment("INSTALL TEST STRIP".into()),
+            ClEvent::Stop,
+            ClEvent::Comment("CHECK".into()),
+            ClEvent::OptionalStop,
+            ClEvent::Stop,
+        ]
+    );
+    assert!(error("END/1\n").message.contains("takes no arguments"));
     assert!(error("DELAY/-1\n").message.contains("negative"));
 }
 

@@ -1,4 +1,4 @@
-//! Every real CL file of `data/cl` (NX, Creo, SOLIDWORKS CAM; origins and
+//! Every real CL file of `data/cl` (NX, Creo, SOLIDWORKS CAM, CATIA V5; origins and
 //! licenses in `data/MANIFEST.md`) posts, with the closed-loop check
 //! passing, on a test machine without travel limits (`tests/machines/`:
 //! `free3`, a three-axis mill, for files whose tool axis is always +Z;
@@ -19,7 +19,8 @@ use kinpost_post::{InsertMode, PostOptions, post};
 
 /// The files, the machine each needs and whether it is in inches without
 /// saying so (NX information listings with `FEDRAT/IPM`).
-const CORPUS: [(&str, &str, bool); 23] = [
+const CORPUS: [(&str, &str, bool); 24] = [
+    ("catia/peening.aptsource", "free5", false),
     ("creo/bohren_1.ncl.8", "free3", false),
     ("creo/profilfraesen_2.ncl.1", "free3", false),
     ("nx/APT_Project2.txt", "free5", true),
@@ -134,7 +135,7 @@ fn every_real_cl_file_posts_to_its_fixed_program() {
 #[test]
 fn the_corpus_list_is_complete() {
     let mut found = Vec::new();
-    for system in ["creo", "nx", "solidworks"] {
+    for system in ["catia", "creo", "nx", "solidworks"] {
         for entry in std::fs::read_dir(root().join("data/cl").join(system)).unwrap() {
             let name = entry.unwrap().file_name().to_string_lossy().into_owned();
             found.push(format!("{system}/{name}"));
