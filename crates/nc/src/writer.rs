@@ -958,10 +958,11 @@ impl<W: Write> NcWriter<W> {
     /// make (`[cycle] dwell`), the tool below the feed start or the bottom
     /// not below it, a retract below the feed start, or, for a dialect
     /// whose cycles return to the feed start or the initial level only
-    /// (`G99`/`G98`), a retract to neither. The caller then writes the hole's moves. A hole after
-    /// the first of a series gets `first` false, and `changed` false when
-    /// only its X and Y differ from the hole before; anything else written
-    /// ends the series with `cycle_off` (`G80`).
+    /// (`G99`/`G98`), a retract to neither. The caller then writes the
+    /// hole's moves. A hole after the first of a series gets `first` false,
+    /// and `changed` false when only its X and Y differ from the hole
+    /// before; anything else written ends the series with `cycle_off`
+    /// (`G80`).
     pub fn hole(&mut self, hole: &Hole) -> Result<bool, NcError> {
         let Some(words) = &self.cycle else {
             return Ok(false);
