@@ -103,12 +103,25 @@ pub fn fit(
     let top_exact = bottom.exact[z] + cycle.depth_mm;
     let mut row = bottom.exact.to_vec();
     let mut out = vec![0.0; row.len()];
-    let mut z_at = |h: f64| {
-        row[z] = top_exact + h;
+    let mut as_z = |v: f64| {
+        row[z] = v;
         round(&row, &mut out);
         out[z]
     };
-    let (top, r, retract) = (z_at(0.0), z_at(cycle.feed_start_mm), z_at(cycle.retract_mm));
+    let (top, r, retract) = (
+        as_z(top_exact),
+        as_z(top_exact + cycle.feed_start_mm),
+        as_z(top_exact + cycle.retract_mm),
+    );
+    // The peck as the cycle's Q writes it: a peck the word rounds is not the
+    // one checked, and the moves below then differ. A peck shorter than the
+    // re-approach clearance (or the chip break's back-off) sends LinuxCNC's
+    // G83 and G73 above R on the way back down (rs274ngc does not stop at
+    // R there, as the expansion does): such a hole is written as moves.
+    let peck = as_z(peck);
+    if matches!(kind, HoleKind::Peck | HoleKind::ChipBreak) && peck < PECK_CLEARANCE_MM {
+        return None;
+    }
     let (hx, hy, bz) = (bottom.written[x], bottom.written[y], bottom.written[z]);
     // Below the feed start, the tool first rises to it, in a block of its
     // own.

@@ -139,3 +139,25 @@ fn tilted_holes_on_a_trunnion_are_cycles_in_machine_z() {
     let holes = same_moves(&rs274, cl.as_bytes(), "tilted.cls", &machine);
     assert_eq!(holes, 2);
 }
+
+/// A peck the program's Q word would round (0.55555 mm at LinuxCNC's four
+/// decimals) is not the peck checked, and one shorter than G83's 0.254 mm
+/// re-approach makes rs274 rapid above R: those holes stay moves; a peck
+/// the word holds is a cycle.
+#[test]
+fn a_peck_the_word_rounds_stays_moves() {
+    let Some(rs274) = rs274() else {
+        return;
+    };
+    let cl = |peck: &str| {
+        format!(
+            "FEDRAT/MMPM,500\nRAPID\nGOTO/0,0,20,0,0,1\n\
+             CYCLE/DEEP,FEDTO,1,RAPTO,1,STEP,{peck},MMPM,100\nGOTO/5,0,0\nCYCLE/OFF\n"
+        )
+    };
+    let free3 = test_machine("free3");
+    for (peck, holes) in [("0.55555", 0), ("0.2", 0), ("0.5555", 1)] {
+        let got = same_moves(&rs274, cl(peck).as_bytes(), "peck.cls", &free3);
+        assert_eq!(got, holes, "peck {peck}");
+    }
+}
