@@ -220,4 +220,6 @@ pub struct Hole {
     pub feed: f64,
     /// Spindle speed in force, rpm (0: unknown or off).
     pub rpm: f64,
+    /// The spindle turns counter-clockwise (a left-hand tap).
+    pub ccw: bool,
 }

@@ -954,7 +954,8 @@ impl<W: Write> NcWriter<W> {
     /// template (see docs/dialects.md, "Canned cycles"); `Ok(false)`, with
     /// nothing written, when the dialect cannot write it as a cycle: no
     /// `[cycle]` or not this kind, inverse-time feed on (a cycle's F is per
-    /// minute), a tap with no spindle speed, a dwell the kind's cycle cannot
+    /// minute), a tap with no spindle speed or a left-hand one (spindle
+    /// counter-clockwise), a dwell the kind's cycle cannot
     /// make (`[cycle] dwell`), the tool below the feed start or the bottom
     /// not below it, a retract below the feed start, or, for a dialect
     /// whose cycles return to the feed start or the initial level only
@@ -983,8 +984,9 @@ impl<W: Write> NcWriter<W> {
             || (hole.dwell > 0.0 && !words.dwell.contains(&hole.kind))
             || !(hole.bottom < hole.r && hole.r <= hole.start_z && hole.r <= hole.retract)
             || hole.feed <= 0.0
-            // (A tap's pitch is its feed over the speed.)
-            || (hole.kind == crate::HoleKind::Tap && hole.rpm <= 0.0)
+            // (A tap's pitch is its feed over the speed; the cycles written
+            // tap right-hand threads.)
+            || (hole.kind == crate::HoleKind::Tap && (hole.rpm <= 0.0 || hole.ccw))
         {
             return Ok(false);
         }

@@ -303,6 +303,7 @@ pub struct Check<S> {
 struct GatheredHole {
     cycle: Box<crate::cycle::HoleCycle>,
     rpm: Option<f64>,
+    ccw: bool,
     /// The values written before the hole.
     start: Joints,
     items: Vec<HeldItem>,
@@ -494,7 +495,8 @@ impl<S: BlockSink> Check<S> {
             return Ok(());
         };
         let mut items = g.items.into_iter();
-        if let Some((prefix, hole)) = self.native_hole(&g.cycle, g.rpm, &g.start, items.as_slice())
+        if let Some((prefix, hole)) =
+            self.native_hole(&g.cycle, (g.rpm, g.ccw), &g.start, items.as_slice())
         {
             for item in items.by_ref().take(prefix) {
                 self.release(item, at)?;
@@ -520,7 +522,7 @@ impl<S: BlockSink> Check<S> {
     fn native_hole(
         &mut self,
         cycle: &crate::cycle::HoleCycle,
-        rpm: Option<f64>,
+        spindle: (Option<f64>, bool),
         start: &Joints,
         items: &[HeldItem],
     ) -> Option<(usize, kinpost_nc::Hole)> {
@@ -543,7 +545,7 @@ impl<S: BlockSink> Check<S> {
             }
         }
         let sink = &mut self.sink;
-        native_cycle::fit(cycle, axes, &start[..n], &blocks, rpm, |v, w| {
+        native_cycle::fit(cycle, axes, &start[..n], &blocks, spindle, |v, w| {
             sink.round(v, w)
         })
     }
@@ -738,13 +740,14 @@ impl<S: BlockSink> MotionSink for Check<S> {
                 Ok(())
             }
             Command::ArcEnd => self.end_arc(&pending.at),
-            Command::HoleBegin { cycle, rpm } => {
+            Command::HoleBegin { cycle, rpm, ccw } => {
                 self.end_arc(&pending.at)?;
                 self.end_hole(&pending.at)?;
                 if self.cycle_axes.is_some() && self.started {
                     self.hole = Some(Box::new(GatheredHole {
                         cycle,
                         rpm,
+                        ccw,
                         start: self.written,
                         items: Vec::new(),
                     }));

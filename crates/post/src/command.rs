@@ -54,6 +54,8 @@ pub enum Command {
         cycle: Box<crate::cycle::HoleCycle>,
         /// The spindle speed in force, rpm.
         rpm: Option<f64>,
+        /// The spindle turns counter-clockwise.
+        ccw: bool,
     },
     /// The end of the blocks of a [`Command::HoleBegin`].
     HoleEnd,

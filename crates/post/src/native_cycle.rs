@@ -68,13 +68,14 @@ pub fn kind_of(cycle: &HoleCycle) -> Option<(HoleKind, f64)> {
 /// which the controls do in different ways), if the blocks are exactly the
 /// cycle's moves (see the module's documentation). `start`: the values
 /// written before the hole; `round`: the writer's rounding of a row of
-/// values; `rpm`: the spindle speed in force.
+/// values; `spindle`: the spindle speed in force and whether it turns
+/// counter-clockwise.
 pub fn fit(
     cycle: &HoleCycle,
     axes: &ProgramAxes,
     start: &[f64],
     blocks: &[HoleBlock<'_>],
-    rpm: Option<f64>,
+    (rpm, ccw): (Option<f64>, bool),
     mut round: impl FnMut(&[f64], &mut [f64]),
 ) -> Option<(usize, Hole)> {
     let (kind, peck) = kind_of(cycle)?;
@@ -194,6 +195,7 @@ pub fn fit(
             dwell: cycle.dwell_s,
             feed,
             rpm: rpm.unwrap_or(0.0),
+            ccw,
         },
     ))
 }

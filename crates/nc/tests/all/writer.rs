@@ -1128,6 +1128,7 @@ fn every_template_gets_the_variables_the_loader_accepts() {
         dwell: 0.0,
         feed: 100.0,
         rpm: 1000.0,
+        ccw: false,
     };
     assert!(w.hole(&hole).unwrap());
     pressure_block(&mut w, 1.0, 3000.0);
@@ -1448,4 +1449,31 @@ fn heidenhain_compensation_is_rl_or_rr_on_the_blocks() {
     assert_eq!(words, ["R0", "RL", "RL", "RR", "R0"], "{out}");
     let read = kinpost_nc::read_program(&dialect, &axes, "h.h", &out).unwrap();
     assert_eq!(read.len(), 5, "{out}");
+}
+
+/// A left-hand tap (the spindle counter-clockwise) is not written as the
+/// right-hand G84; a right-hand one is.
+#[test]
+fn a_left_hand_tap_is_not_a_g84() {
+    let dialect = Dialect::builtin("fanuc").unwrap();
+    let axes = mts_axes();
+    let mut w = NcWriter::new(&dialect, &axes, Vec::new());
+    let tap = kinpost_nc::Hole {
+        kind: kinpost_nc::HoleKind::Tap,
+        x: 1.0,
+        y: 2.0,
+        top: 0.0,
+        r: 2.0,
+        bottom: -5.0,
+        retract: 2.0,
+        start_z: 10.0,
+        peck: 0.0,
+        dwell: 0.0,
+        feed: 500.0,
+        rpm: 400.0,
+        ccw: true,
+    };
+    assert!(!w.hole(&tap).unwrap());
+    assert!(w.hole(&kinpost_nc::Hole { ccw: false, ..tap }).unwrap());
+    assert!(text(w).contains("G84"));
 }

@@ -310,6 +310,7 @@ impl Program<'_> {
             let begin = Command::HoleBegin {
                 cycle: Box::new(cycle.hole.clone()),
                 rpm: self.rpm,
+                ccw: self.spindle_ccw,
             };
             self.command(begin, reader, sink)?;
         }
