@@ -925,15 +925,8 @@ impl<W: Write> NcWriter<W> {
         match on {
             None => self.required_command(TemplateKind::CutcomOff, Vec::new()),
             Some((left, register)) => {
-                // The templates compensate in the XY plane of the header:
-                // select it again after an arc in another plane.
-                if let Some(a) = self.arc.as_mut()
-                    && a.plane.is_some_and(|p| p != crate::ArcPlane::Xy)
-                {
-                    a.plane = Some(crate::ArcPlane::Xy);
-                    let word = String::from_utf8_lossy(&a.planes[0]).into_owned();
-                    self.insert(&word)?;
-                }
+                // The templates compensate in the XY plane of the header.
+                self.select_xy_plane()?;
                 self.required_command(
                     TemplateKind::CutcomOn,
                     vec![
@@ -943,6 +936,19 @@ impl<W: Write> NcWriter<W> {
                 )
             }
         }
+    }
+
+    /// The XY plane (`G17`) again after an arc in another plane, for what
+    /// works in the header's plane (compensation, drilling cycles).
+    fn select_xy_plane(&mut self) -> Result<(), NcError> {
+        if let Some(a) = self.arc.as_mut()
+            && a.plane.is_some_and(|p| p != crate::ArcPlane::Xy)
+        {
+            a.plane = Some(crate::ArcPlane::Xy);
+            let word = String::from_utf8_lossy(&a.planes[0]).into_owned();
+            self.insert(&word)?;
+        }
+        Ok(())
     }
 
     /// Whether the dialect writes canned cycles (`[cycle]`).
@@ -1003,15 +1009,8 @@ impl<W: Write> NcWriter<W> {
         if !continues {
             self.end_cycle_series()?;
         }
-        // The cycles drill along Z of the XY plane: select it again after
-        // an arc in another plane.
-        if let Some(a) = self.arc.as_mut()
-            && a.plane.is_some_and(|p| p != crate::ArcPlane::Xy)
-        {
-            a.plane = Some(crate::ArcPlane::Xy);
-            let word = String::from_utf8_lossy(&a.planes[0]).into_owned();
-            self.insert(&word)?;
-        }
+        // The cycles drill along Z of the XY plane.
+        self.select_xy_plane()?;
         let changed = self.series.is_none_or(|s| {
             let last = s.last;
             (last.kind, last.top, last.r, last.bottom, last.retract)

@@ -306,6 +306,9 @@ impl HoleCycle {
                 let mut done = r;
                 let mut peck = first_mm;
                 loop {
+                    // (Not above R: rs274ngc's G83 would go there for a
+                    // peck under the clearance; such holes are never
+                    // written as G83, see `native_cycle`.)
                     if done < r {
                         steps.rapid(at((done + PECK_CLEARANCE_MM).min(r)));
                     }
