@@ -82,12 +82,30 @@ pub struct SimArgs {
     /// the stock's size).
     #[arg(long, value_name = "MM", requires = "stock")]
     resolution: Option<f64>,
-    /// The design (closed STL, part frame): the simulated part is compared
-    /// with it along the rays, gouges (material removed below it: exit code
-    /// 3) and residuals (material left above it) beyond --difftol, with
-    /// the blocks that made them.
-    #[arg(long, value_name = "FILE.stl", requires = "stock")]
+    /// The design, in the part frame: a closed STL of the part, or one of
+    /// its surfaces as a surface file (`.json`, from `kinpost surface fit`;
+    /// `kinpost surface place` moves it where `kinpost path` placed its
+    /// CL). The simulated part is compared with it along the rays, gouges
+    /// (material removed below it: exit code 3) and residuals (material
+    /// left above it) beyond --difftol, with the blocks that made them.
+    #[arg(long, value_name = "FILE.stl|FILE.json", requires = "stock")]
     design: Option<PathBuf>,
+    /// The outside of a design surface: `+` the side of its normal
+    /// S_u × S_v, `-` the other (as `kinpost path --side`).
+    #[arg(
+        long,
+        value_enum,
+        default_value = "+",
+        allow_hyphen_values = true,
+        requires = "design"
+    )]
+    design_side: DesignSide,
+    /// The part of a design surface that is compared (and that
+    /// `design+ALLOWANCE` grows into the stock): U0,U1,V0,V1 as fractions
+    /// of the parameter domain, as `kinpost path --region` takes the
+    /// region it grinds (default: the whole surface).
+    #[arg(long, value_name = "U0,U1,V0,V1", requires = "design")]
+    design_region: Option<String>,
     /// Comparison tolerance, mm.
     #[arg(long, value_name = "MM", default_value_t = 0.01, requires = "design")]
     difftol: f64,
@@ -210,6 +228,17 @@ pub fn sim(args: &SimArgs) -> Result<()> {
     Ok(())
 }
 
+/// The outside of a design surface (`--design-side`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DesignSide {
+    /// The side of the surface normal S_u × S_v.
+    #[value(name = "+")]
+    Plus,
+    /// The side away from it.
+    #[value(name = "-")]
+    Minus,
+}
+
 /// Material removal as the options ask for it: the stock and tool, and the
 /// design to compare with.
 struct RemovalSetup {
@@ -252,14 +281,24 @@ impl RemovalSetup {
                 Some(crate::sim_stock::read_process(p)?)
             }
         };
-        let mesh = args
+        // Triangles of a design surface stay a tenth of the tolerance (and
+        // of the ray spacing) from it, so the tessellation is not measured.
+        let chord = (args.difftol / 10.0).min(args.resolution.unwrap_or(f64::INFINITY) / 10.0);
+        let source = args
             .design
             .as_deref()
-            .map(crate::sim_stock::read_mesh)
+            .map(|p| {
+                crate::sim_stock::DesignSource::load(
+                    p,
+                    args.design_side,
+                    args.design_region.as_deref(),
+                    chord,
+                )
+            })
             .transpose()?;
         let (stock, description) =
-            crate::sim_stock::load_stock(stock, args.resolution, mesh.as_ref())?;
-        let design = mesh.map(crate::sim_stock::design).transpose()?;
+            crate::sim_stock::load_stock(stock, args.resolution, source.as_ref())?;
+        let design = source.as_ref().map(|s| s.design()).transpose()?;
         let mut cutting = Cutting::new(stock, tool);
         if let Some(model) = process {
             cutting = cutting.with_process(model);

@@ -28,6 +28,10 @@ pub enum SurfaceCommand {
     /// Draw a surface as SVG (shaded, optionally coloured by curvature),
     /// with its data points.
     Plot(PlotArgs),
+    /// Move a surface rigidly into the part frame (the placement `kinpost
+    /// path` gives its CL with the same --rotate and --translate), e.g. to
+    /// compare a simulated part with it (`kinpost sim --design`).
+    Place(PlaceArgs),
 }
 
 #[derive(clap::Args)]
@@ -93,6 +97,22 @@ pub struct EvalArgs {
     /// Output CSV file, or - for standard output (the default).
     #[arg(short = 'o', long = "output-file", value_name = "FILE")]
     output_file: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct PlaceArgs {
+    /// Surface file (JSON).
+    surface: PathBuf,
+    /// Rotate about a part axis through the origin, `x:DEG`, `y:DEG` or
+    /// `z:DEG`; repeatable, applied in order, before --translate.
+    #[arg(long, value_name = "AXIS:DEG", allow_hyphen_values = true)]
+    rotate: Vec<String>,
+    /// Translate by X,Y,Z mm (after the rotations).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    translate: Option<String>,
+    /// Output surface file (JSON), or - for standard output.
+    #[arg(short = 'o', long = "output-file", value_name = "FILE")]
+    output_file: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -245,7 +265,21 @@ pub fn surface(command: SurfaceCommand) -> Result<()> {
         SurfaceCommand::Fit(a) => fit(a),
         SurfaceCommand::Eval(a) => eval(a),
         SurfaceCommand::Plot(a) => plot(a),
+        SurfaceCommand::Place(a) => place(a),
     }
+}
+
+fn place(args: PlaceArgs) -> Result<()> {
+    let mut sinks = open_outputs(
+        &[("surface file", args.surface.as_path())],
+        &[("-o", args.output_file.as_path())],
+    )?;
+    let placement = placement(&args.rotate, args.translate.as_deref())?;
+    let surface = load_surface(&args.surface)?.transformed(&placement);
+    sinks[0]
+        .write_all(to_json(&surface).as_bytes())
+        .with_context(|| format!("cannot write {}", args.output_file.display()))?;
+    deliver(sinks)
 }
 
 fn fit(args: FitArgs) -> Result<()> {

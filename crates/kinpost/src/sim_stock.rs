@@ -5,6 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use kinpost_stock::{Design, Mesh, Stock, Tool, default_resolution};
+use kinpost_surface::Surface;
 use nalgebra::Point3;
 
 use crate::usage;
@@ -110,7 +111,7 @@ pub fn parse_tool(spec: &str) -> Result<Tool> {
 pub fn load_stock(
     spec: &str,
     resolution: Option<f64>,
-    design: Option<&Mesh>,
+    design: Option<&DesignSource>,
 ) -> Result<(Stock, String)> {
     let bad = |why: String| usage(format!("--stock {spec}: {why}"));
     let res =
@@ -129,18 +130,51 @@ pub fn load_stock(
         return Ok((stock, format!("box:{x0},{y0},{z0},{x1},{y1},{z1}")));
     }
     if let Some(rest) = spec.strip_prefix("design+") {
-        let allowance: f64 = rest
-            .trim()
-            .parse()
-            .map_err(|_| bad("expected design+ALLOWANCE in mm (design+0.2)".into()))?;
-        let mesh = design.ok_or_else(|| bad("needs --design FILE.stl".into()))?;
-        let (lo, hi) = mesh
-            .bounds()
-            .ok_or_else(|| bad("the design has no triangles".into()))?;
-        let grow = nalgebra::Vector3::repeat(allowance.max(0.0));
-        let stock = Stock::from_mesh_offset(mesh, allowance, res(lo - grow, hi + grow))
-            .map_err(|e| bad(e.to_string()))?;
-        return Ok((stock, format!("design+{allowance}")));
+        let values: Vec<f64> = rest
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad("expected design+ALLOWANCE[,DEPTH] in mm (design+0.2)".into()))?;
+        let allowance = values[0];
+        let design = design.ok_or_else(|| bad("needs --design".into()))?;
+        return match (design, &values[1..]) {
+            (DesignSource::Mesh(mesh), []) => {
+                let (lo, hi) = mesh
+                    .bounds()
+                    .ok_or_else(|| bad("the design has no triangles".into()))?;
+                let grow = nalgebra::Vector3::repeat(allowance.max(0.0));
+                let stock = Stock::from_mesh_offset(mesh, allowance, res(lo - grow, hi + grow))
+                    .map_err(|e| bad(e.to_string()))?;
+                Ok((stock, format!("design+{allowance}")))
+            }
+            (DesignSource::Mesh(_), _) => Err(bad(
+                "DEPTH is for a design surface (JSON); an STL design is a solid".into(),
+            )),
+            (
+                DesignSource::Surface {
+                    surface,
+                    region,
+                    flip,
+                    chord_mm,
+                },
+                rest,
+            ) => {
+                let depth = match rest {
+                    [] => OPEN_STOCK_DEPTH_MM,
+                    [d] => *d,
+                    _ => return Err(bad("expected design+ALLOWANCE[,DEPTH]".into())),
+                };
+                let shell =
+                    Design::shell_of_surface(surface, *region, *chord_mm, *flip, allowance, depth)
+                        .map_err(|e| bad(e.to_string()))?;
+                let name = if rest.is_empty() {
+                    format!("design+{allowance}")
+                } else {
+                    format!("design+{allowance},{depth}")
+                };
+                stock_of_shell(&shell, res, bad, name)
+            }
+        };
     }
     let mesh = read_mesh(Path::new(spec))?;
     let (lo, hi) = mesh
@@ -175,7 +209,102 @@ pub fn read_process(path: &Path) -> Result<kinpost_stock::ProcessModel> {
         .map_err(crate::report)
 }
 
-/// The design of `--design` as the comparison measures it.
-pub fn design(mesh: Mesh) -> Result<Design> {
-    Ok(Design::from_mesh(mesh)?)
+/// How deep under an open design surface its stock `design+ALLOWANCE`
+/// reaches, mm, when the spec gives no DEPTH: deeper than any grinding or
+/// finishing pass gouges, so a gouge is measured, not cut through.
+pub const OPEN_STOCK_DEPTH_MM: f64 = 2.0;
+
+/// The design of `--design`: a closed STL, or a surface file (JSON) of
+/// which `region` is compared, its material on the side away from its
+/// normal S_u × S_v (`flip`: towards it).
+pub enum DesignSource {
+    /// A closed mesh (STL) of the part.
+    Mesh(Mesh),
+    /// One surface of the part.
+    Surface {
+        /// The surface, in the part frame.
+        surface: Box<Surface>,
+        /// The parameter rectangle compared, `[u0, u1, v0, v1]`.
+        region: [f64; 4],
+        /// The material lies on the side of S_u × S_v.
+        flip: bool,
+        /// Chord tolerance of its triangles, mm.
+        chord_mm: f64,
+    },
+}
+
+impl DesignSource {
+    /// From `--design FILE` (a `.json` file is a surface), `--design-side`
+    /// and `--design-region`; `chord_mm` the tessellation's chord.
+    pub fn load(
+        path: &Path,
+        side: crate::cmd_sim::DesignSide,
+        region: Option<&str>,
+        chord_mm: f64,
+    ) -> Result<DesignSource> {
+        let is_surface = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        if !is_surface {
+            if region.is_some() {
+                return Err(usage(
+                    "--design-region is for a design surface (JSON); an STL is compared whole",
+                ));
+            }
+            return Ok(DesignSource::Mesh(read_mesh(path)?));
+        }
+        let surface = crate::cmd_surface::load_surface(path)?;
+        let (u0, u1) = surface.u_range();
+        let (v0, v1) = surface.v_range();
+        let region = match region {
+            None => [u0, u1, v0, v1],
+            Some(r) => {
+                let v: Vec<f64> = r
+                    .split(',')
+                    .map(|v| v.trim().parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|_| usage(format!("--design-region {r}: expected U0,U1,V0,V1")))?;
+                let [a, b, c, d] = v[..] else {
+                    return Err(usage(format!(
+                        "--design-region {r}: expected four numbers U0,U1,V0,V1"
+                    )));
+                };
+                let (du, dv) = (u1 - u0, v1 - v0);
+                [u0 + a * du, u0 + b * du, v0 + c * dv, v0 + d * dv]
+            }
+        };
+        Ok(DesignSource::Surface {
+            surface: Box::new(surface),
+            region,
+            flip: matches!(side, crate::cmd_sim::DesignSide::Minus),
+            chord_mm,
+        })
+    }
+
+    /// The design as the comparison measures it.
+    pub fn design(&self) -> Result<Design> {
+        Ok(match self {
+            DesignSource::Mesh(mesh) => Design::from_mesh(mesh.clone())?,
+            DesignSource::Surface {
+                surface,
+                region,
+                flip,
+                chord_mm,
+            } => Design::from_surface_region(surface, *region, *chord_mm, *flip)?,
+        })
+    }
+}
+
+/// A stock from a closed shell mesh.
+fn stock_of_shell(
+    shell: &Mesh,
+    res: impl Fn(Point3<f64>, Point3<f64>) -> f64,
+    bad: impl Fn(String) -> anyhow::Error,
+    name: String,
+) -> Result<(Stock, String)> {
+    let (lo, hi) = shell
+        .bounds()
+        .ok_or_else(|| bad("the design has no triangles".into()))?;
+    let stock = Stock::from_mesh(shell, res(lo, hi)).map_err(|e| bad(e.to_string()))?;
+    Ok((stock, name))
 }

@@ -318,6 +318,9 @@ impl SimReport {
                     ", gouge {:.4} mm, residual {:.4} mm beyond {} mm",
                     d.gouge_max_mm, d.residual_max_mm, d.tolerance_mm
                 );
+                if let Some([lo, hi]) = d.deviation_range_mm {
+                    let _ = write!(s, " (deviation {lo:+.4} to {hi:+.4} mm)");
+                }
             }
             if let Some(g) = &r.grinding {
                 let _ = write!(

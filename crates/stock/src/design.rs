@@ -35,7 +35,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::dexel::{Segment, UNCUT};
-use crate::mesh::{Crossing, Mesh, bin_rows, row_crossings};
+use crate::mesh::{Crossing, Mesh, RayGrid, bin_rows, row_crossings};
 use crate::stock::Stock;
 
 /// The part as designed.
@@ -57,6 +57,11 @@ pub enum DesignError {
     /// The surface is degenerate where it is tessellated.
     #[error("the design surface cannot be tessellated: {0}")]
     Surface(&'static str),
+    /// The parameter region is empty or leaves the surface's domain.
+    #[error(
+        "the parameter region {0:?} (U0, U1, V0, V1) must have U0 < U1 and V0 < V1 inside the surface's domain"
+    )]
+    Region([f64; 4]),
 }
 
 impl Design {
@@ -86,22 +91,149 @@ impl Design {
     }
 
     /// An open design surface: a B-spline surface tessellated into a grid of
+    /// triangles whose chords stay within `chord_mm` of the surface (see
+    /// [`Design::from_surface_region`]), over its whole parameter domain.
+    pub fn from_surface(
+        surface: &Surface,
+        chord_mm: f64,
+        flip: bool,
+    ) -> Result<Design, DesignError> {
+        let (u0, u1) = surface.u_range();
+        let (v0, v1) = surface.v_range();
+        Design::from_surface_region(surface, [u0, u1, v0, v1], chord_mm, flip)
+    }
+
+    /// An open design surface over the parameter rectangle
+    /// `[u0, u1, v0, v1]` (the part of a surface a path grinds): a grid of
     /// triangles whose chords stay within `chord_mm` of the surface: the
     /// step √(8·chord/κ), κ the largest principal curvature found on a
     /// 33 × 33 grid of parameters, over the longest parameter line of that
     /// grid (its polygon length), with 8 to 2000 steps per direction. The
     /// surface's normal (S_u × S_v) points out of the material; `flip` turns
     /// it over. Pass a chord a tenth of the comparison tolerance or less.
-    pub fn from_surface(
+    pub fn from_surface_region(
         surface: &Surface,
+        region: [f64; 4],
         chord_mm: f64,
         flip: bool,
     ) -> Result<Design, DesignError> {
+        let grid = SurfaceGrid::new(surface, region, chord_mm)?;
+        let (nu, nv) = (grid.nu, grid.nv);
+        let vertices = grid.points.clone();
+        let mut triangles = Vec::with_capacity(2 * (nu - 1) * (nv - 1));
+        grid.cells(0, flip, &mut triangles);
+        Ok(Design {
+            mesh: Mesh {
+                vertices,
+                triangles,
+            },
+            closed: false,
+        })
+    }
+
+    /// The closed shell of an open design surface over `region`: from
+    /// `above_mm` outside the surface (along its outward normal, turned over
+    /// by `flip`) to `below_mm` inside it, closed by walls along the
+    /// region's edges: the stock `design+ALLOWANCE` of a part known by one
+    /// surface (a blade side), whose material further in is never reached.
+    /// The offsets are exact at the grid points (the chord error of
+    /// [`Design::from_surface_region`] between them); they must stay below
+    /// the surface's smallest radius of curvature or the shell folds.
+    pub fn shell_of_surface(
+        surface: &Surface,
+        region: [f64; 4],
+        chord_mm: f64,
+        flip: bool,
+        above_mm: f64,
+        below_mm: f64,
+    ) -> Result<Mesh, DesignError> {
+        for t in [above_mm, below_mm] {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(DesignError::Surface(
+                    "the shell's offsets must be finite numbers of mm, 0 or more",
+                ));
+            }
+        }
+        if above_mm + below_mm <= 0.0 {
+            return Err(DesignError::Surface("the shell has no thickness"));
+        }
+        let grid = SurfaceGrid::new(surface, region, chord_mm)?;
+        let (nu, nv) = (grid.nu, grid.nv);
+        let n = nu * nv;
+        let sign = if flip { -1.0 } else { 1.0 };
+        let mut vertices = Vec::with_capacity(2 * n);
+        for (p, nrm) in grid.points.iter().zip(&grid.normals) {
+            vertices.push(p + nrm * (sign * above_mm));
+        }
+        for (p, nrm) in grid.points.iter().zip(&grid.normals) {
+            vertices.push(p - nrm * (sign * below_mm));
+        }
+        let mut triangles = Vec::with_capacity(4 * n);
+        // Outer sheet facing out, inner sheet facing in.
+        grid.cells(0, flip, &mut triangles);
+        grid.cells(n as u32, !flip, &mut triangles);
+        // Walls: each boundary edge (a, b) of the outer sheet, walked with the
+        // sheet on its left seen from outside, joined to its inner copy.
+        let id = |i: usize, j: usize| (i * nv + j) as u32;
+        let mut boundary = Vec::with_capacity(2 * (nu + nv));
+        for i in 0..nu - 1 {
+            boundary.push((id(i + 1, 0), id(i, 0)));
+            boundary.push((id(i, nv - 1), id(i + 1, nv - 1)));
+        }
+        for j in 0..nv - 1 {
+            boundary.push((id(0, j), id(0, j + 1)));
+            boundary.push((id(nu - 1, j + 1), id(nu - 1, j)));
+        }
+        let m = n as u32;
+        for (a, b) in boundary {
+            let (a, b) = if flip { (b, a) } else { (a, b) };
+            triangles.push([a, b, b + m]);
+            triangles.push([a, b + m, a + m]);
+        }
+        if !vertices.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+            return Err(DesignError::Surface("its points are not finite"));
+        }
+        Ok(Mesh {
+            vertices,
+            triangles,
+        })
+    }
+
+    /// The design's triangles.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// Whether the design bounds a solid (an STL) rather than being one
+    /// open surface.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+}
+
+/// A surface sampled on a grid fine enough for a chord tolerance, with its
+/// unit normals (S_u × S_v).
+struct SurfaceGrid {
+    nu: usize,
+    nv: usize,
+    points: Vec<Point3<f64>>,
+    normals: Vec<nalgebra::Vector3<f64>>,
+}
+
+impl SurfaceGrid {
+    fn new(surface: &Surface, region: [f64; 4], chord_mm: f64) -> Result<SurfaceGrid, DesignError> {
         if !(chord_mm.is_finite() && chord_mm > 0.0) {
             return Err(DesignError::Tolerance(chord_mm));
         }
-        let (u0, u1) = surface.u_range();
-        let (v0, v1) = surface.v_range();
+        let [u0, u1, v0, v1] = region;
+        let (du0, du1) = surface.u_range();
+        let (dv0, dv1) = surface.v_range();
+        let inside = |a: f64, b: f64, lo: f64, hi: f64| {
+            a.is_finite() && b.is_finite() && lo <= a && a < b && b <= hi
+        };
+        if !(inside(u0, u1, du0, du1) && inside(v0, v1, dv0, dv1)) {
+            return Err(DesignError::Region(region));
+        }
         let coarse = 33;
         let at = |i: usize, n: usize, a: f64, b: f64| a + (b - a) * i as f64 / (n - 1) as f64;
         let mut kappa: f64 = 0.0;
@@ -135,49 +267,43 @@ impl Design {
         };
         let count = |len: f64| ((len / step).ceil() as usize).clamp(8, 2000) + 1;
         let (nu, nv) = (count(len_u), count(len_v));
-        let mut vertices = Vec::with_capacity(nu * nv);
+        let mut points = Vec::with_capacity(nu * nv);
+        let mut normals = Vec::with_capacity(nu * nv);
         for i in 0..nu {
             for j in 0..nv {
-                let p = surface.point(at(i, nu, u0, u1), at(j, nv, v0, v1));
-                vertices.push(Point3::from(p));
+                let d = surface.derivatives(at(i, nu, u0, u1), at(j, nv, v0, v1));
+                points.push(Point3::from(d.point));
+                normals.push(d.du.cross(&d.dv).try_normalize(0.0).unwrap_or_default());
             }
         }
-        let mut triangles = Vec::with_capacity(2 * (nu - 1) * (nv - 1));
-        let id = |i: usize, j: usize| (i * nv + j) as u32;
-        for i in 0..nu - 1 {
-            for j in 0..nv - 1 {
-                // Counter-clockwise about S_u × S_v.
-                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                if flip {
-                    triangles.push([a, c, b]);
-                    triangles.push([a, d, c]);
-                } else {
-                    triangles.push([a, b, c]);
-                    triangles.push([a, c, d]);
-                }
-            }
-        }
-        if !vertices.iter().all(|p| p.iter().all(|c| c.is_finite())) {
+        if !points.iter().all(|p| p.iter().all(|c| c.is_finite())) {
             return Err(DesignError::Surface("its points are not finite"));
         }
-        Ok(Design {
-            mesh: Mesh {
-                vertices,
-                triangles,
-            },
-            closed: false,
+        Ok(SurfaceGrid {
+            nu,
+            nv,
+            points,
+            normals,
         })
     }
 
-    /// The design's triangles.
-    pub fn mesh(&self) -> &Mesh {
-        &self.mesh
-    }
-
-    /// Whether the design bounds a solid (an STL) rather than being one
-    /// open surface.
-    pub fn is_closed(&self) -> bool {
-        self.closed
+    /// Two triangles a grid cell, vertex ids from `offset`, counter-clockwise
+    /// about S_u × S_v (clockwise with `flip`).
+    fn cells(&self, offset: u32, flip: bool, out: &mut Vec<[u32; 3]>) {
+        let nv = self.nv;
+        let id = |i: usize, j: usize| offset + (i * nv + j) as u32;
+        for i in 0..self.nu - 1 {
+            for j in 0..nv - 1 {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                if flip {
+                    out.push([a, c, b]);
+                    out.push([a, d, c]);
+                } else {
+                    out.push([a, b, c]);
+                    out.push([a, c, d]);
+                }
+            }
+        }
     }
 }
 
@@ -247,6 +373,12 @@ pub struct Comparison {
     pub residual_regions: Vec<Region>,
     /// Histogram: bars at ±1, 2, 4, 8 tolerances.
     pub histogram: Vec<Bin>,
+    /// The most negative and the most positive deviation measured, within
+    /// the tolerance or not, mm (`None` when nothing was measured).
+    pub deviation_range_mm: Option<[f64; 2]>,
+    /// Every measured deviation, seen along X, Y and Z (one map a ray
+    /// family), for the deviation picture.
+    pub maps: Vec<DeviationMap>,
     /// Material missing inside a closed design (Z rays), mm³.
     pub gouge_volume_mm3: f64,
     /// Material outside a closed design (Z rays), mm³.
@@ -271,16 +403,89 @@ impl Comparison {
     }
 }
 
+/// The deviations measured on one ray family, seen along its rays: a grid
+/// of at most [`DeviationMap::MAX_CELLS`] cells a side over the rays'
+/// cross-section, each holding the deviation of largest magnitude measured
+/// on its rays.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DeviationMap {
+    /// The rays' axis (0 = X, 1 = Y, 2 = Z): the direction of view.
+    pub axis: usize,
+    /// The axes across, to the right and up.
+    pub across: [usize; 2],
+    /// The part coordinates of the grid's low corner on those axes, mm.
+    pub origin: [f64; 2],
+    /// Cell size, mm.
+    pub cell_mm: f64,
+    /// Cells to the right and up.
+    pub size: [usize; 2],
+    /// Row-major from the low corner; `None`: nothing measured there.
+    pub cells: Vec<Option<f32>>,
+    /// Rays with a measured deviation.
+    pub measured_rays: u64,
+}
+
+impl DeviationMap {
+    /// Largest number of cells a side (a picture of 300 × 300 squares).
+    pub const MAX_CELLS: usize = 300;
+
+    fn of_rows(g: &RayGrid, rows: &[RowResult]) -> DeviationMap {
+        let per = g.nu.max(g.nv).div_ceil(Self::MAX_CELLS).max(1);
+        let size = [g.nu.div_ceil(per), g.nv.div_ceil(per)];
+        let mut cells: Vec<Option<f32>> = vec![None; size[0] * size[1]];
+        let mut measured_rays = 0;
+        for (iv, row) in rows.iter().enumerate() {
+            for (iu, &d) in row.rays.iter().enumerate() {
+                if d.is_nan() {
+                    continue;
+                }
+                measured_rays += 1;
+                let c = &mut cells[(iv / per) * size[0] + iu / per];
+                if c.is_none_or(|e| d.abs() > e.abs()) {
+                    *c = Some(d);
+                }
+            }
+        }
+        DeviationMap {
+            axis: g.k,
+            across: [g.u, g.v],
+            origin: [g.origin[g.u], g.origin[g.v]],
+            cell_mm: per as f64 * g.h,
+            size,
+            cells,
+            measured_rays,
+        }
+    }
+}
+
 /// Histogram edges in tolerances.
 const EDGES: [f64; 8] = [-8.0, -4.0, -2.0, -1.0, 1.0, 2.0, 4.0, 8.0];
 
-#[derive(Default)]
 struct RowResult {
     beyond: Vec<Sample>,
     measured: u64,
+    /// The largest-magnitude deviation measured on each ray of the row
+    /// (NaN: none), for the deviation map.
+    rays: Vec<f32>,
+    /// Smallest and largest deviation measured.
+    range: (f64, f64),
     bins: [(u64, f64); 9],
     gouge_len: f64,
     residual_len: f64,
+}
+
+impl Default for RowResult {
+    fn default() -> RowResult {
+        RowResult {
+            beyond: Vec::new(),
+            measured: 0,
+            rays: Vec::new(),
+            range: (f64::INFINITY, f64::NEG_INFINITY),
+            bins: Default::default(),
+            gouge_len: 0.0,
+            residual_len: 0.0,
+        }
+    }
 }
 
 fn bin_of(dev: f64, tol: f64) -> usize {
@@ -300,6 +505,7 @@ pub fn compare(
     }
     let h = stock.resolution_mm();
     let mut total = RowResult::default();
+    let mut maps = Vec::with_capacity(3);
     for k in 0..3 {
         let g = stock.ray_grid(k);
         let bins = bin_rows(&design.mesh, &g, 0.0);
@@ -309,7 +515,10 @@ pub fn compare(
             .enumerate()
             .map(|(iv, bin)| {
                 let crossings = row_crossings(&design.mesh, &g, bin, iv);
-                let mut out = RowResult::default();
+                let mut out = RowResult {
+                    rays: vec![f32::NAN; g.nu],
+                    ..RowResult::default()
+                };
                 for (iu, c) in crossings.iter().enumerate() {
                     let ray = fam.ray(iu, iv);
                     let at = |t: f64| {
@@ -329,9 +538,11 @@ pub fn compare(
                 out
             })
             .collect();
+        maps.push(DeviationMap::of_rows(&g, &rows));
         for r in rows {
             total.beyond.extend(r.beyond);
             total.measured += r.measured;
+            total.range = (total.range.0.min(r.range.0), total.range.1.max(r.range.1));
             for (t, b) in total.bins.iter_mut().zip(r.bins) {
                 t.0 += b.0;
                 t.1 += b.1;
@@ -364,6 +575,8 @@ pub fn compare(
         gouge_regions,
         residual_regions,
         histogram,
+        deviation_range_mm: (total.measured > 0).then_some([total.range.0, total.range.1]),
+        maps,
         gouge_volume_mm3: total.gouge_len * h * h,
         residual_volume_mm3: total.residual_len * h * h,
     })
@@ -400,6 +613,11 @@ fn measure_ray(
             }
         };
         out.measured += 1;
+        out.range = (out.range.0.min(dev), out.range.1.max(dev));
+        let seen = &mut out.rays[iu];
+        if seen.is_nan() || dev.abs() > f64::from(seen.abs()) {
+            *seen = dev as f32;
+        }
         let area = h * h / x.cosine;
         let b = bin_of(dev, tol);
         out.bins[b].0 += 1;

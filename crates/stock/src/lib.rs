@@ -103,9 +103,9 @@ pub mod tolerance;
 pub mod tool;
 
 pub use contour::{PartMesh, contour};
-pub use design::{Comparison, Design, DesignError, Region, Sample, compare};
+pub use design::{Comparison, Design, DesignError, DeviationMap, Region, Sample, compare};
 pub use mesh::{Mesh, MeshError};
-pub use output::{write_ply, write_stl, write_svg};
+pub use output::{map_colour, write_ply, write_stl, write_svg};
 pub use process::{
     Calibration, Conditions, Contact, GrindStats, ProcessError, ProcessModel, Trace, TraceFile,
     belt_speed_mm_s, calibrate,

@@ -138,29 +138,42 @@ pub fn write_ply<W: Write>(
     out.flush()
 }
 
-/// Writes an SVG map of the deviation seen from +Z: the stock's outline,
-/// every sample beyond tolerance at its XY position (the largest magnitude
-/// per display cell of at most 600 × 600), the deepest gouge and largest
+/// The colour of a deviation on the map: within the tolerance a scale from
+/// amber (−tol, cutting into the design) through green (on it) to teal
+/// (+tol, material left), so the pattern of a pass shows; beyond it the
+/// red and blue of [`deviation_colour`].
+pub fn map_colour(deviation_mm: f64, tolerance_mm: f64) -> [u8; 3] {
+    if deviation_mm.abs() > tolerance_mm {
+        return deviation_colour(deviation_mm, tolerance_mm);
+    }
+    let t = deviation_mm / tolerance_mm;
+    let (green, end) = (
+        [40.0, 170.0, 60.0],
+        if t < 0.0 {
+            [215.0, 175.0, 40.0]
+        } else {
+            [40.0, 150.0, 210.0]
+        },
+    );
+    let a = t.abs();
+    std::array::from_fn(|i| (green[i] + (end[i] - green[i]) * a).round() as u8)
+}
+
+const AXES: [&str; 3] = ["X", "Y", "Z"];
+
+/// Writes an SVG map of the deviation, seen along the ray family that
+/// measured most of the design (the axis closest to most of its normals):
+/// every measured deviation (the largest magnitude per cell of at most
+/// 300 × 300), coloured by [`map_colour`], the deepest gouge and largest
 /// residual marked with their moves, and a legend.
 pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Result<()> {
+    let map = cmp.maps.iter().max_by_key(|m| (m.measured_rays, m.axis));
+    let (axis, [a, b]) = map.map_or((2, [0, 1]), |m| (m.axis, m.across));
     let (lo, hi) = (stock.origin(), stock.max_corner());
-    let (sx, sy) = (hi.x - lo.x, hi.y - lo.y);
-    let cell = (sx.max(sy) / 600.0).max(stock.resolution_mm());
+    let (sx, sy) = (hi[a] - lo[a], hi[b] - lo[b]);
     let scale = 800.0 / sx.max(sy);
-    let (width, height) = (sx * scale + 40.0, sy * scale + 110.0);
-    let mut cells: HashMap<(i64, i64), f64> = HashMap::new();
-    for s in &cmp.beyond {
-        let key = (
-            ((s.part_point[0] - lo.x) / cell).floor() as i64,
-            ((s.part_point[1] - lo.y) / cell).floor() as i64,
-        );
-        let e = cells.entry(key).or_insert(0.0);
-        if s.deviation_mm.abs() > e.abs() {
-            *e = s.deviation_mm;
-        }
-    }
-    let mut keys: Vec<_> = cells.into_iter().collect();
-    keys.sort_by_key(|k| k.0);
+    let (width, height) = (sx * scale + 40.0, sy * scale + 140.0);
+    let t = cmp.tolerance_mm;
     let mut out = io::BufWriter::new(w);
     writeln!(
         out,
@@ -168,47 +181,75 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
     )?;
     writeln!(
         out,
-        r#"<title>Deviation from the design, seen from +Z (tolerance {} mm)</title>"#,
-        cmp.tolerance_mm
+        r#"<title>Deviation from the design, seen along {} ({} to the right, {} up; tolerance {} mm)</title>"#,
+        AXES[axis], AXES[a], AXES[b], cmp.tolerance_mm
     )?;
-    // Part frame X to the right, Y up.
-    let px = |x: f64| 20.0 + (x - lo.x) * scale;
-    let py = |y: f64| 20.0 + (hi.y - y) * scale;
+    let px = |x: f64| 20.0 + (x - lo[a]) * scale;
+    let py = |y: f64| 20.0 + (hi[b] - y) * scale;
     writeln!(
         out,
-        r##"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="#2aaa3c" fill-opacity="0.25" stroke="#333"/>"##,
-        px(lo.x),
-        py(hi.y),
+        r##"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="#f4f4f4" stroke="#333"/>"##,
+        px(lo[a]),
+        py(hi[b]),
         sx * scale,
         sy * scale
     )?;
-    let side = (cell * scale).max(0.5);
-    for ((i, j), dev) in keys {
-        let [r, g, b] = deviation_colour(dev, cmp.tolerance_mm);
-        let (x, y) = (lo.x + i as f64 * cell, lo.y + (j + 1) as f64 * cell);
-        writeln!(
-            out,
-            r#"<rect x="{:.2}" y="{:.2}" width="{side:.2}" height="{side:.2}" fill="rgb({r},{g},{b})"/>"#,
-            px(x),
-            py(y)
-        )?;
+    if let Some(m) = map {
+        // Colours in steps (a tenth of the tolerance within it, half a
+        // tolerance beyond), runs of a row in one colour drawn as one
+        // rectangle: the file stays small. Rectangles a hair taller than
+        // their pitch, so no seams show.
+        let step = |d: f64| {
+            let r = d / t;
+            if r.abs() <= 1.0 {
+                (r * 10.0).round() / 10.0 * t
+            } else {
+                r.signum() * t * (1.0 + ((r.abs() - 1.0) * 2.0).round() / 2.0)
+            }
+        };
+        let pitch = m.cell_mm * scale;
+        for j in 0..m.size[1] {
+            let row = &m.cells[j * m.size[0]..(j + 1) * m.size[0]];
+            let mut i = 0;
+            while i < row.len() {
+                let Some(d) = row[i] else {
+                    i += 1;
+                    continue;
+                };
+                let colour = map_colour(step(f64::from(d)), t);
+                let start = i;
+                while i < row.len()
+                    && row[i].is_some_and(|e| map_colour(step(f64::from(e)), t) == colour)
+                {
+                    i += 1;
+                }
+                let [r, g, bl] = colour;
+                writeln!(
+                    out,
+                    r#"<rect x="{:.2}" y="{:.2}" width="{:.2}" height="{:.2}" fill="rgb({r},{g},{bl})"/>"#,
+                    px(m.origin[0] + start as f64 * m.cell_mm),
+                    py(m.origin[1] + (j + 1) as f64 * m.cell_mm),
+                    (i - start) as f64 * pitch + 0.3,
+                    pitch + 0.3
+                )?;
+            }
+        }
     }
     let mut mark = |s: Option<&Sample>, label: &str| -> io::Result<()> {
         if let Some(s) = s {
             let mv = s
                 .move_id
                 .map_or("uncut stock".to_string(), |m| format!("move {m}"));
+            let (x, y) = (px(s.part_point[a]), py(s.part_point[b]));
             writeln!(
                 out,
-                r#"<circle cx="{:.2}" cy="{:.2}" r="6" fill="none" stroke="black" stroke-width="1.5"/>"#,
-                px(s.part_point[0]),
-                py(s.part_point[1])
+                r#"<circle cx="{x:.2}" cy="{y:.2}" r="6" fill="none" stroke="black" stroke-width="1.5"/>"#
             )?;
             writeln!(
                 out,
                 r#"<text x="{:.2}" y="{:.2}">{label} {:.4} mm ({mv})</text>"#,
-                px(s.part_point[0]) + 8.0,
-                py(s.part_point[1]) - 8.0,
+                x + 8.0,
+                y - 8.0,
                 s.deviation_mm
             )?;
         }
@@ -217,7 +258,6 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
     mark(cmp.gouge_max(), "gouge")?;
     mark(cmp.residual_max(), "residual")?;
     let ly = sy * scale + 50.0;
-    let t = cmp.tolerance_mm;
     for (i, (dev, text)) in [
         (-4.0 * t, "gouge ≥ 4 tol"),
         (-1.5 * t, "gouge"),
@@ -237,10 +277,37 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
             ly + 12.0
         )?;
     }
+    // The scale within the tolerance: 21 steps from −tol to +tol.
+    let sy2 = ly + 30.0;
+    for k in 0..21 {
+        let d = t * (k as f64 / 10.0 - 1.0);
+        let [r, g, b] = map_colour(d, t);
+        writeln!(
+            out,
+            r#"<rect x="{:.0}" y="{sy2:.0}" width="15" height="12" fill="rgb({r},{g},{b})"/>"#,
+            60.0 + k as f64 * 15.0
+        )?;
+    }
     writeln!(
         out,
-        r#"<text x="20" y="{:.0}">gouge max {} · residual max {} · {} gouge and {} residual regions</text>"#,
-        ly + 40.0,
+        r#"<text x="20" y="{:.0}">−{t}</text><text x="380" y="{:.0}">+{t} mm</text>"#,
+        sy2 + 10.0,
+        sy2 + 10.0
+    )?;
+    let range = cmp
+        .deviation_range_mm
+        .map_or("nothing measured".into(), |[lo, hi]| {
+            format!("deviation {lo:+.4} to {hi:+.4} mm")
+        });
+    writeln!(
+        out,
+        r#"<text x="20" y="14">Deviation from the design seen along {}: {} to the right, {} up, {:.0} mm across</text>"#,
+        AXES[axis], AXES[a], AXES[b], sx
+    )?;
+    writeln!(
+        out,
+        r#"<text x="20" y="{:.0}">{range} · gouge max {} · residual max {} · {} gouge and {} residual regions</text>"#,
+        sy2 + 40.0,
         cmp.gouge_max()
             .map_or("none".into(), |s| format!("{:.4} mm", s.deviation_mm)),
         cmp.residual_max()

@@ -58,6 +58,10 @@ pub struct Report {
     pub residual_regions: Vec<ReportRegion>,
     /// Histogram of the measured deviations.
     pub histogram: Vec<Bin>,
+    /// The most negative and the most positive deviation measured, within
+    /// the tolerance or not, mm: the deepest cut into the design and the
+    /// most material left on it.
+    pub deviation_range_mm: Option<[f64; 2]>,
     /// Design points measured.
     pub measured: u64,
     /// Material missing inside a closed design, mm³.
@@ -107,6 +111,7 @@ impl Report {
             gouge_regions: cmp.gouge_regions.iter().map(region).collect(),
             residual_regions: cmp.residual_regions.iter().map(region).collect(),
             histogram: cmp.histogram.clone(),
+            deviation_range_mm: cmp.deviation_range_mm,
             measured: cmp.measured,
             gouge_volume_mm3: cmp.gouge_volume_mm3,
             residual_volume_mm3: cmp.residual_volume_mm3,

@@ -2,7 +2,7 @@
 //! as Li (B-spline grinding) does, or least squares), evaluation with first and
 //! second derivatives, and the local geometry.
 
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use crate::basis::{DEGREE, basis_ders, find_span};
 use crate::fit1d::{Ends, Fit1d, FitError, uniform_params};
@@ -306,6 +306,24 @@ impl Surface {
             return Err(format!("control point {k} is not finite"));
         }
         Ok(())
+    }
+
+    /// The surface moved rigidly by `placement` (a work offset: the part
+    /// frame of a machine). A B-spline is affine invariant, so moving its
+    /// control points moves every point of it (Piegl & Tiller, The NURBS
+    /// Book, §3.4); the knots and the fit data's parameters stay, the data
+    /// points move with the surface.
+    pub fn transformed(&self, placement: &Isometry3<f64>) -> Surface {
+        let moved = |p: &[f64; 3]| -> [f64; 3] { (placement * Point3::from(*p)).coords.into() };
+        Surface {
+            control: self.control.iter().map(moved).collect(),
+            data: self.data.as_ref().map(|d| FitData {
+                u: d.u.clone(),
+                v: d.v.clone(),
+                points: d.points.iter().map(moved).collect(),
+            }),
+            ..self.clone()
+        }
     }
 
     /// Control net size (along u, along v).

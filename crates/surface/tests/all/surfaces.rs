@@ -270,3 +270,36 @@ fn bad_surface_files_are_located() {
     let d = from_json("", "s.json").unwrap_err();
     assert!(d.message.contains("EOF"), "{d}");
 }
+
+#[test]
+fn a_placed_surface_is_the_surface_moved() {
+    // Li's surface turned 180° about z and moved, as `kinpost surface place`
+    // and `kinpost path --rotate z:180 --translate …` place a part: every
+    // point moves with the placement, the normal turns with it, and the fit
+    // data move too (the residual stays).
+    let s = Surface::fit(&common::li_points(), &natural()).unwrap();
+    let placement = nalgebra::Isometry3::new(
+        Vector3::new(-400.0, -10.0, 20.0),
+        Vector3::new(0.3, -0.2, PI),
+    );
+    let moved = s.transformed(&placement);
+    let (u0, u1) = s.u_range();
+    let (v0, v1) = s.v_range();
+    for i in 0..=6 {
+        for j in 0..=6 {
+            let (u, v) = (
+                u0 + (u1 - u0) * i as f64 / 6.0,
+                v0 + (v1 - v0) * j as f64 / 6.0,
+            );
+            let expected = placement * nalgebra::Point3::from(s.point(u, v));
+            assert!((moved.point(u, v) - expected.coords).norm() < 1e-9);
+            let n = s.geometry(u, v).unwrap().normal;
+            let m = moved.geometry(u, v).unwrap().normal;
+            assert!((m - placement.rotation * n).norm() < 1e-9);
+        }
+    }
+    let (r0, r1) = (s.residual().unwrap(), moved.residual().unwrap());
+    assert!((r0.max - r1.max).abs() < 1e-9);
+    let back = from_json(&to_json(&moved), "moved.json").unwrap();
+    assert_eq!(back, moved);
+}
