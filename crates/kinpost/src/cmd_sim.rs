@@ -91,15 +91,9 @@ pub struct SimArgs {
     #[arg(long, value_name = "FILE.stl|FILE.json", requires = "stock")]
     design: Option<PathBuf>,
     /// The outside of a design surface: `+` the side of its normal
-    /// S_u × S_v, `-` the other (as `kinpost path --side`).
-    #[arg(
-        long,
-        value_enum,
-        default_value = "+",
-        allow_hyphen_values = true,
-        requires = "design"
-    )]
-    design_side: DesignSide,
+    /// S_u × S_v (the default), `-` the other (as `kinpost path --side`).
+    #[arg(long, value_enum, allow_hyphen_values = true, requires = "design")]
+    design_side: Option<crate::sim_stock::DesignSide>,
     /// The part of a design surface that is compared (and that
     /// `design+ALLOWANCE` grows into the stock): U0,U1,V0,V1 as fractions
     /// of the parameter domain, as `kinpost path --region` takes the
@@ -226,17 +220,6 @@ pub fn sim(args: &SimArgs) -> Result<()> {
         return Err(anyhow::Error::new(Violated));
     }
     Ok(())
-}
-
-/// The outside of a design surface (`--design-side`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum DesignSide {
-    /// The side of the surface normal S_u × S_v.
-    #[value(name = "+")]
-    Plus,
-    /// The side away from it.
-    #[value(name = "-")]
-    Minus,
 }
 
 /// Material removal as the options ask for it: the stock and tool, and the

@@ -209,6 +209,17 @@ pub fn read_process(path: &Path) -> Result<kinpost_stock::ProcessModel> {
         .map_err(crate::report)
 }
 
+/// The outside of a design surface (`--design-side`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DesignSide {
+    /// The side of the surface normal S_u × S_v.
+    #[value(name = "+")]
+    Plus,
+    /// The side away from it.
+    #[value(name = "-")]
+    Minus,
+}
+
 /// How deep under an open design surface its stock `design+ALLOWANCE`
 /// reaches, mm, when the spec gives no DEPTH: deeper than any grinding or
 /// finishing pass gouges, so a gouge is measured, not cut through.
@@ -238,7 +249,7 @@ impl DesignSource {
     /// and `--design-region`; `chord_mm` the tessellation's chord.
     pub fn load(
         path: &Path,
-        side: crate::cmd_sim::DesignSide,
+        side: Option<DesignSide>,
         region: Option<&str>,
         chord_mm: f64,
     ) -> Result<DesignSource> {
@@ -246,9 +257,9 @@ impl DesignSource {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"));
         if !is_surface {
-            if region.is_some() {
+            if region.is_some() || side.is_some() {
                 return Err(usage(
-                    "--design-region is for a design surface (JSON); an STL is compared whole",
+                    "--design-region and --design-side are for a design surface (JSON); an STL is a closed solid, compared whole",
                 ));
             }
             return Ok(DesignSource::Mesh(read_mesh(path)?));
@@ -269,6 +280,12 @@ impl DesignSource {
                         "--design-region {r}: expected four numbers U0,U1,V0,V1"
                     )));
                 };
+                let ordered = |lo: f64, hi: f64| 0.0 <= lo && lo < hi && hi <= 1.0;
+                if !(ordered(a, b) && ordered(c, d)) {
+                    return Err(usage(format!(
+                        "--design-region {r}: fractions of the parameter domain, 0 ≤ U0 < U1 ≤ 1 and 0 ≤ V0 < V1 ≤ 1"
+                    )));
+                }
                 let (du, dv) = (u1 - u0, v1 - v0);
                 [u0 + a * du, u0 + b * du, v0 + c * dv, v0 + d * dv]
             }
@@ -276,7 +293,7 @@ impl DesignSource {
         Ok(DesignSource::Surface {
             surface: Box::new(surface),
             region,
-            flip: matches!(side, crate::cmd_sim::DesignSide::Minus),
+            flip: side == Some(DesignSide::Minus),
             chord_mm,
         })
     }

@@ -184,6 +184,11 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
         r#"<title>Deviation from the design, seen along {} ({} to the right, {} up; tolerance {} mm)</title>"#,
         AXES[axis], AXES[a], AXES[b], cmp.tolerance_mm
     )?;
+    writeln!(
+        out,
+        r#"<text x="20" y="14">Deviation from the design seen along {}: {} to the right, {} up, {:.0} mm across</text>"#,
+        AXES[axis], AXES[a], AXES[b], sx
+    )?;
     let px = |x: f64| 20.0 + (x - lo[a]) * scale;
     let py = |y: f64| 20.0 + (hi[b] - y) * scale;
     writeln!(
@@ -257,7 +262,14 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
     };
     mark(cmp.gouge_max(), "gouge")?;
     mark(cmp.residual_max(), "residual")?;
-    let ly = sy * scale + 50.0;
+    write_legend(&mut out, cmp, sy * scale + 50.0)?;
+    writeln!(out, "</svg>")?;
+    out.flush()
+}
+
+/// The legend and the summary line of the deviation map, from height `ly`.
+fn write_legend<W: Write>(out: &mut W, cmp: &Comparison, ly: f64) -> io::Result<()> {
+    let t = cmp.tolerance_mm;
     for (i, (dev, text)) in [
         (-4.0 * t, "gouge ≥ 4 tol"),
         (-1.5 * t, "gouge"),
@@ -301,11 +313,6 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
         });
     writeln!(
         out,
-        r#"<text x="20" y="14">Deviation from the design seen along {}: {} to the right, {} up, {:.0} mm across</text>"#,
-        AXES[axis], AXES[a], AXES[b], sx
-    )?;
-    writeln!(
-        out,
         r#"<text x="20" y="{:.0}">{range} · gouge max {} · residual max {} · {} gouge and {} residual regions</text>"#,
         sy2 + 40.0,
         cmp.gouge_max()
@@ -315,6 +322,5 @@ pub fn write_svg<W: Write>(stock: &Stock, cmp: &Comparison, w: &mut W) -> io::Re
         cmp.gouge_regions.len(),
         cmp.residual_regions.len()
     )?;
-    writeln!(out, "</svg>")?;
-    out.flush()
+    Ok(())
 }

@@ -11,6 +11,7 @@ mod calibrate_cli;
 mod cli;
 mod common;
 mod data_manifest;
+mod experiments;
 mod hostile;
 mod li_grinding_path;
 mod rotor37;

@@ -390,6 +390,77 @@ fn removal_options_are_checked() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A design surface's options: the side and region only with a surface
+/// file, a region inside its domain, DEPTH only for a surface; each a usage
+/// error naming what is wrong, nothing written.
+#[test]
+fn design_surface_options_are_checked() {
+    let dir = temp_dir("design-surface-options");
+    std::fs::write(dir.join("slot.ngc"), SLOT).unwrap();
+    std::fs::write(dir.join("box.stl"), box_stl([0.0; 3], [40.0, 40.0, 10.0])).unwrap();
+    let top = root().join("examples/grinding-experiments/block-top.json");
+    let top = top.to_str().unwrap();
+    let machine = free3();
+    let stock = ["--stock", "box:0,0,0,40,40,10", "--tool", "flat:4"];
+    for (extra, want) in [
+        (
+            &["--design", "box.stl", "--design-side", "-"][..],
+            "--design-side",
+        ),
+        (
+            &["--design", "box.stl", "--design-region", "0,1,0,1"][..],
+            "--design-region",
+        ),
+        (
+            &["--design", top, "--design-region", "0,1,0"][..],
+            "four numbers",
+        ),
+        (
+            &["--design", top, "--design-region", "0,1.5,0,1"][..],
+            "fractions of the parameter domain",
+        ),
+        (
+            &["--design", top, "--design-side", "up"][..],
+            "invalid value",
+        ),
+    ] {
+        let mut args = vec!["sim", "slot.ngc", "--machine", &machine, "--json", "r.json"];
+        args.extend_from_slice(&stock);
+        args.extend_from_slice(extra);
+        let o = run_in(&dir, &args);
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(want), "{extra:?}: {}", stderr(&o));
+        assert!(!dir.join("r.json").exists());
+    }
+    for (stock_spec, design, want) in [
+        ("design+0.1,2", "box.stl", "DEPTH is for a design surface"),
+        ("design+-0.1", top, "0 or more"),
+        ("design+0.1,2,3", top, "design+ALLOWANCE[,DEPTH]"),
+    ] {
+        let o = run_in(
+            &dir,
+            &[
+                "sim",
+                "slot.ngc",
+                "--machine",
+                &machine,
+                "--json",
+                "r.json",
+                "--stock",
+                stock_spec,
+                "--tool",
+                "flat:4",
+                "--design",
+                design,
+            ],
+        );
+        assert_exit(&o, 2);
+        assert!(stderr(&o).contains(want), "{stock_spec}: {}", stderr(&o));
+        assert!(!dir.join("r.json").exists());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// A straight wheel pass 0.1 mm deep from at Y50 (in
 /// `pieces` GOTOs) across a flat blank (-440..-200, 0..100, -10..0),
 /// posted for `mts1600` with `post_extra`, replayed with the 25 × 25 mm
