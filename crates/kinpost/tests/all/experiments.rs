@@ -171,6 +171,44 @@ fn traces(report: &serde_json::Value) -> Vec<(f64, f64, u64)> {
     t
 }
 
+/// Posts examples/grinding-experiments/two-traces.cls (with `post_extra`)
+/// to `NAME.mpf` in `dir` and grinds it as run.sh does, with `sim_extra`:
+/// the test block, the 25 mm wheel, 0.1 mm rays, compared with the block's
+/// top (exit code 3: the traces are below it). Returns the JSON report.
+fn grind_traces(
+    dir: &Path,
+    name: &str,
+    post_extra: &[&str],
+    sim_extra: &[&str],
+) -> serde_json::Value {
+    let (program, report) = (format!("{name}.mpf"), format!("{name}.json"));
+    let cl = path("examples/grinding-experiments/two-traces.cls");
+    let mut args = vec!["post", cl.as_str(), "-m", "mts1600", "-o", &program, "-q"];
+    args.extend_from_slice(post_extra);
+    kinpost(dir, &args, 0);
+    let top = path("examples/grinding-experiments/block-top.json");
+    let mut args = vec![
+        "sim",
+        &program,
+        "-m",
+        "mts1600",
+        "--stock",
+        "box:-452,60,-80,-52,160,0",
+        "--tool",
+        "wheel:50,25",
+        "--resolution",
+        "0.1",
+        "--design",
+        &top,
+        "--json",
+        &report,
+        "-q",
+    ];
+    args.extend_from_slice(sim_extra);
+    kinpost(dir, &args, 3);
+    json(&dir.join(&report))
+}
+
 /// Qi (thesis) §4.2–4.3: a trace with the wheel fully retracted (H1 = 3600,
 /// the upper stop) and one with it fully dropped (H1 = 3000, the lower
 /// stop), both 20 mm deep in the CL. Compensated, both traces are 20 mm
@@ -182,36 +220,13 @@ fn traces(report: &serde_json::Value) -> Vec<(f64, f64, u64)> {
 #[test]
 fn qi_two_traces_agree_with_compensation_and_differ_by_the_offset_without() {
     let dir = temp_dir("exp-traces");
-    let cl = path("examples/grinding-experiments/two-traces.cls");
-    let top = path("examples/grinding-experiments/block-top.json");
-    for (name, extra) in [("comp", None), ("raw", Some("--no-pressure-compensation"))] {
-        let out = format!("{name}.mpf");
-        let mut args = vec!["post", cl.as_str(), "-m", "mts1600", "-o", &out, "-q"];
-        args.extend(extra);
-        kinpost(&dir, &args, 0);
-        let report = format!("{name}.json");
-        kinpost(
-            &dir,
-            &[
-                "sim",
-                &out,
-                "-m",
-                "mts1600",
-                "--stock",
-                "box:-452,60,-80,-52,160,0",
-                "--tool",
-                "wheel:50,25",
-                "--resolution",
-                "0.1",
-                "--design",
-                &top,
-                "--json",
-                &report,
-                "-q",
-            ],
-            3,
-        );
-    }
+    let comp = traces(&grind_traces(&dir, "comp", &[], &[]));
+    let raw = traces(&grind_traces(
+        &dir,
+        "raw",
+        &["--no-pressure-compensation"],
+        &[],
+    ));
     let alpha = |h1: f64| -> f64 {
         // The machine file's table: (3000, −6.73°), (3250, −5°), (3600, 5°).
         let t = [(3000.0, -6.73), (3250.0, -5.0), (3600.0, 5.0)];
@@ -221,8 +236,6 @@ fn qi_two_traces_agree_with_compensation_and_differ_by_the_offset_without() {
         (a.1 + (b.1 - a.1) * (h1 - a.0) / (b.0 - a.0)).to_radians()
     };
     let lift = |h1: f64| 250.0 * (alpha(h1).sin() - alpha(3475.0).sin());
-    let comp = traces(&json(&dir.join("comp.json")));
-    let raw = traces(&json(&dir.join("raw.json")));
     assert_eq!(comp.len(), 2, "{comp:?}");
     assert_eq!(raw.len(), 2, "{raw:?}");
     // Sorted by x: the trace at x = −300 (H1 = 3600) first. The NC's 0.001
@@ -256,41 +269,11 @@ fn qi_two_traces_agree_with_compensation_and_differ_by_the_offset_without() {
 fn qi_two_traces_by_the_process_model_have_prestons_depth() {
     let dir = temp_dir("exp-process");
     let process_file = root().join("crates/stock/process/mts1600.toml");
-    kinpost(
+    let report = grind_traces(
         &dir,
-        &[
-            "post",
-            &path("examples/grinding-experiments/two-traces.cls"),
-            "-m",
-            "mts1600",
-            "-o",
-            "t.mpf",
-            "-q",
-        ],
-        0,
-    );
-    kinpost(
-        &dir,
-        &[
-            "sim",
-            "t.mpf",
-            "-m",
-            "mts1600",
-            "--stock",
-            "box:-452,60,-80,-52,160,0",
-            "--tool",
-            "wheel:50,25",
-            "--resolution",
-            "0.1",
-            "--design",
-            &path("examples/grinding-experiments/block-top.json"),
-            "--process",
-            process_file.to_str().unwrap(),
-            "--json",
-            "p.json",
-            "-q",
-        ],
-        3,
+        "t",
+        &[],
+        &["--process", process_file.to_str().unwrap()],
     );
     let model = kinpost_stock::ProcessModel::from_toml(
         &std::fs::read_to_string(&process_file).unwrap(),
@@ -306,7 +289,6 @@ fn qi_two_traces_by_the_process_model_have_prestons_depth() {
     assert_eq!(model.force.newtons.len(), 2, "a two-point force table");
     let belt = 3000.0 * std::f64::consts::TAU / 60.0 * 50.0;
     let preston = |f: f64| model.wheel.preston_mm2_per_n * belt * f / (600.0 / 60.0 * 25.0);
-    let report = json(&dir.join("p.json"));
     let t = traces(&report);
     let expected: Vec<(f64, f64)> = [(-300.0, 3600.0), (-200.0, 3000.0)]
         .into_iter()

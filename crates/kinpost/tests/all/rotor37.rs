@@ -30,10 +30,15 @@ fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
-#[test]
-fn rotor37_side1_reduced_grid_posts_on_mts1600() {
-    let dir = tempfile::tempdir().unwrap();
-    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+/// The work offset of examples/rotor37: `kinpost path` and `kinpost
+/// surface place` take the same options.
+const PLACE: [&str; 4] = ["--rotate", "z:180", "--translate", "-100,-10,20"];
+
+/// Steps 1 and 2 of examples/rotor37/run.sh on the reduced grid in `dir`:
+/// `s.json` (the surface), `s.cls` (the path) and `path.json` (its report),
+/// which is returned; the fit's summary line is checked.
+fn reduced_blade_path(dir: &Path) -> serde_json::Value {
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
     let o = kinpost(&[
         "surface",
         "fit",
@@ -52,9 +57,10 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
         err.contains("13 × 34 points → 15 × 36 control points"),
         "{err}"
     );
-    kinpost(&[
+    let (surface, cl, svg, report) = (p("s.json"), p("s.cls"), p("path.svg"), p("path.json"));
+    let mut args = vec![
         "path",
-        &p("s.json"),
+        &surface,
         "--tool",
         "wheel:radius=20,width=2",
         "--direction",
@@ -71,18 +77,23 @@ fn rotor37_side1_reduced_grid_posts_on_mts1600() {
         "1200",
         "--pressure",
         "H1=3000",
-        "--rotate",
-        "z:180",
-        "--translate",
-        "-100,-10,20",
         "-o",
-        &p("s.cls"),
+        &cl,
         "--svg",
-        &p("path.svg"),
+        &svg,
         "--json",
-        &p("path.json"),
-    ]);
-    let report = json(&dir.path().join("path.json"));
+        &report,
+    ];
+    args.extend(PLACE);
+    kinpost(&args);
+    json(&dir.join("path.json"))
+}
+
+#[test]
+fn rotor37_side1_reduced_grid_posts_on_mts1600() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
+    let report = reduced_blade_path(dir.path());
     let scallop = report["scallop_max_mm"].as_f64().unwrap();
     assert!(scallop > 0.0 && scallop <= 0.01, "scallop {scallop}");
     for g in report["gaps"].as_array().unwrap() {
@@ -172,50 +183,7 @@ fn rotor67_reads_both_blade_sides() {
 fn rotor37_side1_ground_from_design_plus_0_1_has_no_gouge() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name).to_string_lossy().into_owned();
-    kinpost(&[
-        "surface",
-        "fit",
-        "data/nasa-rotors/rotor37geometry.dat",
-        "--blade-side",
-        "1",
-        "--params",
-        "chord-length",
-        "--every",
-        "1,3",
-        "-o",
-        &p("s.json"),
-    ]);
-    let place = ["--rotate", "z:180", "--translate", "-100,-10,20"];
-    let mut args = vec![
-        "path",
-        &p("s.json"),
-        "--tool",
-        "wheel:radius=20,width=2",
-        "--direction",
-        "v",
-        "--side",
-        "-",
-        "--scallop",
-        "0.01",
-        "--chordtol",
-        "0.003",
-        "--region",
-        "0,0.9,0.05,0.95",
-        "--feed",
-        "1200",
-        "--pressure",
-        "H1=3000",
-        "-o",
-        &p("s.cls"),
-        "--json",
-        &p("path.json"),
-    ]
-    .into_iter()
-    .map(String::from)
-    .collect::<Vec<_>>();
-    args.extend(place.iter().map(|s| s.to_string()));
-    kinpost(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    let path = json(&dir.path().join("path.json"));
+    let path = reduced_blade_path(dir.path());
     let scallop = path["scallop_max_mm"].as_f64().unwrap();
     let edge = path["wheel_edge_interference_max_mm"].as_f64().unwrap();
     let chord = path["chord_error_max_mm"].as_f64().unwrap();
@@ -236,7 +204,7 @@ fn rotor37_side1_ground_from_design_plus_0_1_has_no_gouge() {
     let s_json = p("s.json");
     let placed_json = p("placed.json");
     placed.push(&s_json);
-    placed.extend(place);
+    placed.extend(PLACE);
     placed.extend(["-o", &placed_json]);
     kinpost(&placed);
     let resolution = 0.1;

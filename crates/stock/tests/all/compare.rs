@@ -10,6 +10,23 @@ fn corners() -> (Point3<f64>, Point3<f64>) {
     (Point3::new(0.0, 0.0, 0.0), Point3::new(40.0, 20.0, 10.0))
 }
 
+/// The box of [`corners`] at 0.25 mm with a slot of a 4 mm flat end mill
+/// `depth` deep below its top, x 10…30 at y 10, cut by move `id`.
+fn slotted(depth: f64, id: u32) -> Stock {
+    let (lo, hi) = corners();
+    let mut s = Stock::from_box(lo, hi, 0.25).unwrap();
+    let tool = Tool::FlatEnd {
+        diameter: 4.0,
+        flute_length: 20.0,
+        shank: None,
+    };
+    let z = hi.z - depth;
+    let a = ToolPose::new(Point3::new(10.0, 10.0, z), Vector3::z());
+    let b = ToolPose::new(Point3::new(30.0, 10.0, z), Vector3::z());
+    s.cut_move(&tool, &a, &b, id).unwrap();
+    s
+}
+
 #[test]
 fn cuboid_mesh_faces_out_and_bounds_the_box() {
     let (lo, hi) = corners();
@@ -49,15 +66,7 @@ fn a_stock_compared_with_itself_as_design_has_no_gouge_or_residual() {
 #[test]
 fn a_slot_below_the_design_is_a_gouge_of_its_depth_made_by_its_move() {
     let (lo, hi) = corners();
-    let mut s = Stock::from_box(lo, hi, 0.25).unwrap();
-    let tool = Tool::FlatEnd {
-        diameter: 4.0,
-        flute_length: 20.0,
-        shank: None,
-    };
-    let a = ToolPose::new(Point3::new(10.0, 10.0, 9.7), Vector3::z());
-    let b = ToolPose::new(Point3::new(30.0, 10.0, 9.7), Vector3::z());
-    s.cut_move(&tool, &a, &b, 41).unwrap();
+    let s = slotted(0.3, 41);
     let d = Design::from_mesh(Mesh::cuboid(lo, hi)).unwrap();
     let c = compare(&s, &d, 0.01).unwrap();
     assert_eq!(c.gouge_regions.len(), 1, "{:?}", c.gouge_regions);
@@ -228,16 +237,7 @@ fn the_deviation_map_sees_every_measured_ray() {
     // Z holds the slot's depth where the slot is and 0 elsewhere.
     let plane = graph_surface((0.0, 40.0), (0.0, 20.0), |_, _| 10.0);
     let design = Design::from_surface(&plane, 0.001, false).unwrap();
-    let (lo, hi) = corners();
-    let mut s = Stock::from_box(lo, hi, 0.25).unwrap();
-    let tool = Tool::FlatEnd {
-        diameter: 4.0,
-        flute_length: 20.0,
-        shank: None,
-    };
-    let a = ToolPose::new(Point3::new(10.0, 10.0, 9.6), Vector3::z());
-    let b = ToolPose::new(Point3::new(30.0, 10.0, 9.6), Vector3::z());
-    s.cut_move(&tool, &a, &b, 3).unwrap();
+    let s = slotted(0.4, 3);
     let c = compare(&s, &design, 0.01).unwrap();
     let map = c.maps.iter().max_by_key(|m| m.measured_rays).unwrap();
     assert_eq!(map.axis, 2);
