@@ -137,8 +137,9 @@ impl Design {
     /// region's edges: the stock `design+ALLOWANCE` of a part known by one
     /// surface (a blade side), whose material further in is never reached.
     /// The offsets are exact at the grid points (the chord error of
-    /// [`Design::from_surface_region`] between them); they must stay below
-    /// the surface's smallest radius of curvature or the shell folds.
+    /// [`Design::from_surface_region`] between them). An offset that
+    /// reaches the smallest radius of curvature found (the shell would fold)
+    /// and a point without a normal (it would pinch) are errors.
     pub fn shell_of_surface(
         surface: &Surface,
         region: [f64; 4],
@@ -158,6 +159,16 @@ impl Design {
             return Err(DesignError::Surface("the shell has no thickness"));
         }
         let grid = SurfaceGrid::new(surface, region, chord_mm)?;
+        if above_mm.max(below_mm) * grid.kappa >= 1.0 {
+            return Err(DesignError::Surface(
+                "the shell's offset reaches the surface's centre of curvature: the shell would fold over itself",
+            ));
+        }
+        if grid.normals.iter().any(|n| n.norm() == 0.0) {
+            return Err(DesignError::Surface(
+                "its normal is undefined at a point (S_u × S_v = 0): the shell would pinch there",
+            ));
+        }
         let (nu, nv) = (grid.nu, grid.nv);
         let n = nu * nv;
         let sign = if flip { -1.0 } else { 1.0 };
@@ -218,6 +229,8 @@ struct SurfaceGrid {
     nv: usize,
     points: Vec<Point3<f64>>,
     normals: Vec<nalgebra::Vector3<f64>>,
+    /// The largest principal curvature found, 1/mm.
+    kappa: f64,
 }
 
 impl SurfaceGrid {
@@ -284,6 +297,7 @@ impl SurfaceGrid {
             nv,
             points,
             normals,
+            kappa,
         })
     }
 

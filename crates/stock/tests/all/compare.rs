@@ -224,6 +224,11 @@ fn a_curved_shell_offsets_along_the_normal() {
     let c = compare(&stock, &design, 0.01).unwrap();
     let [lo, hi] = c.deviation_range_mm.unwrap();
     assert!(lo > 0.2 - 0.003 && hi < 0.2 + 0.003, "{lo} {hi}");
+    // A shell as deep as the radius would fold over itself: refused.
+    assert!(matches!(
+        Design::shell_of_surface(&cylinder, region, 0.001, false, 0.2, 50.0),
+        Err(kinpost_stock::DesignError::Surface(_))
+    ));
     // A region outside the domain is refused.
     assert!(matches!(
         Design::from_surface_region(&cylinder, [u0, u1 + 1.0, v0, v1], 0.001, false),
