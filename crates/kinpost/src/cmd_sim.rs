@@ -58,8 +58,10 @@ pub struct SimArgs {
     blocks: Option<PathBuf>,
     /// Remove material while replaying: the stock in the part frame,
     /// `box:XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX`, `design+ALLOWANCE` (the design
-    /// grown by ALLOWANCE mm; needs --design), or a closed STL file. Needs
-    /// --tool. A rapid that removes material is an error (exit code 3).
+    /// grown by ALLOWANCE mm; needs --design; for a design surface
+    /// `design+ALLOWANCE[,DEPTH]`, the shell from ALLOWANCE outside it to
+    /// DEPTH inside, default 2 mm), or a closed STL file. Needs --tool. A
+    /// rapid that removes material is an error (exit code 3).
     #[arg(long, value_name = "SPEC", requires = "tool")]
     stock: Option<String>,
     /// The tool that cuts the stock, mm and degrees: `flat:D[,FLUTE]`,

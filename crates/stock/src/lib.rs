@@ -29,8 +29,9 @@
 //! last cut them ([`Stock`]). One interval per ray is stored inline (32
 //! bytes a ray). Stocks come from a box, a closed STL mesh (ray parity with
 //! exact predicates, [`mesh`]) or a design grown by an allowance
-//! ([`Stock::from_mesh_offset`]); [`default_resolution`] picks h for about
-//! 16 million rays.
+//! ([`Stock::from_mesh_offset`]; for a design known by one surface, the
+//! closed shell of [`Design::shell_of_surface`]); [`default_resolution`]
+//! picks h for about 16 million rays.
 //!
 //! **Cutting.** [`Stock::cut_move`] removes what the tool sweeps between two
 //! poses: exactly for translations of cylinders and spheres ([`kernel`]),
@@ -56,10 +57,13 @@
 //! file; [`Stock::grind_move`] grinds with it; [`calibrate`] fits Preston's
 //! coefficient and the wheel's stiffness to measured traces ([`process`]).
 //!
-//! **Comparison and output.** [`compare`] measures the design along the
-//! rays ([`design`]); [`contour`] meshes the part (marching tetrahedra on
-//! the ray lattice); [`write_stl`], [`write_ply`], [`write_svg`] and
-//! [`Report`] give the files and the report.
+//! **Comparison and output.** [`compare`] measures the design (a closed
+//! mesh, or a B-spline surface over a parameter region) along the rays
+//! ([`design`]), keeping the samples beyond tolerance, a histogram, the
+//! range of all deviations and a [`DeviationMap`] of every ray seen along
+//! each axis; [`contour`] meshes the part (marching tetrahedra on the ray
+//! lattice); [`write_stl`], [`write_ply`], [`write_svg`] and [`Report`]
+//! give the files and the report.
 //!
 //! ```
 //! use kinpost_stock::{Design, Mesh, Stock, Tool, ToolPose, compare};
