@@ -1,7 +1,8 @@
 //! Fuzz target: any bytes fed to the CL reader, with and without a default
 //! tool axis, must never panic or loop, and every diagnostic must point into
 //! the input. The fast paths (whole input in memory) must read exactly what
-//! the general path (a one-byte buffer) reads. Run with
+//! the general path (a one-byte buffer) reads, and the bytes read as
+//! ISO 8859-1 what their UTF-8 text reads. Run with
 //! `cargo +nightly fuzz run cl_reader fuzz/corpus/cl_reader
 //! fuzz/seeds/cl_reader data/cl/nx data/cl/creo data/cl/solidworks --
 //! -max_len=8192` from the repository root (the first folder is where
@@ -36,6 +37,17 @@ fuzz_target!(|data: &[u8]| {
         transcript(ClReader::new(data, "fuzz.cls")),
         transcript(ClReader::new(std::io::BufReader::with_capacity(1, data), "fuzz.cls")),
         "the fast paths read differently from the general path"
+    );
+    // Read as ISO 8859-1 (`--encoding latin1`), every byte is a character:
+    // the same text the standard library makes of it.
+    let latin1: String = data.iter().map(|&b| char::from(b)).collect();
+    assert_eq!(
+        transcript(ClReader::new(
+            std::io::BufReader::with_capacity(3, kinpost_cl::encoding::Latin1::new(data)),
+            "fuzz.cls"
+        )),
+        transcript(ClReader::new(latin1.as_bytes(), "fuzz.cls")),
+        "Latin-1 read differently from its UTF-8 text"
     );
     let lines = data.split(|&b| b == b'\n').count();
     for (default_axis, units) in [(false, None), (true, None), (true, Some(Units::Inch))] {

@@ -131,6 +131,7 @@
 #![deny(missing_docs)]
 
 pub mod curve;
+pub mod encoding;
 pub mod frame;
 mod number;
 mod reader;

@@ -36,6 +36,9 @@ pub struct SimArgs {
     /// axis are compared with it along the path.
     #[arg(long, value_name = "FILE")]
     cl: Option<PathBuf>,
+    /// Text encoding of the --cl file: utf-8, or latin1 (ISO 8859-1).
+    #[arg(long, value_enum, default_value = "utf-8", requires = "cl")]
+    cl_encoding: crate::EncodingArg,
     /// A machine input or system variable the program reads, NAME=VALUE
     /// (`'$A_IN[5]=1'`, `_hal[pin]=1`, `M66[2]=1`, `#1000=1`); inputs not
     /// given read 0, and the run says so.
@@ -158,7 +161,8 @@ pub fn sim(args: &SimArgs) -> Result<()> {
             let f = std::fs::File::open(p)
                 .with_context(|| format!("cannot open CL file {}", p.display()))?;
             let name = p.to_string_lossy();
-            Some(ClPath::read(BufReader::with_capacity(1 << 16, f), &name).map_err(sim_error)?)
+            let text = args.cl_encoding.decode(f);
+            Some(ClPath::read(BufReader::with_capacity(1 << 16, text), &name).map_err(sim_error)?)
         }
     };
     let names: Vec<String> = kinpost_post::axis_specs(&machine)

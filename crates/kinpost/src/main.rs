@@ -208,6 +208,10 @@ struct PostArgs {
     /// inch or mm. An inch feed in a file without either is an error.
     #[arg(long, value_enum)]
     units: Option<UnitsArg>,
+    /// Text encoding of the CL file: utf-8, or latin1 (ISO 8859-1, the
+    /// accented comments CATIA V5 writes on Western European systems).
+    #[arg(long, value_enum, default_value = "utf-8")]
+    encoding: EncodingArg,
     /// What a CL INSERT becomes: verbatim code (the APT meaning; a line
     /// that moves an axis or changes a tool is warned about), a comment
     /// (SOLIDWORKS CAM writes tool and stock notes as INSERT), or nothing.
@@ -290,6 +294,27 @@ enum InsertArg {
 enum UnitsArg {
     Inch,
     Mm,
+}
+
+/// The text encoding of a CL file (`--encoding`).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EncodingArg {
+    /// UTF-8 (and so ASCII).
+    #[value(name = "utf-8", alias = "utf8")]
+    Utf8,
+    /// ISO 8859-1.
+    #[value(name = "latin1", alias = "iso-8859-1")]
+    Latin1,
+}
+
+impl EncodingArg {
+    /// `input` as the UTF-8 text the CL reader takes.
+    pub fn decode<'a>(self, input: impl Read + 'a) -> Box<dyn Read + 'a> {
+        match self {
+            EncodingArg::Utf8 => Box::new(input),
+            EncodingArg::Latin1 => Box::new(kinpost_post::cl::encoding::Latin1::new(input)),
+        }
+    }
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -809,7 +834,10 @@ fn post(args: PostArgs) -> Result<()> {
     let config = Config::resolve(&options, &machine, &dialect).map_err(|e| usage(e.to_string()))?;
     let progress = progress_bar(&args);
     let input: Box<dyn BufRead> = if args.input == "-" {
-        Box::new(BufReader::with_capacity(1 << 16, io::stdin().lock()))
+        Box::new(BufReader::with_capacity(
+            1 << 16,
+            args.encoding.decode(io::stdin().lock()),
+        ))
     } else {
         let f = std::fs::File::open(&args.input)
             .with_context(|| format!("cannot open CL file {}", args.input))?;
@@ -823,10 +851,10 @@ fn post(args: PostArgs) -> Result<()> {
         }
         Box::new(BufReader::with_capacity(
             1 << 16,
-            Progress {
+            args.encoding.decode(Progress {
                 inner: f,
                 bar: progress.clone(),
-            },
+            }),
         ))
     };
 

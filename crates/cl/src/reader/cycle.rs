@@ -10,6 +10,9 @@ use super::{ClReader, Span};
 use crate::number::parse_number;
 use crate::{ClEvent, Cycle, CycleKind, Dwell};
 
+/// The positional forms read, for the error messages.
+const POSITIONAL: &str = "`depth, clearance` or `depth, IPM|MMPM|IPR|MMPR, feed, clearance`";
+
 /// The couplet keywords a cycle may carry, for the error message.
 const KEYWORDS: &str = "FEDTO, DEPTH, RAPTO, CLEAR, RTRCTO, RETURN, STEP, INCR, 1STPECK, SUBPECK, DWELL, REV, BACK, TIMES, PITCH, MMPM, IPM, MMPR, IPR";
 
@@ -33,7 +36,7 @@ impl<R: BufRead> ClReader<R> {
         if !self.is_word(first) {
             return Err(self.error(
                 first,
-                "expected the cycle's kind (DRILL, DEEP, BRKCHP, TAP, BORE, REAM, …): cycles with positional values (Creo's fixed format) are not read; write them as keyword,value couplets",
+                "expected the cycle's kind (DRILL, DEEP, BRKCHP, TAP, BORE, REAM, …)",
             ));
         }
         let mut kind = match kind_word.as_str() {
@@ -70,6 +73,10 @@ impl<R: BufRead> ClReader<R> {
             back_off_mm: None,
             full_retract_every: None,
         };
+        if k < n && !self.is_word(self.fields[k]) {
+            self.positional_cycle(&mut cycle, k)?;
+            return Ok(Some(ClEvent::Cycle(Box::new(cycle))));
+        }
         let mut rapto: Option<f64> = None;
         let mut clear: Option<f64> = None;
         while k < n {
@@ -79,7 +86,7 @@ impl<R: BufRead> ClReader<R> {
                 return Err(self.error(
                     key_span,
                     format!(
-                        "a number where a keyword ({KEYWORDS}) is expected: cycles with positional values (Creo's fixed format) are not read; write them as keyword,value couplets"
+                        "a number where a keyword ({KEYWORDS}) is expected: positional values come right after the kind ({POSITIONAL})"
                     ),
                 ));
             }
@@ -151,5 +158,61 @@ impl<R: BufRead> ClReader<R> {
             None => rapto,
         };
         Ok(Some(ClEvent::Cycle(Box::new(cycle))))
+    }
+
+    /// APT's positional cycle, the values in a fixed order after the kind
+    /// (`CYCLE/DRILL, depth, IPM, feed, rapid plane`: the depth into the
+    /// material and the height above the hole point where the feed starts),
+    /// and the two-value form CATIA V5 writes, `CYCLE/DRILL, depth,
+    /// clearance`, with the feed of the last FEDRAT. Only the single-pass
+    /// kinds have a positional form: a peck or a thread needs its keywords.
+    fn positional_cycle(&mut self, cycle: &mut Cycle, k: usize) -> Result<(), Diagnostic> {
+        let first = self.fields[k];
+        let kinds = [
+            CycleKind::Drill,
+            CycleKind::Face,
+            CycleKind::Bore,
+            CycleKind::Ream,
+            CycleKind::Countersink,
+        ];
+        if !kinds.contains(&cycle.kind) {
+            return Err(self.error(
+                first,
+                format!(
+                    "a number where a keyword ({KEYWORDS}) is expected: positional values ({POSITIONAL}) are read for DRILL, FACE, BORE, REAM and CSINK only"
+                ),
+            ));
+        }
+        let values = &self.fields[k..];
+        let bad = |this: &Self| {
+            this.error(
+                first,
+                format!("positional CYCLE values are {POSITIONAL} (APT's fixed order)"),
+            )
+        };
+        let (depth, clearance) = match *values {
+            [depth, clearance] if !self.is_word(clearance) => (depth, clearance),
+            [depth, unit, feed, clearance] if !self.is_word(feed) && !self.is_word(clearance) => {
+                let Some(unit_kind) = feed_unit(&self.word(unit)) else {
+                    return Err(bad(self));
+                };
+                let value = self.number(feed)?;
+                if value <= 0.0 {
+                    return Err(self.error(
+                        feed,
+                        format!(
+                            "the cycle's feed rate must be positive, got `{}`",
+                            self.field(feed)
+                        ),
+                    ));
+                }
+                cycle.feed = Some(self.feed_mm(value, unit_kind, unit)?);
+                (depth, clearance)
+            }
+            _ => return Err(bad(self)),
+        };
+        cycle.depth_mm = Some(self.mm(self.number(depth)?).abs());
+        cycle.feed_start_mm = Some(self.mm(self.number(clearance)?));
+        Ok(())
     }
 }

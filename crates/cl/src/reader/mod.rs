@@ -817,7 +817,7 @@ impl<R: BufRead> ClReader<R> {
             1,
             String::from_utf8_lossy(bytes),
             format!(
-                "invalid UTF-8 (byte 0x{:02X}); CL files must be UTF-8 text (convert it, e.g. with `iconv -f GBK -t UTF-8`, or `-f LATIN1` for the ISO 8859-1 accented comments CATIA V5 writes)",
+                "invalid UTF-8 (byte 0x{:02X}); CL files are read as UTF-8 text: for the ISO 8859-1 accented comments CATIA V5 writes give `--encoding latin1`; convert other encodings (e.g. `iconv -f GBK -t UTF-8`)",
                 bytes[valid]
             ),
         )

@@ -32,6 +32,8 @@ struct Case {
     /// The post-processor words of the file's own machine, which the
     /// reader rightly warns about as unknown statements (and nothing else).
     machine_words: &'static [&'static str],
+    /// The file is ISO 8859-1 text (`--encoding latin1`).
+    latin1: bool,
 }
 
 const fn case(path: &'static str, default_axis: bool, units: Option<Units>) -> Case {
@@ -40,6 +42,7 @@ const fn case(path: &'static str, default_axis: bool, units: Option<Units>) -> C
         default_axis,
         units,
         machine_words: &[],
+        latin1: false,
     }
 }
 
@@ -56,6 +59,16 @@ const CASES: &[Case] = &[
             "AIR", "FEEDOVER", "GLASS", "INITIAL", "RECIPE", "SATUTEST", "SAVERE", "SPINDLE",
             "STANDOFF", "SUBPROG", "SURFACE",
         ],
+        latin1: false,
+    },
+    // CATIA V5 spot drilling: French comments in ISO 8859-1, positional
+    // CYCLE/DRILL.
+    Case {
+        path: "catia/PrepaFlans_Pointage.aptsource",
+        default_axis: false,
+        units: None,
+        machine_words: &[],
+        latin1: true,
     },
     case("nx/APT_Project2.txt", false, INCH),
     case("nx/APT_SimpleMillPlane.txt", false, None),
@@ -101,7 +114,12 @@ fn fnv1a(text: &str) -> u64 {
 fn statements(case: &Case) -> Vec<Statement> {
     let path = data().join(case.path);
     let file = File::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut reader = ClReader::new(BufReader::new(file), case.path).with_units(case.units);
+    let text: Box<dyn std::io::Read> = if case.latin1 {
+        Box::new(kinpost_cl::encoding::Latin1::new(file))
+    } else {
+        Box::new(file)
+    };
+    let mut reader = ClReader::new(BufReader::new(text), case.path).with_units(case.units);
     if case.default_axis {
         reader = reader.with_default_axis([0.0, 0.0, 1.0]);
     }

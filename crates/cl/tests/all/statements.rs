@@ -226,12 +226,16 @@ fn nx_nurbs_starts_at_the_current_point() {
     assert_eq!(e[3], ClEvent::Fini);
 }
 
-#[test]
-fn cycles_in_three_dialects() {
-    let cycle = |e: &ClEvent| match e {
+/// The cycle an event carries.
+fn cycle(e: &ClEvent) -> Cycle {
+    match e {
         ClEvent::Cycle(c) => (**c).clone(),
         _ => panic!("{e:?}"),
-    };
+    }
+}
+
+#[test]
+fn cycles_in_three_dialects() {
     let base = Cycle {
         kind: CycleKind::Drill,
         depth_mm: None,
@@ -323,6 +327,45 @@ fn cycles_in_three_dialects() {
             .contains("number where a keyword")
     );
     assert!(error("CYCLE/DRILL,MMPM,0\n").message.contains("positive"));
+}
+
+#[test]
+fn positional_cycles_in_apts_fixed_order() {
+    // CATIA V5: `CYCLE/DRILL, depth, clearance` (its file approaches to
+    // 5 mm above the hole point before the cycle), the feed of FEDRAT.
+    let e = events("CYCLE/DRILL,    3.000000,    5.000000\nCYCLE/OFF\n");
+    let c = cycle(&e[0]);
+    assert_eq!(
+        (c.kind, c.depth_mm, c.feed_start_mm, c.feed),
+        (CycleKind::Drill, Some(3.0), Some(5.0), None)
+    );
+    // APT: depth, feed unit, feed, rapid plane; inch values in mm.
+    let e = events("UNITS/INCHES\nCYCLE/BORE, 0.5, IPM, 4.0, 0.1\n");
+    let c = cycle(&e[1]);
+    assert_eq!(c.kind, CycleKind::Bore);
+    assert!((c.depth_mm.unwrap() - 12.7).abs() < 1e-12);
+    assert!((c.feed_start_mm.unwrap() - 2.54).abs() < 1e-12);
+    assert!((c.feed.unwrap().value - 101.6).abs() < 1e-12);
+    // Other orders and kinds are errors that say what is read.
+    for bad in [
+        "CYCLE/DRILL,5,100,MMPM\n",
+        "CYCLE/DRILL,5\n",
+        "CYCLE/DRILL,5,FOO,1,2\n",
+        "CYCLE/DRILL,5,MMPM,100\n",
+    ] {
+        let m = error(bad).message;
+        assert!(m.contains("depth, clearance"), "{bad}: {m}");
+    }
+    assert!(
+        error("CYCLE/DRILL,5,MMPM,0,2\n")
+            .message
+            .contains("positive")
+    );
+    let m = error("CYCLE/DEEP,5,2\n").message;
+    assert!(
+        m.contains("read for DRILL, FACE, BORE, REAM and CSINK only"),
+        "{m}"
+    );
 }
 
 #[test]

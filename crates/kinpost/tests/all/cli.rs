@@ -1350,3 +1350,74 @@ fn fk_and_ik_print_no_negative_zero() {
     ]);
     assert!(!ik.contains("-0.000000"), "{ik}");
 }
+
+/// CATIA V5's ISO 8859-1 APT source: an error at the first accented byte
+/// that names `--encoding latin1`; with it, the comments keep their accents
+/// and the positional `CYCLE/DRILL, 3.0, 5.0` holes post as G81. The
+/// virtual machine replays the program against the same CL with
+/// `--cl-encoding latin1`.
+#[test]
+fn a_latin1_catia_file_posts_with_its_encoding() {
+    let dir = crate::common::temp_dir("latin1");
+    let cl = root().join("data/cl/catia/PrepaFlans_Pointage.aptsource");
+    let cl = cl.to_str().unwrap();
+    let machine = root().join("crates/post/tests/machines/free3.toml");
+    let machine = machine.to_str().unwrap();
+    let o = run_in(&dir, &["post", cl, "-m", machine, "-d", "linuxcnc"]);
+    assert_exit(&o, 1);
+    let err = stderr(&o);
+    assert!(
+        err.contains("invalid UTF-8 (byte 0xE9)") && err.contains("--encoding latin1"),
+        "{err}"
+    );
+    assert!(err.contains("PrepaFlans_Pointage.aptsource:2:9"), "{err}");
+    let o = run_in(
+        &dir,
+        &[
+            "post",
+            cl,
+            "-m",
+            machine,
+            "-d",
+            "linuxcnc",
+            "--encoding",
+            "latin1",
+            "-o",
+            "p.ngc",
+        ],
+    );
+    assert_exit(&o, 0);
+    let program = std::fs::read_to_string(dir.join("p.ngc")).unwrap();
+    assert!(
+        program.contains("(Généré le jeudi 30 novembre 2023 08:46:00)"),
+        "{program}"
+    );
+    assert_eq!(program.matches("G99 G81 ").count(), 12, "{program}");
+    assert!(
+        program.contains("G99 G81 X98 Y100 Z17 R25 F300"),
+        "{program}"
+    );
+    let o = run_in(
+        &dir,
+        &[
+            "sim",
+            "p.ngc",
+            "-m",
+            machine,
+            "--cl",
+            cl,
+            "--cl-encoding",
+            "latin1",
+            "--json",
+            "r.json",
+        ],
+    );
+    assert_exit(&o, 0);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+    assert!(
+        report["max_position_error_mm"].as_f64().unwrap() < 0.001,
+        "{report}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

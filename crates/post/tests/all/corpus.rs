@@ -19,7 +19,8 @@ use kinpost_post::{InsertMode, PostOptions, post};
 
 /// The files, the machine each needs and whether it is in inches without
 /// saying so (NX information listings with `FEDRAT/IPM`).
-const CORPUS: [(&str, &str, bool); 24] = [
+const CORPUS: [(&str, &str, bool); 25] = [
+    ("catia/PrepaFlans_Pointage.aptsource", "free3", false),
     ("catia/peening.aptsource", "free5", false),
     ("creo/bohren_1.ncl.8", "free3", false),
     ("creo/profilfraesen_2.ncl.1", "free3", false),
@@ -46,6 +47,9 @@ const CORPUS: [(&str, &str, bool); 24] = [
     ("solidworks/shimemcunha.apt", "free5", false),
 ];
 
+/// The files in ISO 8859-1 (`--encoding latin1`).
+const LATIN1: [&str; 1] = ["catia/PrepaFlans_Pointage.aptsource"];
+
 /// Programs larger than this are fixed by digest, head and tail.
 const FULL_SNAPSHOT_BYTES: usize = 120_000;
 
@@ -68,7 +72,15 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 
 /// The program of `file` on its machine, and the post's warnings.
 fn post_file(file: &str, machine_name: &str, inch: bool) -> (String, Vec<String>) {
-    let cl = std::fs::read(root().join("data/cl").join(file)).unwrap();
+    let mut cl = std::fs::read(root().join("data/cl").join(file)).unwrap();
+    if LATIN1.contains(&file) {
+        // ISO 8859-1 is the first 256 code points: each byte its char.
+        cl = cl
+            .iter()
+            .map(|&b| char::from(b))
+            .collect::<String>()
+            .into_bytes();
+    }
     let options = PostOptions {
         cl_file: file.into(),
         lintol_mm: Some(0.01),
