@@ -83,6 +83,8 @@ pub struct Program<'a> {
     tool_loaded: bool,
     /// The tool changed to last (`None`: the header's, `tool_number`).
     spindle_tool: Option<u32>,
+    /// The length offset register in force (`G43 H`), once a tool is loaded.
+    length_register: Option<u32>,
     /// The first `MSYS` (origin and axes as written, mm) and its line:
     /// every point is posted in the machine file's part frame, so a later
     /// `MSYS` must not change it.
@@ -158,6 +160,7 @@ impl<'a> Program<'a> {
             uncompensated: Vec::new(),
             tool_loaded: false,
             spindle_tool: None,
+            length_register: None,
             msys: None,
             frame: None,
             modal: None,
@@ -458,20 +461,27 @@ impl<'a> Program<'a> {
     ) -> Result<(), PostError> {
         sink.break_segment();
         let register = adjust.unwrap_or(number);
+        let in_spindle = self
+            .spindle_tool
+            .or(self.info.tool_loaded.then_some(self.info.tool_number));
         if !self.tool_loaded && self.six_axis.is_none() {
             self.info.tool_number = number;
             self.info.tool_loaded = true;
             self.info.length_register = register;
-        } else if Some(number)
-            != self
-                .spindle_tool
-                .or(self.info.tool_loaded.then_some(self.info.tool_number))
+        } else if Some(number) != in_spindle
+            // The same tool with another length register (CATIA's
+            // `LOADTL/2` then `LOADTL/2,1`): the change again, so that the
+            // program's `G43 H` is the CL's.
+            || (adjust.is_some() && self.length_register != Some(register))
         {
             let tool = self.info.tool.clone();
             self.command(Command::ToolChange(number, tool, register), reader, sink)?;
             self.spindle_tool = Some(number);
+        } else {
+            return Ok(());
         }
         self.tool_loaded = true;
+        self.length_register = Some(register);
         Ok(())
     }
 

@@ -947,6 +947,22 @@ fn loading_the_tool_in_the_spindle_again_is_no_tool_change() {
 }
 
 #[test]
+fn the_same_tool_with_another_length_register_is_loaded_again() {
+    // CATIA V5: `LOADTL/2` at the tool change, `LOADTL/2,1` (tool 2, length
+    // register 1) at the operation: the program's G43 H follows the CL.
+    // The same register again, or the tool again without one, changes
+    // nothing.
+    let cl = "LOADTL/2\nRAPID\nGOTO/0,0,50,0,0,1\nLOADTL/2,1\nFEDRAT/MMPM,100\nGOTO/0,0,10\n\
+              LOADTL/2,1\nGOTO/10,0,10\nLOADTL/2\nGOTO/20,0,10\n";
+    let nc = post_trunnion(cl, "linuxcnc", kinpost_post::FeedMode::Tip).unwrap();
+    let lines: Vec<&str> = nc
+        .lines()
+        .filter(|l| l.contains("M6") || l.starts_with("G43"))
+        .collect();
+    assert_eq!(lines, ["T2 M6", "G43 H2", "T2 M6", "G43 H1"], "{nc}");
+}
+
+#[test]
 fn a_feed_the_dialect_cannot_write_names_its_cl_line() {
     // Fanuc's feed word has too few decimals for 0.0001 mm/min: F0.
     let cl = "RAPID\nGOTO/0,0,50,0,0,1\nFEDRAT/MMPM,0.0001\nGOTO/0,0,10\n";
