@@ -8,7 +8,7 @@ use kinpost_diag::Diagnostic;
 use super::motion::feed_unit;
 use super::{ClReader, Span};
 use crate::number::parse_number;
-use crate::{ClEvent, Cycle, CycleKind, Dwell};
+use crate::{ClEvent, Cycle, CycleKind, Dwell, Feed, FeedUnit};
 
 /// The positional forms read, for the error messages.
 const POSITIONAL: &str = "`depth, clearance` or `depth, IPM|MMPM|IPR|MMPR, feed, clearance`";
@@ -131,18 +131,7 @@ impl<R: BufRead> ClReader<R> {
                     cycle.full_retract_every = (n != 0).then_some(n);
                 }
                 unit => match feed_unit(unit) {
-                    Some(unit) => {
-                        if value <= 0.0 {
-                            return Err(self.error(
-                                value_span,
-                                format!(
-                                    "the cycle's feed rate must be positive, got `{}`",
-                                    self.field(value_span)
-                                ),
-                            ));
-                        }
-                        cycle.feed = Some(self.feed_mm(value, unit, key_span)?);
-                    }
+                    Some(unit) => cycle.feed = Some(self.cycle_feed(value_span, unit, key_span)?),
                     None => {
                         return Err(self.error(
                             key_span,
@@ -196,17 +185,7 @@ impl<R: BufRead> ClReader<R> {
                 let Some(unit_kind) = feed_unit(&self.word(unit)) else {
                     return Err(bad(self));
                 };
-                let value = self.number(feed)?;
-                if value <= 0.0 {
-                    return Err(self.error(
-                        feed,
-                        format!(
-                            "the cycle's feed rate must be positive, got `{}`",
-                            self.field(feed)
-                        ),
-                    ));
-                }
-                cycle.feed = Some(self.feed_mm(value, unit_kind, unit)?);
+                cycle.feed = Some(self.cycle_feed(feed, unit_kind, unit)?);
                 (depth, clearance)
             }
             _ => return Err(bad(self)),
@@ -214,5 +193,21 @@ impl<R: BufRead> ClReader<R> {
         cycle.depth_mm = Some(self.mm(self.number(depth)?).abs());
         cycle.feed_start_mm = Some(self.mm(self.number(clearance)?));
         Ok(())
+    }
+
+    /// A cycle's own feed: the number at `value` in `unit` (the word at
+    /// `unit_span`), which must be positive.
+    fn cycle_feed(&self, value: Span, unit: FeedUnit, unit_span: Span) -> Result<Feed, Diagnostic> {
+        let v = self.number(value)?;
+        if v <= 0.0 {
+            return Err(self.error(
+                value,
+                format!(
+                    "the cycle's feed rate must be positive, got `{}`",
+                    self.field(value)
+                ),
+            ));
+        }
+        self.feed_mm(v, unit, unit_span)
     }
 }
