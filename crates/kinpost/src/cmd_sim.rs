@@ -287,7 +287,9 @@ impl RemovalSetup {
             .transpose()?;
         let (stock, description) =
             crate::sim_stock::load_stock(stock, args.resolution, source.as_ref())?;
-        let design = source.as_ref().map(|s| s.design()).transpose()?;
+        let design = source
+            .map(crate::sim_stock::DesignSource::into_design)
+            .transpose()?;
         let mut cutting = Cutting::new(stock, tool);
         if let Some(model) = process {
             cutting = cutting.with_process(model);

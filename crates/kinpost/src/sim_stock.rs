@@ -298,16 +298,16 @@ impl DesignSource {
         })
     }
 
-    /// The design as the comparison measures it.
-    pub fn design(&self) -> Result<Design> {
+    /// The design as the comparison measures it (the mesh moves into it).
+    pub fn into_design(self) -> Result<Design> {
         Ok(match self {
-            DesignSource::Mesh(mesh) => Design::from_mesh(mesh.clone())?,
+            DesignSource::Mesh(mesh) => Design::from_mesh(mesh)?,
             DesignSource::Surface {
                 surface,
                 region,
                 flip,
                 chord_mm,
-            } => Design::from_surface_region(surface, *region, *chord_mm, *flip)?,
+            } => Design::from_surface_region(&surface, region, chord_mm, flip)?,
         })
     }
 }
