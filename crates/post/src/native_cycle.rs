@@ -160,6 +160,7 @@ pub fn fit(
         ..cycle.clone()
     };
     let mut moves = blocks[prefix..].iter();
+    let (mut want, mut rounded) = (row, out);
     for step in control.expand([hx, hy, top], [0.0, 0.0, 1.0], from) {
         let (motion, p) = match step {
             HoleStep::Rapid(p) => (Motion::Rapid, p),
@@ -167,11 +168,10 @@ pub fn fit(
             HoleStep::Dwell(_) | HoleStep::ReverseSpindle(_) => continue,
         };
         let b = moves.next()?;
-        let mut want = b.exact.to_vec();
+        want.copy_from_slice(b.exact);
         want[x] = p[0];
         want[y] = p[1];
         want[z] = p[2];
-        let mut rounded = vec![0.0; want.len()];
         round(&want, &mut rounded);
         if b.motion != motion || !same_point(b, axes, [rounded[x], rounded[y], rounded[z]]) {
             return None;
