@@ -36,11 +36,28 @@ fn main() {
         .unwrap();
     let last = (first + moves).min(poses.len() - 1);
     let (start, cpu0) = (Instant::now(), cpu_seconds());
+    let batch: usize = std::env::var("BATCH")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     pool.install(|| {
-        for i in first..last {
-            stock
-                .cut_move(&tool, &poses[i], &poses[i + 1], i as u32)
-                .unwrap();
+        if batch == 0 {
+            for i in first..last {
+                stock
+                    .cut_move(&tool, &poses[i], &poses[i + 1], i as u32)
+                    .unwrap();
+            }
+        } else {
+            let moves: Vec<kinpost_stock::Move> = (first..last)
+                .map(|i| kinpost_stock::Move {
+                    from: poses[i],
+                    to: poses[i + 1],
+                    id: i as u32,
+                })
+                .collect();
+            for chunk in moves.chunks(batch) {
+                stock.cut_moves(&tool, chunk).unwrap();
+            }
         }
     });
     let t = start.elapsed().as_secs_f64();

@@ -115,5 +115,7 @@ pub use process::{
     belt_speed_mm_s, calibrate,
 };
 pub use report::{BlockRef, GrindBlock, GrindingSummary, Report, ReportRegion};
-pub use stock::{CutError, Family, MoveCut, Removal, Stock, StockError, default_resolution};
+pub use stock::{
+    BatchError, CutError, Family, Move, MoveCut, Removal, Stock, StockError, default_resolution,
+};
 pub use tool::{Piece, PlacedTool, Shank, Tool, ToolError, ToolPose};

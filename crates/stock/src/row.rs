@@ -770,10 +770,13 @@ pub(crate) struct Scratch {
     first: Vec<f64>,
     last: Vec<f64>,
     m: Vec<f64>,
+    /// The move whose span set m (its place in the batch, from 1, as an
+    /// exact float); 0 while m is the ray's top.
+    ms: Vec<f64>,
     /// Rays with a span that meets the material but ends below its top.
     split: Vec<bool>,
-    /// The spans that end inside their ray's material.
-    found: Vec<(u32, Span)>,
+    /// The spans that end inside their ray's material: ray, move, span.
+    found: Vec<(u32, u32, Span)>,
     spans: Vec<Span>,
 }
 
@@ -784,6 +787,8 @@ pub(crate) struct Active {
     pub solid: usize,
     pub a: usize,
     pub b: usize,
+    /// The solid's move: its place in the batch, from 1.
+    pub seq: u32,
 }
 
 /// What [`cut_row`] needs of the solids: the prepared kernels, each
@@ -805,7 +810,7 @@ pub(crate) fn cut_row(
     row: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
-    id: u32,
+    ids: &[u32],
     scratch: &mut Scratch,
 ) {
     #[cfg(target_arch = "x86_64")]
@@ -813,11 +818,11 @@ pub(crate) fn cut_row(
         if !portable_forced() && std::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2 (checked just above), the one
             // requirement of `cut_row_avx2`.
-            unsafe { cut_row_avx2(frame, row, active, solids, id, scratch) };
+            unsafe { cut_row_avx2(frame, row, active, solids, ids, scratch) };
             return;
         }
     }
-    cut_row_any(frame, row, active, solids, id, scratch);
+    cut_row_any(frame, row, active, solids, ids, scratch);
 }
 
 /// Tests can force the portable path, to check it on processors with AVX2.
@@ -846,10 +851,10 @@ fn cut_row_avx2(
     row: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
-    id: u32,
+    ids: &[u32],
     scratch: &mut Scratch,
 ) {
-    cut_row_any(frame, row, active, solids, id, scratch);
+    cut_row_any(frame, row, active, solids, ids, scratch);
 }
 
 #[inline(always)]
@@ -858,13 +863,13 @@ fn cut_row_any(
     row: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
-    id: u32,
+    ids: &[u32],
     scratch: &mut Scratch,
 ) {
     match frame.k {
-        0 => cut_row_k::<0, 1, 2>(frame, row, active, solids, id, scratch),
-        1 => cut_row_k::<1, 0, 2>(frame, row, active, solids, id, scratch),
-        _ => cut_row_k::<2, 0, 1>(frame, row, active, solids, id, scratch),
+        0 => cut_row_k::<0, 1, 2>(frame, row, active, solids, ids, scratch),
+        1 => cut_row_k::<1, 0, 2>(frame, row, active, solids, ids, scratch),
+        _ => cut_row_k::<2, 0, 1>(frame, row, active, solids, ids, scratch),
     }
 }
 
@@ -876,35 +881,47 @@ fn sweep<Kn: Kernel>(
     kern: &Kn,
     (j0, j1): (usize, usize),
     (lo_k, hi_k): (f64, f64),
+    seq: u32,
     sc: &mut Scratch,
 ) -> bool {
     let lane = F(std::array::from_fn(|i| i as f64));
     let (lo_k, hi_k) = (s(lo_k), s(hi_k));
     let mut any_split = false;
-    // Whole segments first, from either end, in doubling steps while they
-    // are certainly above their levels; then the rest four rays at a time.
-    // [j0, end) is what is left.
+    // Whole segments first, from either end, while they are certainly
+    // above their levels: steps that double while segments are skipped and
+    // halve (down to two chunks) when one is not. Then the rest four rays
+    // at a time. [j0, end) is what is left. A segment's level is the float
+    // after its largest m: its spans start strictly above every level in
+    // it, so none lowers one, whichever move set it.
     let (mut j0, mut end) = (j0, j1 + 1);
     let seg_max = |sc: &Scratch, a: usize, b: usize| {
-        sc.m[a..b].iter().fold(f64::NEG_INFINITY, |x, &y| x.max(y))
+        sc.m[a..b]
+            .iter()
+            .fold(f64::NEG_INFINITY, |x, &y| x.max(y))
+            .next_up()
     };
-    let mut step = 2 * W;
-    while j0 + step <= end
-        && kern.segment_skips(sc.pu[j0], sc.pu[j0 + step - 1], seg_max(sc, j0, j0 + step))
-    {
-        j0 += step;
-        step *= 2;
+    let (mut step, mut grow) = (2 * W, true);
+    while step >= 2 * W && j0 + step <= end {
+        if kern.segment_skips(sc.pu[j0], sc.pu[j0 + step - 1], seg_max(sc, j0, j0 + step)) {
+            j0 += step;
+            if grow {
+                step *= 2;
+            }
+        } else {
+            (step, grow) = (step / 2, false);
+        }
     }
-    step = 2 * W;
-    while end >= j0 + step
-        && kern.segment_skips(
-            sc.pu[end - step],
-            sc.pu[end - 1],
-            seg_max(sc, end - step, end),
-        )
-    {
-        end -= step;
-        step *= 2;
+    (step, grow) = (2 * W, true);
+    while step >= 2 * W && end >= j0 + step {
+        let (a, b) = (end - step, end);
+        if kern.segment_skips(sc.pu[a], sc.pu[b - 1], seg_max(sc, a, b)) {
+            end = a;
+            if grow {
+                step *= 2;
+            }
+        } else {
+            (step, grow) = (step / 2, false);
+        }
     }
     if end <= j0 {
         return false;
@@ -912,6 +929,7 @@ fn sweep<Kn: Kernel>(
     let j1 = end - 1;
     let j0f = s(j0 as f64);
     let j1f = s(j1 as f64);
+    let seqf = s(f64::from(seq));
     let mut base = j0 / W * W;
     while base <= j1 {
         let idx = s(base as f64) + lane;
@@ -921,13 +939,23 @@ fn sweep<Kn: Kernel>(
         let gate = idx.ge(j0f) & idx.le(j1f) & !(hi_k.le(first) | lo_k.ge(last));
         if gate.any() {
             let m = F::load(&sc.m, base);
-            let (need, span) = kern.chunk(F::load(&sc.pu, base), m, gate);
+            let ms = F::load(&sc.ms, base);
+            // A move before the one that set m lowers it only from strictly
+            // below: of two moves that reach the same level, the first makes
+            // the end (and names it), as when they are cut one by one.
+            let earlier = seqf.lt(ms);
+            let level = if earlier.any() {
+                earlier.select(m.next_up(), m)
+            } else {
+                m
+            };
+            let (need, span) = kern.chunk(F::load(&sc.pu, base), level, gate);
             let keep = need & span.some;
             if keep.any() {
                 let reach = keep & span.hi.ge(last);
-                (reach & span.lo.lt(m))
-                    .select(span.lo, m)
-                    .store(&mut sc.m, base);
+                let lower = reach & (span.lo.lt(m) | (span.lo.eq(m) & earlier));
+                lower.select(span.lo, m).store(&mut sc.m, base);
+                lower.select(seqf, ms).store(&mut sc.ms, base);
                 // Spans that end inside the material are kept for their
                 // ray; the others are all summed up by m.
                 let split = keep & !span.hi.ge(last) & span.hi.gt(first);
@@ -937,6 +965,7 @@ fn sweep<Kn: Kernel>(
                         if split.lane(i) {
                             sc.found.push((
                                 (base + i) as u32,
+                                seq,
                                 Span {
                                     lo: span.lo.0[i],
                                     hi: span.hi.0[i],
@@ -959,7 +988,7 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     row: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
-    id: u32,
+    ids: &[u32],
     sc: &mut Scratch,
 ) {
     let Some(a_min) = active.iter().map(|s| s.a).min() else {
@@ -988,6 +1017,8 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     sc.last.resize(padded, f64::NEG_INFINITY);
     sc.m.clear();
     sc.m.extend_from_slice(&sc.last);
+    sc.ms.clear();
+    sc.ms.resize(padded, 0.0);
     sc.split.clear();
     sc.split.resize(padded, false);
     sc.found.clear();
@@ -1006,6 +1037,7 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                 &CylinderKernel::<K, U, V>::new(origin, axis, z0, z1, r, pv),
                 range,
                 along,
+                act.seq,
                 sc,
             ),
             RowSolid::Sphere {
@@ -1021,7 +1053,7 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                     dz: s(dz),
                     a: s(1.0 - dz * dz + dz * dz),
                 };
-                sweep(&kern, range, along, sc)
+                sweep(&kern, range, along, act.seq, sc)
             }
             RowSolid::Capsule(ref k) => {
                 let kern = CapsuleKernel::<K, U, V> {
@@ -1035,7 +1067,7 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                     rr: s(k.r * k.r),
                     a: s(k.a),
                 };
-                sweep(&kern, range, along, sc)
+                sweep(&kern, range, along, act.seq, sc)
             }
             RowSolid::Other => {
                 let kern = ScalarKernel {
@@ -1043,39 +1075,60 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                     solid: act.solid,
                     pv,
                 };
-                sweep(&kern, range, along, sc)
+                sweep(&kern, range, along, act.seq, sc)
             }
         };
     }
     for j in 0..n {
         if !sc.split[j] && sc.m[j] < sc.last[j] {
             // Every span that met the material reached its top.
-            cut_top(&mut row[a_min + j], sc.m[j], id);
+            cut_top(&mut row[a_min + j], sc.m[j], ids[sc.ms[j] as usize]);
         }
     }
     if !any_split {
         return;
     }
-    // Rays with a span that ends inside the material: the union of those
-    // spans and of [m, +∞), which within the material is the union of the
-    // spans that reach the top (those skipped add nothing there), as the
-    // reference subtracts it.
-    sc.found.sort_by_key(|&(j, _)| j);
+    // Rays with a span that ends inside the material: move by move, the
+    // union of that move's such spans, and [m, +∞) for the move that set m.
+    // Within the material this is what the reference subtracts move by
+    // move: every span that reaches the top starts at or above m, so only
+    // the first move to reach m leaves an end below it (module doc).
+    sc.found.sort_by_key(|&(j, seq, _)| (j, seq));
     let mut i = 0;
     while i < sc.found.len() {
         let j = sc.found[i].0 as usize;
-        sc.spans.clear();
+        let top = (sc.m[j] < sc.last[j]).then_some((sc.ms[j] as u32, sc.m[j]));
+        let mut top_done = top.is_none();
         while i < sc.found.len() && sc.found[i].0 as usize == j {
-            sc.spans.push(sc.found[i].1);
-            i += 1;
+            let seq = sc.found[i].1;
+            if let Some((ms, m)) = top
+                && !top_done
+                && ms < seq
+            {
+                subtract(&mut row[a_min + j], m, f64::INFINITY, ids[ms as usize]);
+                top_done = true;
+            }
+            sc.spans.clear();
+            while i < sc.found.len() && sc.found[i].0 as usize == j && sc.found[i].1 == seq {
+                sc.spans.push(sc.found[i].2);
+                i += 1;
+            }
+            if let Some((ms, m)) = top
+                && ms == seq
+            {
+                sc.spans.push(Span {
+                    lo: m,
+                    hi: f64::INFINITY,
+                });
+                top_done = true;
+            }
+            remove_spans(&mut row[a_min + j], &mut sc.spans, ids[seq as usize]);
         }
-        if sc.m[j] < sc.last[j] {
-            sc.spans.push(Span {
-                lo: sc.m[j],
-                hi: f64::INFINITY,
-            });
+        if let Some((ms, m)) = top
+            && !top_done
+        {
+            subtract(&mut row[a_min + j], m, f64::INFINITY, ids[ms as usize]);
         }
-        remove_spans(&mut row[a_min + j], &mut sc.spans, id);
     }
 }
 

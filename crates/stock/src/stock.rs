@@ -109,6 +109,29 @@ pub struct Stock {
     removal: Removal,
 }
 
+/// One move of a batch ([`Stock::cut_moves`]): the tool from one pose to
+/// the next, as move `id`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Move {
+    /// The start pose.
+    pub from: ToolPose,
+    /// The end pose.
+    pub to: ToolPose,
+    /// The move's id: the interval ends it makes remember it.
+    pub id: u32,
+}
+
+/// A move of a batch that could not be cut (the moves before it were).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("move {index} of the batch: {source}")]
+pub struct BatchError {
+    /// The move's place in the batch.
+    pub index: usize,
+    /// Why it could not be cut.
+    #[source]
+    pub source: CutError,
+}
+
 /// How a move was cut.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct MoveCut {
@@ -161,6 +184,8 @@ struct Bounded {
     solid: Solid,
     lo: [f64; 3],
     hi: [f64; 3],
+    /// The solid's move: its place in the batch being cut, from 1.
+    seq: u32,
 }
 
 impl Bounded {
@@ -217,7 +242,7 @@ impl Bounded {
     }
 }
 
-fn placed_solids(t: &PlacedTool, boxed: &Aabb, out: &mut Vec<Bounded>) {
+fn placed_solids(t: &PlacedTool, boxed: &Aabb, seq: u32, out: &mut Vec<Bounded>) {
     for p in &t.pieces {
         if let Some((lo, hi)) = piece_in_box(p, &t.origin, &t.axis, boxed) {
             out.push(Bounded {
@@ -228,6 +253,7 @@ fn placed_solids(t: &PlacedTool, boxed: &Aabb, out: &mut Vec<Bounded>) {
                 },
                 lo,
                 hi,
+                seq,
             });
         }
     }
@@ -460,8 +486,8 @@ impl Stock {
     pub fn cut_pose(&mut self, tool: &Tool, pose: &ToolPose, move_id: u32) -> Result<(), CutError> {
         let placed = tool.place(pose)?;
         let mut solids = Vec::new();
-        placed_solids(&placed, &self.lattice_box(), &mut solids);
-        self.remove(&solids, move_id);
+        placed_solids(&placed, &self.lattice_box(), 1, &mut solids);
+        self.remove(&solids, &[UNCUT, move_id]);
         self.last = Some((*tool, *pose));
         Ok(())
     }
@@ -492,6 +518,74 @@ impl Stock {
         to: &ToolPose,
         move_id: u32,
     ) -> Result<MoveCut, CutError> {
+        let mut solids = Vec::new();
+        let cut = self.move_solids(tool, from, to, 1, &mut solids)?;
+        self.remove(&solids, &[UNCUT, move_id]);
+        self.last = Some((*tool, *to));
+        Ok(cut)
+    }
+
+    /// Cuts the moves in order: the stock [`Stock::cut_move`] called on
+    /// each would give, bit for bit (every interval end and the move that
+    /// made it), in one visit of the rays instead of one a move. Consecutive
+    /// moves over the same part of the stock are cut together: a ray's
+    /// level is found once for all of them, and the threads share rows of a
+    /// whole batch rather than of one short move. (Moves spread far apart
+    /// are cut in several visits, so a visit's rows stay those the tools
+    /// cover.)
+    ///
+    /// Returns how each move was cut. A move that cannot be cut is an
+    /// error naming it; the moves before it are cut, as one by one.
+    pub fn cut_moves(&mut self, tool: &Tool, moves: &[Move]) -> Result<Vec<MoveCut>, BatchError> {
+        let mut cuts = Vec::with_capacity(moves.len());
+        let mut solids: Vec<Bounded> = Vec::new();
+        let mut fresh: Vec<Bounded> = Vec::new();
+        let mut ids = vec![UNCUT];
+        let mut spread = Spread::default();
+        let h = self.resolution;
+        for (index, m) in moves.iter().enumerate() {
+            fresh.clear();
+            let seq = u32::try_from(ids.len()).unwrap_or(u32::MAX);
+            let cut = match self.move_solids(tool, &m.from, &m.to, seq, &mut fresh) {
+                Ok(cut) => cut,
+                Err(source) => {
+                    self.remove(&solids, &ids);
+                    return Err(BatchError { index, source });
+                }
+            };
+            cuts.push(cut);
+            if let Some(b) = solids_bounds(&fresh)
+                && (!spread.admits(&b, h) || ids.len() >= u32::MAX as usize)
+            {
+                // Cut what is gathered; this move starts the next visit.
+                self.remove(&solids, &ids);
+                solids.clear();
+                ids.truncate(1);
+                spread = Spread::default();
+                spread.admits(&b, h);
+                for f in &mut fresh {
+                    f.seq = 1;
+                }
+            }
+            solids.append(&mut fresh);
+            ids.push(m.id);
+            self.last = Some((*tool, m.to));
+        }
+        self.remove(&solids, &ids);
+        Ok(cuts)
+    }
+
+    /// The solids that sweep the tool from one pose to the next, as move
+    /// `seq` of a batch (appended to `solids`); the start pose is left out
+    /// when it is the last pose cut with the same tool.
+    fn move_solids(
+        &self,
+        tool: &Tool,
+        from: &ToolPose,
+        to: &ToolPose,
+        seq: u32,
+        solids: &mut Vec<Bounded>,
+    ) -> Result<MoveCut, CutError> {
         let p0 = tool.place(from)?;
         let p1 = tool.place(to)?;
         let start_done = self
@@ -503,7 +597,6 @@ impl Stock {
         // angle change) still translates.
         let same_axis = (p0.axis - p1.axis).norm() <= SAME_AXIS;
         let step = SAMPLE_STEP_FRACTION * self.resolution;
-        let mut solids = Vec::new();
         let mut samples = 0u64;
         let boxed = self.lattice_box();
         let result = if same_axis {
@@ -519,6 +612,7 @@ impl Stock {
                                 solid: Solid::Capsule { c0, v, r },
                                 lo,
                                 hi,
+                                seq,
                             });
                         }
                     }
@@ -537,6 +631,7 @@ impl Stock {
                                 },
                                 lo,
                                 hi,
+                                seq,
                             });
                         }
                     }
@@ -557,6 +652,7 @@ impl Stock {
                                     },
                                     lo,
                                     hi,
+                                    seq,
                                 });
                             }
                         }
@@ -601,15 +697,13 @@ impl Stock {
                     continue;
                 }
                 let pose = interpolate(from, to, i as f64 / n as f64).ok_or(CutError::HalfTurn)?;
-                placed_solids(&tool.place(&pose)?, &boxed, &mut solids);
+                placed_solids(&tool.place(&pose)?, &boxed, seq, solids);
             }
             MoveCut {
                 samples: n + 1 - u64::from(start_done),
                 analytic: false,
             }
         };
-        self.remove(&solids, move_id);
-        self.last = Some((*tool, *to));
         Ok(result)
     }
 
@@ -620,20 +714,33 @@ impl Stock {
             [] => Ok(()),
             [p] => self.cut_pose(tool, p, move_id),
             _ => {
-                for w in poses.windows(2) {
-                    self.cut_move(tool, &w[0], &w[1], move_id)?;
-                }
-                Ok(())
+                let moves: Vec<Move> = poses
+                    .windows(2)
+                    .map(|w| Move {
+                        from: w[0],
+                        to: w[1],
+                        id: move_id,
+                    })
+                    .collect();
+                self.cut_moves(tool, &moves)
+                    .map(|_| ())
+                    .map_err(|e| e.source)
             }
         }
     }
 
     /// Subtracts the union of the solids from every ray that crosses their
     /// bounds, by the chosen [`Removal`].
-    fn remove(&mut self, solids: &[Bounded], id: u32) {
+    /// `ids[seq]` is the id of the batch's move `seq` (`ids[0]` unused).
+    fn remove(&mut self, solids: &[Bounded], ids: &[u32]) {
         match self.removal {
-            Removal::Fast => self.remove_fast(solids, id),
-            Removal::Reference => self.remove_reference(solids, id),
+            Removal::Fast => self.remove_fast(solids, ids),
+            Removal::Reference => {
+                // Move by move (a move's solids are consecutive).
+                for group in solids.chunk_by(|a, b| a.seq == b.seq) {
+                    self.remove_reference(group, ids[group[0].seq as usize]);
+                }
+            }
         }
     }
 
@@ -720,10 +827,11 @@ impl Stock {
     /// span found that reaches the top), ray by ray or a whole row segment
     /// at once. The reasons, and why this changes no bit, are in the
     /// `row` module's doc.
-    fn remove_fast(&mut self, solids: &[Bounded], id: u32) {
+    fn remove_fast(&mut self, solids: &[Bounded], ids: &[u32]) {
         let Some((lo, hi)) = solids_bounds(solids) else {
             return;
         };
+        let order = visit_order(solids.len());
         let (origin, h, counts) = (self.origin, self.resolution, self.counts);
         // The three families at once (their rays are apart), each by rows.
         self.families.par_iter_mut().for_each(|f| {
@@ -774,15 +882,21 @@ impl Stock {
                         // the rays within their bounds (the reference's test
                         // lo ≤ pu ≤ hi; pu grows with the index).
                         active.clear();
-                        for (si, s) in solids.iter().enumerate().rev() {
+                        for &si in &order {
+                            let s = &solids[si];
                             if frame.pv < s.lo[v] || frame.pv > s.hi[v] {
                                 continue;
                             }
                             if let Some((a, b)) = rays_within(&pu_at, u0, u1, s.lo[u], s.hi[u]) {
-                                active.push(Active { solid: si, a, b });
+                                active.push(Active {
+                                    solid: si,
+                                    a,
+                                    b,
+                                    seq: s.seq,
+                                });
                             }
                         }
-                        cut_row(&frame, row, active, &row_solids, id, scratch);
+                        cut_row(&frame, row, active, &row_solids, ids, scratch);
                     })
                 });
         });
@@ -792,6 +906,64 @@ impl Stock {
 thread_local! {
     /// Each thread's buffers for the rows it cuts, kept from move to move.
     static SCRATCH: std::cell::RefCell<(Vec<Active>, Scratch)> = Default::default();
+}
+
+/// The order the fast removal visits `n` solids in: the last first (on most
+/// rays it meets, the most advanced sample of a batch is the deepest), then
+/// back through the batch halving the stride (the van der Corput order of
+/// the distance from the last: n−1, n−1−2^k, n−1−2^(k−1), ...), so that
+/// every ray soon meets a solid near its deepest and most later ones are
+/// skipped, a whole row segment at once.
+fn visit_order(n: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&i| ((n - 1 - i) as u64).reverse_bits());
+    order
+}
+
+/// How far a batch of moves spreads: the union of its moves' bounds and
+/// the sum of their areas as each family of rays sees them (the rays a
+/// visit sets up against those the tools cover).
+#[derive(Default)]
+struct Spread {
+    union: Option<([f64; 3], [f64; 3])>,
+    areas: [f64; 3],
+}
+
+impl Spread {
+    /// Rays a visit may set up per ray a tool covers, family by family,
+    /// before a batch is cut in two visits.
+    const MAX_RATIO: f64 = 4.0;
+
+    /// Adds a move's bounds when the batch then stays compact (or is
+    /// empty); `false` (nothing added) when it would spread too thin.
+    fn admits(&mut self, b: &([f64; 3], [f64; 3]), h: f64) -> bool {
+        // Each family's area (across its rays), with a ray's spacing added
+        // so that a flat box counts the rays it meets.
+        let area = |lo: &[f64; 3], hi: &[f64; 3]| -> [f64; 3] {
+            std::array::from_fn(|k| {
+                let (u, v) = ((k + 1) % 3, (k + 2) % 3);
+                (hi[u] - lo[u] + h) * (hi[v] - lo[v] + h)
+            })
+        };
+        let mine = area(&b.0, &b.1);
+        let Some(u) = self.union else {
+            self.union = Some(*b);
+            self.areas = mine;
+            return true;
+        };
+        let joined: ([f64; 3], [f64; 3]) = (
+            std::array::from_fn(|i| u.0[i].min(b.0[i])),
+            std::array::from_fn(|i| u.1[i].max(b.1[i])),
+        );
+        let whole = area(&joined.0, &joined.1);
+        let sums: [f64; 3] = std::array::from_fn(|k| self.areas[k] + mine[k]);
+        if (0..3).any(|k| !(whole[k] <= Self::MAX_RATIO * sums[k])) {
+            return false;
+        }
+        self.union = Some(joined);
+        self.areas = sums;
+        true
+    }
 }
 
 /// The union of the solids' bounds.

@@ -10,7 +10,7 @@
 //! branches of the kernels), translations (swept exactly), five-axis moves
 //! (sampled) and single poses.
 
-use kinpost_stock::{Removal, Stock, Tool, ToolPose};
+use kinpost_stock::{Move as Batched, Removal, Stock, Tool, ToolPose};
 use nalgebra::{Point3, Vector3};
 use proptest::prelude::*;
 
@@ -197,6 +197,45 @@ fn run(case: &Case, removal: Removal) -> Vec<u8> {
     bytes(&s)
 }
 
+/// The first half of the moves as [`run`]; then the rest, with ids from
+/// `ids` (repeated and out of order), one by one with the reference path
+/// (`batch` false) or as one batch with `removal`, up to the first move
+/// that cannot be cut (a single pose is a move to itself).
+fn run_rest(case: &Case, ids: &[u32], batch: Option<Removal>) -> Vec<u8> {
+    let mut s = Stock::from_box(case.lo, case.lo + case.size, case.h).unwrap();
+    s.set_removal(Removal::Reference);
+    let half = case.moves.len() / 2;
+    for (i, m) in case.moves[..half].iter().enumerate() {
+        let _ = match m.to {
+            Some(to) => s.cut_move(&case.tool, &m.from, &to, i as u32).map(|_| ()),
+            None => s.cut_pose(&case.tool, &m.from, i as u32),
+        };
+    }
+    let rest: Vec<Batched> = case.moves[half..]
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Batched {
+            from: m.from,
+            to: m.to.unwrap_or(m.from),
+            id: ids[i % ids.len()],
+        })
+        .collect();
+    match batch {
+        Some(removal) => {
+            s.set_removal(removal);
+            let _ = s.cut_moves(&case.tool, &rest);
+        }
+        None => {
+            for m in &rest {
+                if s.cut_move(&case.tool, &m.from, &m.to, m.id).is_err() {
+                    break;
+                }
+            }
+        }
+    }
+    bytes(&s)
+}
+
 fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -216,6 +255,18 @@ proptest! {
     }
 
     #[test]
+    fn a_batch_of_moves_gives_the_stock_of_its_moves_one_by_one(
+        case in case_strategy(),
+        ids in prop::collection::vec(0u32..4, 1..4),
+    ) {
+        let one_by_one = run_rest(&case, &ids, None);
+        for removal in [Removal::Fast, Removal::Reference] {
+            let batch = run_rest(&case, &ids, Some(removal));
+            prop_assert!(batch == one_by_one, "the {removal:?} batch differs");
+        }
+    }
+
+    #[test]
     fn the_fast_removal_gives_the_same_bytes_for_1_2_and_4_threads(case in case_strategy()) {
         let one = in_pool(1, || run(&case, Removal::Fast));
         for n in [2, 4] {
@@ -230,7 +281,7 @@ proptest! {
 /// consecutive moves on one stock, fast against reference.
 #[test]
 fn consecutive_wheel_and_ball_moves_match_the_reference() {
-    let run = |removal: Removal| {
+    let run = |removal: Removal, batched: bool| {
         let mut s = Stock::from_box(
             Point3::new(0.0, 0.0, 0.0),
             Point3::new(30.0, 12.0, 6.0),
@@ -261,14 +312,95 @@ fn consecutive_wheel_and_ball_moves_match_the_reference() {
                         ToolPose::new(Point3::new(x, y, z), axis).with_reference(Vector3::x())
                     })
                     .collect();
-                for w in poses.windows(2) {
-                    s.cut_move(&tool, &w[0], &w[1], id).unwrap();
-                    id += 1;
+                if batched {
+                    let moves: Vec<Batched> = poses
+                        .windows(2)
+                        .enumerate()
+                        .map(|(i, w)| Batched {
+                            from: w[0],
+                            to: w[1],
+                            id: id + i as u32,
+                        })
+                        .collect();
+                    s.cut_moves(&tool, &moves).unwrap();
+                    id += moves.len() as u32;
+                } else {
+                    for w in poses.windows(2) {
+                        s.cut_move(&tool, &w[0], &w[1], id).unwrap();
+                        id += 1;
+                    }
                 }
             }
         }
         bytes(&s)
     };
-    let reference = run(Removal::Reference);
-    assert!(reference == run(Removal::Fast));
+    let reference = run(Removal::Reference, false);
+    assert!(reference == run(Removal::Fast, false), "one by one");
+    assert!(reference == run(Removal::Fast, true), "in batches");
+    assert!(
+        reference == run(Removal::Reference, true),
+        "in batches, reference"
+    );
+}
+
+/// Moves that cut exactly the same spans (the same move again under
+/// another id, the later visited first): the first move makes the ends and
+/// names them, as one by one.
+#[test]
+fn the_first_of_two_equal_moves_names_the_ends_in_a_batch() {
+    let wheel = Tool::ContactWheel {
+        radius: 10.0,
+        width: 4.0,
+        edge_radius: 0.0,
+    };
+    let ball = Tool::BallEnd {
+        diameter: 2.0,
+        flute_length: 8.0,
+        shank: None,
+    };
+    let a = ToolPose::new(Point3::new(3.0, 4.0, 4.7), Vector3::new(0.0, -0.01, 1.0))
+        .with_reference(Vector3::x());
+    let b = ToolPose::new(Point3::new(9.0, 4.2, 4.6), Vector3::new(0.0, 0.01, 1.0))
+        .with_reference(Vector3::x());
+    let c = ToolPose::new(Point3::new(9.0, 4.2, 4.6), Vector3::new(0.0, 0.0, 1.0))
+        .with_reference(Vector3::x());
+    for tool in [wheel, ball] {
+        for (from, to) in [(a, b), (a, c)] {
+            let moves = [
+                Batched { from, to, id: 5 },
+                Batched { from, to, id: 7 },
+                Batched {
+                    from: to,
+                    to: from,
+                    id: 9,
+                },
+                Batched { from, to, id: 11 },
+            ];
+            let stock = || {
+                Stock::from_box(Point3::new(0.0, 0.0, 0.0), Point3::new(12.0, 8.0, 5.0), 0.1)
+                    .unwrap()
+            };
+            let mut one = stock();
+            one.set_removal(Removal::Reference);
+            for m in &moves {
+                one.cut_move(&tool, &m.from, &m.to, m.id).unwrap();
+            }
+            for removal in [Removal::Fast, Removal::Reference] {
+                let mut batch = stock();
+                batch.set_removal(removal);
+                batch.cut_moves(&tool, &moves).unwrap();
+                assert!(bytes(&batch) == bytes(&one), "{tool:?} {removal:?}");
+            }
+            // The ends below the tool are move 5's (or 9's, where the way
+            // back cut deeper), never 7's or 11's.
+            let z = one.family(2);
+            let named: std::collections::BTreeSet<u32> = z
+                .rays
+                .iter()
+                .filter_map(|r| r.last().map(|s| s.hi_move))
+                .collect();
+            assert!(named.contains(&5), "{named:?}");
+            assert!(!named.contains(&7) && !named.contains(&11), "{named:?}");
+        }
+    }
 }
