@@ -773,7 +773,12 @@ pub(crate) struct Scratch {
     /// The move whose span set m (its place in the batch, from 1, as an
     /// exact float); 0 while m is the ray's top.
     ms: Vec<f64>,
-    /// Rays with a span that meets the material but ends below its top.
+    /// The bottom level: the material's start, raised to the end of every
+    /// span found that starts at or below it (and ends below the top).
+    mb: Vec<f64>,
+    /// The move that set mb, as `ms`.
+    mbs: Vec<f64>,
+    /// Rays with a span that ends inside their material.
     split: Vec<bool>,
     /// The spans that end inside their ray's material: ray, move, span.
     found: Vec<(u32, u32, Span)>,
@@ -956,9 +961,23 @@ fn sweep<Kn: Kernel>(
                 let lower = reach & (span.lo.lt(m) | (span.lo.eq(m) & earlier));
                 lower.select(span.lo, m).store(&mut sc.m, base);
                 lower.select(seqf, ms).store(&mut sc.ms, base);
-                // Spans that end inside the material are kept for their
-                // ray; the others are all summed up by m.
-                let split = keep & !span.hi.ge(last) & span.hi.gt(first);
+                // Spans that meet the material below its top: those from
+                // below its bottom are summed up by mb, as the others by m
+                // (mirrored); those that end inside it are kept for their
+                // ray.
+                let rest = keep & !reach & span.hi.gt(first);
+                if !rest.any() {
+                    base += W;
+                    continue;
+                }
+                let bottom = rest & span.lo.le(first);
+                if bottom.any() {
+                    let (mb, mbs) = (F::load(&sc.mb, base), F::load(&sc.mbs, base));
+                    let raise = bottom & (span.hi.gt(mb) | (span.hi.eq(mb) & seqf.lt(mbs)));
+                    raise.select(span.hi, mb).store(&mut sc.mb, base);
+                    raise.select(seqf, mbs).store(&mut sc.mbs, base);
+                }
+                let split = rest & !bottom;
                 if split.any() {
                     any_split = true;
                     for i in 0..W {
@@ -1019,6 +1038,10 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     sc.m.extend_from_slice(&sc.last);
     sc.ms.clear();
     sc.ms.resize(padded, 0.0);
+    sc.mb.clear();
+    sc.mb.extend_from_slice(&sc.first);
+    sc.mbs.clear();
+    sc.mbs.resize(padded, 0.0);
     sc.split.clear();
     sc.split.resize(padded, false);
     sc.found.clear();
@@ -1080,8 +1103,20 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
         };
     }
     for j in 0..n {
-        if !sc.split[j] && sc.m[j] < sc.last[j] {
-            // Every span that met the material reached its top.
+        if sc.split[j] {
+            continue;
+        }
+        // Every span that met the material reached its bottom or its top.
+        // (The two cuts commute: each removes all beyond its level.)
+        if sc.mb[j] > sc.first[j] {
+            subtract(
+                &mut row[a_min + j],
+                f64::NEG_INFINITY,
+                sc.mb[j],
+                ids[sc.mbs[j] as usize],
+            );
+        }
+        if sc.m[j] < sc.last[j] {
             cut_top(&mut row[a_min + j], sc.m[j], ids[sc.ms[j] as usize]);
         }
     }
@@ -1089,46 +1124,48 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
         return;
     }
     // Rays with a span that ends inside the material: move by move, the
-    // union of that move's such spans, and [m, +∞) for the move that set m.
-    // Within the material this is what the reference subtracts move by
-    // move: every span that reaches the top starts at or above m, so only
-    // the first move to reach m leaves an end below it (module doc).
-    sc.found.sort_by_key(|&(j, seq, _)| (j, seq));
+    // union of that move's such spans, with (−∞, mb] for the move that set
+    // mb and [m, +∞) for the one that set m. Within the material this is
+    // what the reference subtracts move by move: every span that reaches
+    // the top starts at or above m, so only the first move to reach m
+    // leaves an end at m, and the same below mb (module doc).
+    let n_found = sc.found.len();
+    for f in 0..n_found {
+        let j = sc.found[f].0 as usize;
+        if sc.split[j] {
+            // Each split ray's two levels, once.
+            sc.split[j] = false;
+            if sc.m[j] < sc.last[j] {
+                let span = Span {
+                    lo: sc.m[j],
+                    hi: f64::INFINITY,
+                };
+                sc.found.push((j as u32, sc.ms[j] as u32, span));
+            }
+            if sc.mb[j] > sc.first[j] {
+                let span = Span {
+                    lo: f64::NEG_INFINITY,
+                    hi: sc.mb[j],
+                };
+                sc.found.push((j as u32, sc.mbs[j] as u32, span));
+            }
+        }
+    }
+    // (Spans of one ray and one move are united: their order is free.)
+    sc.found.sort_unstable_by_key(|&(j, seq, _)| (j, seq));
     let mut i = 0;
     while i < sc.found.len() {
-        let j = sc.found[i].0 as usize;
-        let top = (sc.m[j] < sc.last[j]).then_some((sc.ms[j] as u32, sc.m[j]));
-        let mut top_done = top.is_none();
-        while i < sc.found.len() && sc.found[i].0 as usize == j {
-            let seq = sc.found[i].1;
-            if let Some((ms, m)) = top
-                && !top_done
-                && ms < seq
-            {
-                subtract(&mut row[a_min + j], m, f64::INFINITY, ids[ms as usize]);
-                top_done = true;
-            }
-            sc.spans.clear();
-            while i < sc.found.len() && sc.found[i].0 as usize == j && sc.found[i].1 == seq {
-                sc.spans.push(sc.found[i].2);
-                i += 1;
-            }
-            if let Some((ms, m)) = top
-                && ms == seq
-            {
-                sc.spans.push(Span {
-                    lo: m,
-                    hi: f64::INFINITY,
-                });
-                top_done = true;
-            }
-            remove_spans(&mut row[a_min + j], &mut sc.spans, ids[seq as usize]);
+        let (j, seq) = (sc.found[i].0, sc.found[i].1);
+        sc.spans.clear();
+        while i < sc.found.len() && sc.found[i].0 == j && sc.found[i].1 == seq {
+            sc.spans.push(sc.found[i].2);
+            i += 1;
         }
-        if let Some((ms, m)) = top
-            && !top_done
-        {
-            subtract(&mut row[a_min + j], m, f64::INFINITY, ids[ms as usize]);
-        }
+        remove_spans(
+            &mut row[a_min + j as usize],
+            &mut sc.spans,
+            ids[seq as usize],
+        );
     }
 }
 

@@ -153,19 +153,23 @@ struct Case {
 }
 
 fn case_strategy() -> impl Strategy<Value = Case> {
+    case_with_moves(1..6)
+}
+
+fn case_with_moves(moves: std::ops::Range<usize>) -> impl Strategy<Value = Case> {
     (
         prop::array::uniform3(-12.0f64..4.0),
         prop::array::uniform3(2.0f64..10.0),
         0.15f64..0.4,
     )
-        .prop_flat_map(|(lo, size, h)| {
+        .prop_flat_map(move |(lo, size, h)| {
             let (lo, size) = (Point3::from(lo), Vector3::from(size));
             (
                 Just(lo),
                 Just(size),
                 Just(h),
                 tool_strategy(),
-                prop::collection::vec(move_strategy(lo, size), 1..6),
+                prop::collection::vec(move_strategy(lo, size), moves.clone()),
             )
         })
         .prop_map(|(lo, size, h, tool, moves)| Case {
@@ -256,7 +260,7 @@ proptest! {
 
     #[test]
     fn a_batch_of_moves_gives_the_stock_of_its_moves_one_by_one(
-        case in case_strategy(),
+        case in case_with_moves(2..14),
         ids in prop::collection::vec(0u32..4, 1..4),
     ) {
         let one_by_one = run_rest(&case, &ids, None);
@@ -364,8 +368,11 @@ fn the_first_of_two_equal_moves_names_the_ends_in_a_batch() {
         .with_reference(Vector3::x());
     let c = ToolPose::new(Point3::new(9.0, 4.2, 4.6), Vector3::new(0.0, 0.0, 1.0))
         .with_reference(Vector3::x());
+    // From outside the stock, a translation: the rays along X are cut from
+    // their start.
+    let d = ToolPose::new(Point3::new(-2.0, 4.0, 4.7), Vector3::z()).with_reference(Vector3::x());
     for tool in [wheel, ball] {
-        for (from, to) in [(a, b), (a, c)] {
+        for (from, to) in [(a, b), (a, c), (d, c)] {
             let moves = [
                 Batched { from, to, id: 5 },
                 Batched { from, to, id: 7 },
@@ -401,6 +408,17 @@ fn the_first_of_two_equal_moves_names_the_ends_in_a_batch() {
                 .collect();
             assert!(named.contains(&5), "{named:?}");
             assert!(!named.contains(&7) && !named.contains(&11), "{named:?}");
+            // And the starts the moves from outside make along X.
+            if from == d {
+                let starts: std::collections::BTreeSet<u32> = one
+                    .family(0)
+                    .rays
+                    .iter()
+                    .filter_map(|r| r.first().map(|s| s.lo_move))
+                    .collect();
+                assert!(starts.contains(&5), "{starts:?}");
+                assert!(!starts.contains(&7) && !starts.contains(&11), "{starts:?}");
+            }
         }
     }
 }
