@@ -103,16 +103,18 @@ impl Capsule {
     }
 }
 
-/// What a row needs beyond its solids: where its rays are.
+/// What a tile of rows needs beyond its solids: where its rays are.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct RowFrame {
-    /// The rays' axis (the row runs along the first other axis).
+pub(crate) struct RowFrame<'a> {
+    /// The rays' axis (the rows run along the first other axis).
     pub k: usize,
-    /// Lattice origin along the row, spacing, and the row's coordinate on
-    /// the second other axis.
+    /// Lattice origin along the rows, spacing, and each row's coordinate
+    /// on the second other axis (increasing).
     pub origin_u: f64,
     pub h: f64,
-    pub pv: f64,
+    pub pv: &'a [f64],
+    /// Rays a row of the stock holds.
+    pub nu: usize,
 }
 
 /// A span on four rays: its ends and whether it exists.
@@ -370,11 +372,11 @@ trait Kernel {
     /// above `m`, and their spans (meaningful on those lanes).
     fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt);
 
-    /// Whether the span of every ray of the row at a coordinate in [pa, pb]
-    /// (rays `pa` to `pb`) certainly starts at or above `m` (or is empty);
-    /// `false` when not certain.
+    /// Whether the span of every ray at (pu, pv) with pu in [pa, pb] and pv
+    /// in [va, vb] (rays of rows of a tile) certainly starts at or above `m`
+    /// (or is empty); `false` when not certain.
     #[inline(always)]
-    fn segment_skips(&self, _pa: f64, _pb: f64, _m: f64) -> bool {
+    fn segment_skips(&self, _pa: f64, _pb: f64, _va: f64, _vb: f64, _m: f64) -> bool {
         false
     }
 }
@@ -500,7 +502,6 @@ struct CylinderKernel<const K: usize, const U: usize, const V: usize> {
     /// The same constants as scalars, for [`Kernel::segment_skips`].
     origin_f: [f64; 3],
     axis_f: [f64; 3],
-    pv: f64,
     r: f64,
     origin_u: F,
     /// p[V]·w[V] and p[K]·w[K] are constant along the row, but are summed in
@@ -525,7 +526,6 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
         CylinderKernel {
             origin_f: *origin,
             axis_f: *axis,
-            pv,
             r,
             origin_u: s(origin[U]),
             p,
@@ -554,14 +554,17 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
     /// `Local::along` on the rays with pu in [pa, pb]: enclosures of the
     /// computed (z0, b, c) (the same operations, [`Iv`]).
     #[inline(always)]
-    fn line_segment(&self, pa: f64, pb: f64) -> (Iv, Iv, Iv) {
+    fn line_segment(&self, pa: f64, pb: f64, va: f64, vb: f64) -> (Iv, Iv, Iv) {
         let (o, w) = (&self.origin_f, &self.axis_f);
         let mut p = [Iv::point(0.0); 3];
         p[U] = Iv {
             lo: pa - o[U],
             hi: pb - o[U],
         };
-        p[V] = Iv::point(self.pv - o[V]);
+        p[V] = Iv {
+            lo: va - o[V],
+            hi: vb - o[V],
+        };
         p[K] = Iv::point(-o[K]);
         let z0 = p[0].times(w[0]).add(p[1].times(w[1])).add(p[2].times(w[2]));
         let pp = [
@@ -576,8 +579,8 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
 
 impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K, U, V> {
     #[inline(always)]
-    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
-        let (z0, b, c) = self.line_segment(pa, pb);
+    fn segment_skips(&self, pa: f64, pb: f64, va: f64, vb: f64, m: f64) -> bool {
+        let (z0, b, c) = self.line_segment(pa, pb, va, vb);
         let dz = self.axis_f[K];
         slab_segment_skips(z0, dz, self.z0, self.z1, m)
             || quadratic_segment_skips(1.0 - dz * dz, b, c.sub(Iv::point(self.r * self.r)), m)
@@ -654,11 +657,11 @@ impl<const K: usize, const U: usize, const V: usize> Kernel for CapsuleKernel<'_
     /// Every part certainly above m on every ray of the segment ([`Iv`]
     /// enclosures of the same operations as [`Kernel::chunk`]).
     #[inline(always)]
-    fn segment_skips(&self, pa: f64, pb: f64, m: f64) -> bool {
+    fn segment_skips(&self, pa: f64, pb: f64, va: f64, vb: f64, m: f64) -> bool {
         let k = self.k;
         let mut o = [Iv::point(0.0); 3];
         o[U] = Iv { lo: pa, hi: pb };
-        o[V] = Iv::point(self.pv.0[0]);
+        o[V] = Iv { lo: va, hi: vb };
         let dot = |x: &[Iv; 3], y: &[f64; 3]| {
             x[0].times(y[0]).add(x[1].times(y[1])).add(x[2].times(y[2]))
         };
@@ -761,11 +764,14 @@ impl Kernel for ScalarKernel<'_> {
 }
 
 // ---------------------------------------------------------------------------
-// A row.
+// A tile of rows.
 
-/// Scratch buffers of a row, kept by each thread from row to row.
+/// Scratch buffers of a tile of rows, kept by each thread from tile to tile.
+/// Per-ray arrays hold the tile's rows one after the other, `padded` rays
+/// each (the rays of the tile's range, rounded up to whole chunks).
 #[derive(Default)]
 pub(crate) struct Scratch {
+    /// The rays' coordinate along the rows (the same on every row).
     pu: Vec<f64>,
     first: Vec<f64>,
     last: Vec<f64>,
@@ -773,6 +779,8 @@ pub(crate) struct Scratch {
     /// The move whose span set m (its place in the batch, from 1, as an
     /// exact float); 0 while m is the ray's top.
     ms: Vec<f64>,
+    /// Each ray's largest m over the tile's rows.
+    col: Vec<f64>,
     /// The bottom level: the material's start, raised to the end of every
     /// span found that starts at or below it (and ends below the top).
     mb: Vec<f64>,
@@ -780,23 +788,27 @@ pub(crate) struct Scratch {
     mbs: Vec<f64>,
     /// Rays with a span that ends inside their material.
     split: Vec<bool>,
-    /// The spans that end inside their ray's material: ray, move, span.
+    /// The spans that end inside their ray's material: ray (its place in
+    /// the arrays above), move, span.
     found: Vec<(u32, u32, Span)>,
     spans: Vec<Span>,
 }
 
-/// A solid that meets a row: its index and its first and last ray (row
-/// indices, within the solid's bounds).
+/// A solid that meets a tile: its index, its first and last ray (indices
+/// along the rows, within the solid's bounds: the same on every row), its
+/// first and last row in the tile, and its move.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Active {
     pub solid: usize,
     pub a: usize,
     pub b: usize,
+    pub r0: usize,
+    pub r1: usize,
     /// The solid's move: its place in the batch, from 1.
     pub seq: u32,
 }
 
-/// What [`cut_row`] needs of the solids: the prepared kernels, each
+/// What [`cut_tile`] needs of the solids: the prepared kernels, each
 /// solid's extent along the rays, and the scalar span of every solid.
 pub(crate) struct RowSolids<'a> {
     pub prepared: &'a [RowSolid],
@@ -807,12 +819,13 @@ pub(crate) struct RowSolids<'a> {
     pub span: &'a (dyn Fn(usize, f64, f64) -> Option<Span> + Sync),
 }
 
-/// Cuts one row: every active solid (visited in the order given) on the
-/// rays `row[a..=b]` of its range, then each ray as the reference removal
-/// would (module doc).
-pub(crate) fn cut_row(
+/// Cuts a tile of consecutive rows (`rows` holds them whole, `frame.nu`
+/// rays each): every active solid (visited in the order given) on the rays
+/// of its range and rows, then each ray as the reference removal would
+/// (module doc).
+pub(crate) fn cut_tile(
     frame: &RowFrame,
-    row: &mut [Ray],
+    rows: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
     ids: &[u32],
@@ -822,12 +835,12 @@ pub(crate) fn cut_row(
     {
         if !portable_forced() && std::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor has AVX2 (checked just above), the one
-            // requirement of `cut_row_avx2`.
-            unsafe { cut_row_avx2(frame, row, active, solids, ids, scratch) };
+            // requirement of `cut_tile_avx2`.
+            unsafe { cut_tile_avx2(frame, rows, active, solids, ids, scratch) };
             return;
         }
     }
-    cut_row_any(frame, row, active, solids, ids, scratch);
+    cut_tile_any(frame, rows, active, solids, ids, scratch);
 }
 
 /// Tests can force the portable path, to check it on processors with AVX2.
@@ -847,67 +860,54 @@ fn portable_forced() -> bool {
     false
 }
 
-/// [`cut_row`] compiled for AVX2: the same operations, four lanes in one
+/// [`cut_tile`] compiled for AVX2: the same operations, four lanes in one
 /// instruction.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn cut_row_avx2(
+fn cut_tile_avx2(
     frame: &RowFrame,
-    row: &mut [Ray],
+    rows: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
     ids: &[u32],
     scratch: &mut Scratch,
 ) {
-    cut_row_any(frame, row, active, solids, ids, scratch);
+    cut_tile_any(frame, rows, active, solids, ids, scratch);
 }
 
 #[inline(always)]
-fn cut_row_any(
+fn cut_tile_any(
     frame: &RowFrame,
-    row: &mut [Ray],
+    rows: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
     ids: &[u32],
     scratch: &mut Scratch,
 ) {
     match frame.k {
-        0 => cut_row_k::<0, 1, 2>(frame, row, active, solids, ids, scratch),
-        1 => cut_row_k::<1, 0, 2>(frame, row, active, solids, ids, scratch),
-        _ => cut_row_k::<2, 0, 1>(frame, row, active, solids, ids, scratch),
+        0 => cut_tile_k::<0, 1, 2>(frame, rows, active, solids, ids, scratch),
+        1 => cut_tile_k::<1, 0, 2>(frame, rows, active, solids, ids, scratch),
+        _ => cut_tile_k::<2, 0, 1>(frame, rows, active, solids, ids, scratch),
     }
 }
 
-/// The solid's rays `j0..=j1` of the row: skip test, exact spans, and the
-/// levels m lowered by the spans that reach the top. Returns whether a span
-/// ends inside a ray's material.
+/// Narrows [j0, end) from either end to the rays whose span may start
+/// below their level: segments certainly above every level in them are
+/// dropped, in steps that double while segments are dropped and halve
+/// (down to two chunks) when one is not. `level(a, b)` is the float after
+/// the largest m of rays a..b on the rows tested, so a dropped segment's
+/// spans start strictly above every level in it and none lowers one,
+/// whichever move set it.
 #[inline(always)]
-fn sweep<Kn: Kernel>(
-    kern: &Kn,
-    (j0, j1): (usize, usize),
-    (lo_k, hi_k): (f64, f64),
-    seq: u32,
-    sc: &mut Scratch,
-) -> bool {
-    let lane = F(std::array::from_fn(|i| i as f64));
-    let (lo_k, hi_k) = (s(lo_k), s(hi_k));
-    let mut any_split = false;
-    // Whole segments first, from either end, while they are certainly
-    // above their levels: steps that double while segments are skipped and
-    // halve (down to two chunks) when one is not. Then the rest four rays
-    // at a time. [j0, end) is what is left. A segment's level is the float
-    // after its largest m: its spans start strictly above every level in
-    // it, so none lowers one, whichever move set it.
-    let (mut j0, mut end) = (j0, j1 + 1);
-    let seg_max = |sc: &Scratch, a: usize, b: usize| {
-        sc.m[a..b]
-            .iter()
-            .fold(f64::NEG_INFINITY, |x, &y| x.max(y))
-            .next_up()
-    };
+fn narrow(
+    (mut j0, mut end): (usize, usize),
+    pu: &[f64],
+    level: impl Fn(usize, usize) -> f64,
+    skips: impl Fn(f64, f64, f64) -> bool,
+) -> (usize, usize) {
     let (mut step, mut grow) = (2 * W, true);
     while step >= 2 * W && j0 + step <= end {
-        if kern.segment_skips(sc.pu[j0], sc.pu[j0 + step - 1], seg_max(sc, j0, j0 + step)) {
+        if skips(pu[j0], pu[j0 + step - 1], level(j0, j0 + step)) {
             j0 += step;
             if grow {
                 step *= 2;
@@ -919,7 +919,7 @@ fn sweep<Kn: Kernel>(
     (step, grow) = (2 * W, true);
     while step >= 2 * W && end >= j0 + step {
         let (a, b) = (end - step, end);
-        if kern.segment_skips(sc.pu[a], sc.pu[b - 1], seg_max(sc, a, b)) {
+        if skips(pu[a], pu[b - 1], level(a, b)) {
             end = a;
             if grow {
                 step *= 2;
@@ -928,6 +928,89 @@ fn sweep<Kn: Kernel>(
             (step, grow) = (step / 2, false);
         }
     }
+    (j0, end)
+}
+
+/// The float after the largest of `m[a..b]`, b − a a multiple of the lane
+/// count (four lanes at once: `f64::max` is exact, so the order is free).
+#[inline(always)]
+fn level_above(m: &[f64], a: usize, b: usize) -> f64 {
+    let mut top = F::splat(f64::NEG_INFINITY);
+    for i in (a..b).step_by(W) {
+        top = top.max(F::load(m, i));
+    }
+    top.0
+        .iter()
+        .fold(f64::NEG_INFINITY, |x, &y| x.max(y))
+        .next_up()
+}
+
+/// One solid on its rays `j0..=j1` of rows `r0..=r1` of the tile: first
+/// whole segments across all those rows (one interval test for all), then
+/// row by row ([`sweep_row`]); `make` gives the solid's kernel for a row's
+/// coordinate. Returns whether a span ends inside a ray's material.
+#[inline(always)]
+fn sweep_tile<Kn: Kernel>(
+    make: impl Fn(f64) -> Kn,
+    (j0, j1): (usize, usize),
+    (r0, r1): (usize, usize),
+    along: (f64, f64),
+    seq: u32,
+    pv: &[f64],
+    sc: &mut Scratch,
+) -> bool {
+    // (Every row holds as many rays as `pu`.)
+    let padded = sc.pu.len();
+    let mut range = (j0, j1 + 1);
+    if r1 > r0 {
+        // The rows' largest level on each ray (`col`) bounds them all.
+        let kern = make(pv[r0]);
+        let (va, vb) = (pv[r0], pv[r1]);
+        range = narrow(
+            range,
+            &sc.pu,
+            |a, b| level_above(&sc.col, a, b),
+            |pa, pb, m| kern.segment_skips(pa, pb, va, vb, m),
+        );
+    }
+    let mut any_split = false;
+    if range.1 > range.0 {
+        for r in r0..=r1 {
+            any_split |= sweep_row(&make(pv[r]), range, along, seq, pv[r], r * padded, sc);
+        }
+        // Levels only fall: `col` is exact again once the rays swept are
+        // taken again.
+        let rows = pv.len();
+        for j in range.0..range.1 {
+            sc.col[j] = (0..rows).fold(f64::NEG_INFINITY, |x, r| x.max(sc.m[r * padded + j]));
+        }
+    }
+    any_split
+}
+
+/// The solid's rays `j0..end` of one row (its arrays from `off`): whole
+/// segments dropped first ([`narrow`]), then the skip test and the exact
+/// spans four rays at a time, and the levels they lower. Returns whether a
+/// span ends inside a ray's material.
+#[inline(always)]
+fn sweep_row<Kn: Kernel>(
+    kern: &Kn,
+    range: (usize, usize),
+    (lo_k, hi_k): (f64, f64),
+    seq: u32,
+    pv: f64,
+    off: usize,
+    sc: &mut Scratch,
+) -> bool {
+    let lane = F(std::array::from_fn(|i| i as f64));
+    let (lo_k, hi_k) = (s(lo_k), s(hi_k));
+    let mut any_split = false;
+    let (j0, end) = narrow(
+        range,
+        &sc.pu,
+        |a, b| level_above(&sc.m, off + a, off + b),
+        |pa, pb, m| kern.segment_skips(pa, pb, pv, pv, m),
+    );
     if end <= j0 {
         return false;
     }
@@ -937,14 +1020,15 @@ fn sweep<Kn: Kernel>(
     let seqf = s(f64::from(seq));
     let mut base = j0 / W * W;
     while base <= j1 {
+        let at = off + base;
         let idx = s(base as f64) + lane;
-        let (first, last) = (F::load(&sc.first, base), F::load(&sc.last, base));
+        let (first, last) = (F::load(&sc.first, at), F::load(&sc.last, at));
         // The reference's gate: the ray's index within the solid's bounds
         // and its material within the solid's extent.
         let gate = idx.ge(j0f) & idx.le(j1f) & !(hi_k.le(first) | lo_k.ge(last));
         if gate.any() {
-            let m = F::load(&sc.m, base);
-            let ms = F::load(&sc.ms, base);
+            let m = F::load(&sc.m, at);
+            let ms = F::load(&sc.ms, at);
             // A move before the one that set m lowers it only from strictly
             // below: of two moves that reach the same level, the first makes
             // the end (and names it), as when they are cut one by one.
@@ -959,8 +1043,8 @@ fn sweep<Kn: Kernel>(
             if keep.any() {
                 let reach = keep & span.hi.ge(last);
                 let lower = reach & (span.lo.lt(m) | (span.lo.eq(m) & earlier));
-                lower.select(span.lo, m).store(&mut sc.m, base);
-                lower.select(seqf, ms).store(&mut sc.ms, base);
+                lower.select(span.lo, m).store(&mut sc.m, at);
+                lower.select(seqf, ms).store(&mut sc.ms, at);
                 // Spans that meet the material below its top: those from
                 // below its bottom are summed up by mb, as the others by m
                 // (mirrored); those that end inside it are kept for their
@@ -972,10 +1056,10 @@ fn sweep<Kn: Kernel>(
                 }
                 let bottom = rest & span.lo.le(first);
                 if bottom.any() {
-                    let (mb, mbs) = (F::load(&sc.mb, base), F::load(&sc.mbs, base));
+                    let (mb, mbs) = (F::load(&sc.mb, at), F::load(&sc.mbs, at));
                     let raise = bottom & (span.hi.gt(mb) | (span.hi.eq(mb) & seqf.lt(mbs)));
-                    raise.select(span.hi, mb).store(&mut sc.mb, base);
-                    raise.select(seqf, mbs).store(&mut sc.mbs, base);
+                    raise.select(span.hi, mb).store(&mut sc.mb, at);
+                    raise.select(seqf, mbs).store(&mut sc.mbs, at);
                 }
                 let split = rest & !bottom;
                 if split.any() {
@@ -983,14 +1067,14 @@ fn sweep<Kn: Kernel>(
                     for i in 0..W {
                         if split.lane(i) {
                             sc.found.push((
-                                (base + i) as u32,
+                                (at + i) as u32,
                                 seq,
                                 Span {
                                     lo: span.lo.0[i],
                                     hi: span.hi.0[i],
                                 },
                             ));
-                            sc.split[base + i] = true;
+                            sc.split[at + i] = true;
                         }
                     }
                 }
@@ -1002,9 +1086,9 @@ fn sweep<Kn: Kernel>(
 }
 
 #[inline(always)]
-fn cut_row_k<const K: usize, const U: usize, const V: usize>(
+fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
     frame: &RowFrame,
-    row: &mut [Ray],
+    rows: &mut [Ray],
     active: &[Active],
     solids: &RowSolids,
     ids: &[u32],
@@ -1016,39 +1100,51 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     let b_max = active.iter().map(|s| s.b).max().unwrap_or(a_min);
     let n = b_max + 1 - a_min;
     let padded = n.div_ceil(W) * W;
-    let pv = frame.pv;
+    let (nu, pv) = (frame.nu, frame.pv);
     sc.pu.clear();
-    sc.first.clear();
-    sc.last.clear();
     sc.pu
         .extend((0..padded).map(|j| frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h));
-    for ray in &row[a_min..=b_max] {
-        // Empty rays (and the padding): no solid passes the gate against
-        // their ends.
-        let (f, l) = match (ray.first(), ray.last()) {
-            (Some(f), Some(l)) => (f.lo, l.hi),
-            _ => (f64::INFINITY, f64::NEG_INFINITY),
-        };
-        sc.first.push(f);
-        sc.last.push(l);
+    sc.first.clear();
+    sc.last.clear();
+    for r in 0..pv.len() {
+        for ray in &rows[r * nu + a_min..=r * nu + b_max] {
+            // Empty rays (and the padding): no solid passes the gate against
+            // their ends.
+            let (f, l) = match (ray.first(), ray.last()) {
+                (Some(f), Some(l)) => (f.lo, l.hi),
+                _ => (f64::INFINITY, f64::NEG_INFINITY),
+            };
+            sc.first.push(f);
+            sc.last.push(l);
+        }
+        sc.first.resize((r + 1) * padded, f64::INFINITY);
+        sc.last.resize((r + 1) * padded, f64::NEG_INFINITY);
     }
-    sc.first.resize(padded, f64::INFINITY);
-    sc.last.resize(padded, f64::NEG_INFINITY);
+    let all = pv.len() * padded;
     sc.m.clear();
     sc.m.extend_from_slice(&sc.last);
+    sc.col.clear();
+    sc.col.extend_from_slice(&sc.m[..padded]);
+    for r in 1..pv.len() {
+        for j in 0..padded {
+            sc.col[j] = sc.col[j].max(sc.m[r * padded + j]);
+        }
+    }
     sc.ms.clear();
-    sc.ms.resize(padded, 0.0);
+    sc.ms.resize(all, 0.0);
     sc.mb.clear();
     sc.mb.extend_from_slice(&sc.first);
     sc.mbs.clear();
-    sc.mbs.resize(padded, 0.0);
+    sc.mbs.resize(all, 0.0);
     sc.split.clear();
-    sc.split.resize(padded, false);
+    sc.split.resize(all, false);
     sc.found.clear();
     let mut any_split = false;
     for act in active {
         let range = (act.a - a_min, act.b - a_min);
+        let rows_of = (act.r0, act.r1);
         let along = solids.along[act.solid];
+        let seq = act.seq;
         any_split |= match solids.prepared[act.solid] {
             RowSolid::Cylinder {
                 ref origin,
@@ -1056,11 +1152,13 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                 z0,
                 z1,
                 r,
-            } => sweep(
-                &CylinderKernel::<K, U, V>::new(origin, axis, z0, z1, r, pv),
+            } => sweep_tile(
+                |pv| CylinderKernel::<K, U, V>::new(origin, axis, z0, z1, r, pv),
                 range,
+                rows_of,
                 along,
-                act.seq,
+                seq,
+                pv,
                 sc,
             ),
             RowSolid::Sphere {
@@ -1070,16 +1168,16 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                 r,
             } => {
                 let dz = axis[K];
-                let kern = SphereKernel {
+                let make = |pv| SphereKernel {
                     line: CylinderKernel::<K, U, V>::new(origin, axis, 0.0, 0.0, r, pv),
                     zc: s(zc),
                     dz: s(dz),
                     a: s(1.0 - dz * dz + dz * dz),
                 };
-                sweep(&kern, range, along, act.seq, sc)
+                sweep_tile(make, range, rows_of, along, seq, pv, sc)
             }
             RowSolid::Capsule(ref k) => {
-                let kern = CapsuleKernel::<K, U, V> {
+                let make = |pv| CapsuleKernel::<K, U, V> {
                     k,
                     pv: s(pv),
                     d: splat3(&k.d),
@@ -1090,34 +1188,33 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
                     rr: s(k.r * k.r),
                     a: s(k.a),
                 };
-                sweep(&kern, range, along, act.seq, sc)
+                sweep_tile(make, range, rows_of, along, seq, pv, sc)
             }
             RowSolid::Other => {
-                let kern = ScalarKernel {
+                let make = |pv| ScalarKernel {
                     solids,
                     solid: act.solid,
                     pv,
                 };
-                sweep(&kern, range, along, act.seq, sc)
+                sweep_tile(make, range, rows_of, along, seq, pv, sc)
             }
         };
     }
-    for j in 0..n {
-        if sc.split[j] {
-            continue;
-        }
-        // Every span that met the material reached its bottom or its top.
-        // (The two cuts commute: each removes all beyond its level.)
-        if sc.mb[j] > sc.first[j] {
-            subtract(
-                &mut row[a_min + j],
-                f64::NEG_INFINITY,
-                sc.mb[j],
-                ids[sc.mbs[j] as usize],
-            );
-        }
-        if sc.m[j] < sc.last[j] {
-            cut_top(&mut row[a_min + j], sc.m[j], ids[sc.ms[j] as usize]);
+    for r in 0..pv.len() {
+        for j in 0..n {
+            let at = r * padded + j;
+            if sc.split[at] {
+                continue;
+            }
+            let ray = &mut rows[r * nu + a_min + j];
+            // Every span that met the material reached its bottom or its
+            // top. (The two cuts commute: each removes all beyond its level.)
+            if sc.mb[at] > sc.first[at] {
+                subtract(ray, f64::NEG_INFINITY, sc.mb[at], ids[sc.mbs[at] as usize]);
+            }
+            if sc.m[at] < sc.last[at] {
+                cut_top(ray, sc.m[at], ids[sc.ms[at] as usize]);
+            }
         }
     }
     if !any_split {
@@ -1131,38 +1228,39 @@ fn cut_row_k<const K: usize, const U: usize, const V: usize>(
     // leaves an end at m, and the same below mb (module doc).
     let n_found = sc.found.len();
     for f in 0..n_found {
-        let j = sc.found[f].0 as usize;
-        if sc.split[j] {
+        let at = sc.found[f].0 as usize;
+        if sc.split[at] {
             // Each split ray's two levels, once.
-            sc.split[j] = false;
-            if sc.m[j] < sc.last[j] {
+            sc.split[at] = false;
+            if sc.m[at] < sc.last[at] {
                 let span = Span {
-                    lo: sc.m[j],
+                    lo: sc.m[at],
                     hi: f64::INFINITY,
                 };
-                sc.found.push((j as u32, sc.ms[j] as u32, span));
+                sc.found.push((at as u32, sc.ms[at] as u32, span));
             }
-            if sc.mb[j] > sc.first[j] {
+            if sc.mb[at] > sc.first[at] {
                 let span = Span {
                     lo: f64::NEG_INFINITY,
-                    hi: sc.mb[j],
+                    hi: sc.mb[at],
                 };
-                sc.found.push((j as u32, sc.mbs[j] as u32, span));
+                sc.found.push((at as u32, sc.mbs[at] as u32, span));
             }
         }
     }
     // (Spans of one ray and one move are united: their order is free.)
-    sc.found.sort_unstable_by_key(|&(j, seq, _)| (j, seq));
+    sc.found.sort_unstable_by_key(|&(at, seq, _)| (at, seq));
     let mut i = 0;
     while i < sc.found.len() {
-        let (j, seq) = (sc.found[i].0, sc.found[i].1);
+        let (at, seq) = (sc.found[i].0, sc.found[i].1);
         sc.spans.clear();
-        while i < sc.found.len() && sc.found[i].0 == j && sc.found[i].1 == seq {
+        while i < sc.found.len() && sc.found[i].0 == at && sc.found[i].1 == seq {
             sc.spans.push(sc.found[i].2);
             i += 1;
         }
+        let (r, j) = (at as usize / padded, at as usize % padded);
         remove_spans(
-            &mut row[a_min + j as usize],
+            &mut rows[r * nu + a_min + j],
             &mut sc.spans,
             ids[seq as usize],
         );
