@@ -973,10 +973,14 @@ fn sweep_tile<Kn: Kernel>(
             |pa, pb, m| kern.segment_skips(pa, pb, va, vb, m),
         );
     }
+    // Row by row, segments are tested again unless the tile's test left
+    // less than half the rays (then testing costs more than it saves).
+    let narrow_rows = 2 * (range.1 - range.0) > j1 + 1 - j0;
     let mut any_split = false;
     if range.1 > range.0 {
         for r in r0..=r1 {
-            any_split |= sweep_row(&make(pv[r]), range, along, seq, pv[r], r * padded, sc);
+            let row = (pv[r], r * padded, narrow_rows);
+            any_split |= sweep_row(&make(pv[r]), range, along, seq, row, sc);
         }
         // Levels only fall: `col` is exact again once the rays swept are
         // taken again.
@@ -998,19 +1002,22 @@ fn sweep_row<Kn: Kernel>(
     range: (usize, usize),
     (lo_k, hi_k): (f64, f64),
     seq: u32,
-    pv: f64,
-    off: usize,
+    (pv, off, narrow_first): (f64, usize, bool),
     sc: &mut Scratch,
 ) -> bool {
     let lane = F(std::array::from_fn(|i| i as f64));
     let (lo_k, hi_k) = (s(lo_k), s(hi_k));
     let mut any_split = false;
-    let (j0, end) = narrow(
-        range,
-        &sc.pu,
-        |a, b| level_above(&sc.m, off + a, off + b),
-        |pa, pb, m| kern.segment_skips(pa, pb, pv, pv, m),
-    );
+    let (j0, end) = if narrow_first {
+        narrow(
+            range,
+            &sc.pu,
+            |a, b| level_above(&sc.m, off + a, off + b),
+            |pa, pb, m| kern.segment_skips(pa, pb, pv, pv, m),
+        )
+    } else {
+        range
+    };
     if end <= j0 {
         return false;
     }
