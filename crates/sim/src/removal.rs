@@ -7,7 +7,7 @@
 
 use kinpost_machine::Pose;
 use kinpost_stock::{
-    BlockRef, Comparison, Conditions, Design, DesignError, GrindStats, GrindingSummary,
+    BlockRef, Comparison, Conditions, Design, DesignError, GrindStats, GrindingSummary, Move,
     ProcessModel, Stock, Tool, ToolPose, compare,
 };
 use nalgebra::{Point3, Unit};
@@ -30,7 +30,15 @@ pub struct Cutting {
     rapids_in_box: Vec<At>,
     /// What each block ground with the process model.
     ground: Vec<(u32, GrindStats)>,
+    /// Moves held back to be cut together ([`Stock::cut_moves`]: the same
+    /// stock as one by one), and the line of each one's block.
+    pending: Vec<Move>,
+    pending_lines: Vec<usize>,
 }
+
+/// Moves held back before they are cut together: enough for the stock to
+/// share a visit of its rays among many short blocks.
+const PENDING_MOVES: usize = 256;
 
 /// What the process model needs of a feed block besides its poses.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,6 +62,8 @@ impl Cutting {
             rapid_cuts: Vec::new(),
             rapids_in_box: Vec::new(),
             ground: Vec::new(),
+            pending: Vec::new(),
+            pending_lines: Vec::new(),
         }
     }
 
@@ -68,9 +78,25 @@ impl Cutting {
         self
     }
 
-    /// The stock as cut so far.
+    /// The stock as cut so far. (During a replay the last blocks' moves
+    /// may still be held back: [`crate::Replay::finish_cutting`] cuts them
+    /// before it gives the cutting back.)
     pub fn stock(&self) -> &Stock {
         &self.stock
+    }
+
+    /// Cuts the moves held back.
+    pub(crate) fn flush(&mut self) -> Result<(), SimError> {
+        if self.pending.is_empty() {
+            return Ok(());
+        }
+        let result = self.stock.cut_moves(&self.tool, &self.pending);
+        let lines = std::mem::take(&mut self.pending_lines);
+        self.pending.clear();
+        result.map(|_| ()).map_err(|e| SimError::Cut {
+            line: lines[e.index],
+            source: e.source,
+        })
     }
 
     /// The block of every move id ([`kinpost_stock::Report::new`] takes it).
@@ -137,24 +163,34 @@ impl Cutting {
         let in_box = rapid && self.reaches_stock(&tool_poses).map_err(cut_error)?;
         if in_box {
             self.rapids_in_box.push(at.clone());
+            self.flush()?;
         }
         let volume_before = in_box.then(|| self.stock.volume_mm3());
         if let Some(c) = conditions.filter(|_| !rapid)
             && let Some(grinding) = self.grinding_conditions(&tool_poses, &c, at)?
         {
+            self.flush()?;
             return self.grind(&tool_poses, &grinding, id, at);
         }
         match tool_poses.as_slice() {
             [] => {}
-            [only] => self
-                .stock
-                .cut_pose(&self.tool, only, id)
-                .map_err(cut_error)?,
+            [only] => {
+                self.flush()?;
+                self.stock
+                    .cut_pose(&self.tool, only, id)
+                    .map_err(cut_error)?
+            }
             many => {
                 for w in many.windows(2) {
-                    self.stock
-                        .cut_move(&self.tool, &w[0], &w[1], id)
-                        .map_err(cut_error)?;
+                    self.pending.push(Move {
+                        from: w[0],
+                        to: w[1],
+                        id,
+                    });
+                    self.pending_lines.push(at.line);
+                }
+                if in_box || self.pending.len() >= PENDING_MOVES {
+                    self.flush()?;
                 }
             }
         }
@@ -263,5 +299,52 @@ fn tool_pose(p: &Pose) -> ToolPose {
         point: Point3::from(p.point),
         axis: Unit::new_normalize(p.axis),
         reference: p.reference.map(Unit::new_normalize),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    fn at(line: usize) -> At {
+        At {
+            block: line as u64,
+            line,
+            number: None,
+        }
+    }
+
+    fn pose(x: f64, axis: Vector3<f64>) -> Pose {
+        Pose {
+            point: Vector3::new(x, 5.0, 9.0),
+            axis,
+            reference: None,
+        }
+    }
+
+    /// Blocks are cut together, later: a block that cannot be cut is still
+    /// named by its own line, and the blocks before it are cut.
+    #[test]
+    fn a_block_held_back_that_cannot_be_cut_is_named_by_its_line() {
+        let stock = Stock::from_box(Point3::origin(), Point3::new(20.0, 10.0, 10.0), 0.2).unwrap();
+        let ball = Tool::BallEnd {
+            diameter: 4.0,
+            flute_length: 10.0,
+            shank: None,
+        };
+        let mut c = Cutting::new(stock, ball);
+        let z = Vector3::z();
+        c.cut(&[pose(2.0, z), pose(8.0, z)], &at(10), false, None)
+            .unwrap();
+        // The axis turns half a turn within the block.
+        c.cut(&[pose(8.0, z), pose(12.0, -z)], &at(20), false, None)
+            .unwrap();
+        assert_eq!(c.stock().removed_volume_mm3(), 0.0, "held back");
+        match c.flush() {
+            Err(SimError::Cut { line, .. }) => assert_eq!(line, 20),
+            other => panic!("{other:?}"),
+        }
+        assert!(c.stock().removed_volume_mm3() > 0.0, "line 10 is cut");
     }
 }

@@ -349,6 +349,9 @@ impl Replay {
         if let Some(e) = self.error {
             return Err(e);
         }
+        if let Some(c) = &mut self.cutting {
+            c.flush()?;
+        }
         let r = &mut self.report;
         r.executed_blocks = interp.executed_blocks;
         let mut assumed = interp.assumed.clone();

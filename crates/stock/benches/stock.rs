@@ -14,13 +14,14 @@
 //!   against its box as the design.
 //!
 //! Each iteration cuts the next 500 moves of the program on the same
-//! stock (a fresh stock when the program ends, made outside the timing);
-//! pools of 1 and 2 threads.
+//! stock (a fresh stock when the program ends, made outside the timing),
+//! as `kinpost sim` does: handed over together to `Stock::cut_moves`, each
+//! move its own id; pools of 1 and 2 threads.
 
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinpost_stock::{Design, Mesh, Stock, Tool, ToolPose, compare};
+use kinpost_stock::{Design, Mesh, Move, Stock, Tool, ToolPose, compare};
 use nalgebra::Point3;
 
 mod programs;
@@ -49,13 +50,15 @@ fn run(c: &mut Criterion, name: &str, tool: Tool, poses: &[ToolPose], threads: u
                     s = stock(0.05);
                     next = 0;
                 }
+                let moves: Vec<Move> = (next..next + CHUNK)
+                    .map(|i| Move {
+                        from: poses[i],
+                        to: poses[i + 1],
+                        id: i as u32,
+                    })
+                    .collect();
                 let start = Instant::now();
-                pool.install(|| {
-                    for i in next..next + CHUNK {
-                        s.cut_move(&tool, &poses[i], &poses[i + 1], i as u32)
-                            .unwrap();
-                    }
-                });
+                pool.install(|| s.cut_moves(&tool, &moves).unwrap());
                 total += start.elapsed();
                 next += CHUNK;
             }

@@ -8,8 +8,11 @@
 //!
 //! Arguments: `wheel` or `ball`, the number of moves, the thread count,
 //! optionally the first move (default 0) and `reference` for the
-//! straightforward removal ([`kinpost_stock::Removal::Reference`]). Prints the time of the cut
-//! alone and a checksum of the stock (the same for any thread count).
+//! straightforward removal ([`kinpost_stock::Removal::Reference`]). The
+//! moves go to `Stock::cut_moves` 256 at a time, as `kinpost sim` hands
+//! them over (`BATCH=n` in the environment for n at a time, `BATCH=0` for
+//! `Stock::cut_move` one by one). Prints the time of the cut alone and a
+//! checksum of the stock (the same for any thread count and batch).
 
 use std::time::Instant;
 
@@ -39,7 +42,7 @@ fn main() {
     let batch: usize = std::env::var("BATCH")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
+        .unwrap_or(256);
     pool.install(|| {
         if batch == 0 {
             for i in first..last {
