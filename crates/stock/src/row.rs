@@ -984,9 +984,14 @@ fn sweep_tile<Kn: Kernel>(
         }
         // Levels only fall: `col` is exact again once the rays swept are
         // taken again.
+        // (Whole chunks, four rays at a time: `padded` is a multiple of W.)
         let rows = pv.len();
-        for j in range.0..range.1 {
-            sc.col[j] = (0..rows).fold(f64::NEG_INFINITY, |x, r| x.max(sc.m[r * padded + j]));
+        for base in (range.0 / W * W..range.1).step_by(W) {
+            let mut top = F::load(&sc.m, base);
+            for r in 1..rows {
+                top = top.max(F::load(&sc.m, r * padded + base));
+            }
+            top.store(&mut sc.col, base);
         }
     }
     any_split
