@@ -368,6 +368,12 @@ const NONE: Opt = Opt {
 
 /// A solid's kernel on the rays of one row, its constants made once.
 trait Kernel {
+    /// The shortest segment (rays) a tile's test is worth: a test of all
+    /// the tile's rows costs about a chunk of one row, so a kernel whose
+    /// tests often succeed near the solid's deepest rays (a cylinder's
+    /// flat profile) is tested down to one chunk.
+    const TILE_LEAST: usize = 2 * W;
+
     /// The rays (lanes of `gate`) at `pu` whose span is not certainly at or
     /// above `m`, and their spans (meaningful on those lanes).
     fn chunk(&self, pu: F, m: F, gate: M) -> (M, Opt);
@@ -578,6 +584,8 @@ impl<const K: usize, const U: usize, const V: usize> CylinderKernel<K, U, V> {
 }
 
 impl<const K: usize, const U: usize, const V: usize> Kernel for CylinderKernel<K, U, V> {
+    const TILE_LEAST: usize = W;
+
     #[inline(always)]
     fn segment_skips(&self, pa: f64, pb: f64, va: f64, vb: f64, m: f64) -> bool {
         let (z0, b, c) = self.line_segment(pa, pb, va, vb);
@@ -901,12 +909,13 @@ fn cut_tile_any(
 #[inline(always)]
 fn narrow(
     (mut j0, mut end): (usize, usize),
+    least: usize,
     pu: &[f64],
     level: impl Fn(usize, usize) -> f64,
     skips: impl Fn(f64, f64, f64) -> bool,
 ) -> (usize, usize) {
     let (mut step, mut grow) = (2 * W, true);
-    while step >= 2 * W && j0 + step <= end {
+    while step >= least && j0 + step <= end {
         if skips(pu[j0], pu[j0 + step - 1], level(j0, j0 + step)) {
             j0 += step;
             if grow {
@@ -917,7 +926,7 @@ fn narrow(
         }
     }
     (step, grow) = (2 * W, true);
-    while step >= 2 * W && end >= j0 + step {
+    while step >= least && end >= j0 + step {
         let (a, b) = (end - step, end);
         if skips(pu[a], pu[b - 1], level(a, b)) {
             end = a;
@@ -968,6 +977,7 @@ fn sweep_tile<Kn: Kernel>(
         let (va, vb) = (pv[r0], pv[r1]);
         range = narrow(
             range,
+            Kn::TILE_LEAST,
             &sc.pu,
             |a, b| level_above(&sc.col, a, b),
             |pa, pb, m| kern.segment_skips(pa, pb, va, vb, m),
@@ -1016,6 +1026,7 @@ fn sweep_row<Kn: Kernel>(
     let (j0, end) = if narrow_first {
         narrow(
             range,
+            2 * W,
             &sc.pu,
             |a, b| level_above(&sc.m, off + a, off + b),
             |pa, pb, m| kern.segment_skips(pa, pb, pv, pv, m),
