@@ -901,8 +901,9 @@ fn cut_tile_any(
 
 /// Narrows [j0, end) from either end to the rays whose span may start
 /// below their level: segments certainly above every level in them are
-/// dropped, in steps that double while segments are dropped and halve
-/// (down to two chunks) when one is not. `level(a, b)` is the float after
+/// dropped, in steps of four chunks at first that double while segments
+/// are dropped and halve (down to `least` rays) when one is not.
+/// `level(a, b)` is the float after
 /// the largest m of rays a..b on the rows tested, so a dropped segment's
 /// spans start strictly above every level in it and none lowers one,
 /// whichever move set it.
@@ -914,7 +915,7 @@ fn narrow(
     level: impl Fn(usize, usize) -> f64,
     skips: impl Fn(f64, f64, f64) -> bool,
 ) -> (usize, usize) {
-    let (mut step, mut grow) = (2 * W, true);
+    let (mut step, mut grow) = (4 * W, true);
     while step >= least && j0 + step <= end {
         if skips(pu[j0], pu[j0 + step - 1], level(j0, j0 + step)) {
             j0 += step;
@@ -925,7 +926,7 @@ fn narrow(
             (step, grow) = (step / 2, false);
         }
     }
-    (step, grow) = (2 * W, true);
+    (step, grow) = (4 * W, true);
     while step >= least && end >= j0 + step {
         let (a, b) = (end - step, end);
         if skips(pu[a], pu[b - 1], level(a, b)) {
