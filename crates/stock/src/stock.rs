@@ -870,11 +870,12 @@ impl Stock {
                 along: &along,
                 span: &span,
             };
-            // Tiles of rows, a few tasks a thread: a batch's work is a few
-            // milliseconds, so finer tasks cost more than they balance.
+            // Tiles of rows, sixteen tasks a thread: tiles differ in work
+            // (a tool's deepest rays against its rim), and a visit's work
+            // is a few milliseconds.
             let rows = v1 + 1 - v0;
             let tiles = rows.div_ceil(TILE_ROWS);
-            let per_task = tiles.div_ceil(4 * rayon::current_num_threads()).max(1);
+            let per_task = tiles.div_ceil(16 * rayon::current_num_threads()).max(1);
             f.rays[v0 * nu..(v1 + 1) * nu]
                 .par_chunks_mut(nu * TILE_ROWS)
                 .with_min_len(per_task)
