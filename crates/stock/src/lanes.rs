@@ -56,11 +56,6 @@ impl F {
     pub fn sqrt(self) -> F {
         self.map(f64::sqrt)
     }
-    /// The next float up, lane by lane (`f64::next_up`).
-    #[inline(always)]
-    pub fn next_up(self) -> F {
-        self.map(f64::next_up)
-    }
     /// `f64::min`, lane by lane (the scalar kernels' `min`).
     #[inline(always)]
     pub fn min(self, o: F) -> F {

@@ -941,6 +941,14 @@ fn narrow(
     (j0, end)
 }
 
+/// A float above each finite lane of `m` (at most a few ulps above):
+/// |m|·2⁻⁵² is at least the spacing of the floats just above m, and the
+/// floor lifts 0 (`f64::next_up` lane by lane, without its branches).
+#[inline(always)]
+fn above(m: F) -> F {
+    m + m.abs() * s(f64::EPSILON) + s(TINY)
+}
+
 /// The float after the largest of `m[a..b]`, b − a a multiple of the lane
 /// count (four lanes at once: `f64::max` is exact, so the order is free).
 #[inline(always)]
@@ -1058,7 +1066,7 @@ fn sweep_row<Kn: Kernel>(
             // the end (and names it), as when they are cut one by one.
             let earlier = seqf.lt(ms);
             let level = if earlier.any() {
-                earlier.select(m.next_up(), m)
+                earlier.select(above(m), m)
             } else {
                 m
             };
