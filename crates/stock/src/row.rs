@@ -1281,7 +1281,8 @@ fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
         }
     }
     // (Spans of one ray and one move are united: their order is free.)
-    sc.found.sort_unstable_by_key(|&(at, seq, _)| (at, seq));
+    sc.found
+        .sort_unstable_by_key(|&(at, seq, _)| u64::from(at) << 32 | u64::from(seq));
     let mut i = 0;
     while i < sc.found.len() {
         let (at, seq) = (sc.found[i].0, sc.found[i].1);
