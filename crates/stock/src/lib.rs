@@ -39,16 +39,20 @@
 //! between samples ([`tolerance::SAMPLE_STEP_FRACTION`]). Only the rays
 //! within the tool's bounds clipped to the stock's box are visited
 //! ([`clip`]); rows of rays run in parallel, each ray alone, so the result
-//! is the same bytes for any thread count.
+//! is the same bytes for any thread count. [`Stock::cut_moves`] cuts a
+//! batch of moves in one visit of their rays (up to 32 moves a visit), the
+//! stock of its moves one by one bit for bit: `kinpost sim` hands its
+//! blocks' moves over that way.
 //!
 //! **Speed.** Most of a move's spans change nothing: a wheel's or a ball's
-//! surface behind its contact, or a sample of a move above the deeper one
-//! after it. The default [`Removal::Fast`] skips them where a test with
-//! products and sums only (no root, no quotient, every rounding bounded)
-//! proves that the span the kernel would compute starts at or above the
-//! ray's material, ray by ray or a whole row segment at once, and computes
-//! the others four rays at a time ([`Stock::set_removal`]; AVX2 chosen at
-//! run time). It gives the stock of [`Removal::Reference`], the
+//! surface behind its contact, or a sample of a move above a deeper one.
+//! The default [`Removal::Fast`] visits a batch's solids in an order that
+//! meets each ray's deepest early, skips them where a test with products
+//! and sums only (no root, no quotient, every rounding bounded) proves that
+//! the span the kernel would compute starts at or above the ray's level,
+//! ray by ray or a whole segment of eight rows at once, and computes the
+//! others four rays at a time ([`Stock::set_removal`]; AVX2 chosen at run
+//! time). It gives the stock of [`Removal::Reference`], the
 //! straightforward evaluation of every span, bit for bit, on every
 //! processor and for any thread count.
 //!

@@ -1,30 +1,43 @@
-//! The fast removal along one row of rays.
+//! The fast removal on a tile of rows of rays.
 //!
-//! The stock's fast removal hands each row of rays (one family, one
-//! index across the row) to [`cut_row`]. Each ray keeps a level m, at first
-//! the top of its material (`last`). The solids are visited one after the
-//! other (last sample first: on most rays it meets, the most advanced
-//! sample of a move is the deepest); for each, the rays within its bounds
-//! are taken four at a time ([`crate::lanes`]): a *skip test* asks whether
-//! the span the solid would compute there certainly starts at or above m,
-//! without a root or a quotient ([`quadratic_lo_at_least`]), and the rays
-//! that fail it get their exact span, with the operations, in the order, of
-//! [`crate::kernel`]'s scalar functions. A span that reaches the ray's top
-//! lowers m to its start. At the end, a ray whose spans all reached the top
-//! loses (m, top); a ray with a span that ends inside its material (rare for
-//! the family along the tool: a wheel's hole through a side ray) is cut by
-//! the reference procedure, every span computed.
+//! The stock's fast removal hands the rays of a batch of moves to
+//! [`cut_tile`], eight rows of one family at a time. Each ray keeps a top
+//! level m, at first the top of its material (`last`), and a bottom level
+//! mb, at first its start (`first`), each with the move that set it. The
+//! solids are visited in the order given (the batch's last sample first,
+//! then back through the batch halving the stride, so that every ray soon
+//! meets a solid near its deepest); for each, whole segments of its rays
+//! whose spans certainly start above their levels are dropped, for all the
+//! tile's rows at once and then row by row (interval enclosures, [`Iv`]),
+//! and the other rays are taken four at a time ([`crate::lanes`]): a *skip
+//! test* asks whether the span the solid would compute there certainly
+//! starts at or above m, without a root or a quotient
+//! ([`quadratic_lo_at_least`]), and the rays that fail it get their exact
+//! span, with the operations, in the order, of [`crate::kernel`]'s scalar
+//! functions. A span that reaches the ray's top lowers m to its start; one
+//! that starts at or below the ray's start and ends inside raises mb to its
+//! end. At the end, a ray whose spans all reached its top or its start
+//! loses (m, top) and (start, mb); a ray with a span that ends inside its
+//! material at both ends (a slot across the ray) is cut move by move by the
+//! reference procedure, with its levels in the places of the moves that
+//! set them.
 //!
-//! Why this is the reference's stock, bit for bit: the subtraction of a
-//! union of spans from a ray ([`remove_spans`]) depends only on the union
-//! within the ray's material (first, last): pieces that miss it are no-ops
-//! in [`subtract`], and a piece that reaches past an end acts as if it ended
-//! there (no piece is kept beyond it). A span that starts at or above m adds
-//! nothing within the material: m is the top, or the start of a span that
-//! reaches the top. If all spans that meet the material reach its top, their
-//! union within it is [m, top), so `subtract(m, +∞)` is the reference's cut.
+//! Why this is the stock of the reference cutting the moves one by one,
+//! bit for bit: the subtraction of a union of spans from a ray
+//! ([`remove_spans`]) depends only on the union within the ray's material
+//! (first, last): pieces that miss it are no-ops in [`subtract`], and a
+//! piece that reaches past an end acts as if it ended there (no piece is
+//! kept beyond it). A span that starts at or above m adds nothing within
+//! the material: m is the top, or the start of a span that reaches the top.
+//! The spans that reach the top, whichever their moves, remove everything
+//! above the lowest start among them, and its end is made (and named) by
+//! the first move to reach it: a later move lowers a level from at or
+//! below it, an earlier one only from strictly below. So `subtract(m, +∞)`
+//! as the move that set m does what all those moves do; the same holds
+//! below mb (whose spans are computed, not skipped), and the two cuts
+//! commute.
 //!
-//! [`cut_row`] runs compiled for AVX2 when the processor has it, else for
+//! [`cut_tile`] runs compiled for AVX2 when the processor has it, else for
 //! the x86-64 baseline (or any other target): the same operations on the
 //! same lanes, so the same bits on every processor and for any thread count
 //! (each ray is cut alone).

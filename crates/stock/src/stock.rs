@@ -826,16 +826,15 @@ impl Stock {
         }
     }
 
-    /// The fast removal: the same stock as [`Stock::remove_reference`], bit
-    /// for bit, computing far fewer spans. Each family's rows go to
-    /// [`crate::row::cut_row`] (the three families at once, rows in
-    /// parallel): on each ray the solids are visited last first (the most
-    /// advanced sample of a move is the deepest on most rays it meets), and
-    /// a solid is skipped where its span certainly starts at or above the
-    /// ray's level m (the top of its material, lowered to the start of every
-    /// span found that reaches the top), ray by ray or a whole row segment
-    /// at once. The reasons, and why this changes no bit, are in the
-    /// `row` module's doc.
+    /// The fast removal: the stock [`Stock::remove_reference`] gives cutting
+    /// the batch's moves one by one, bit for bit, computing far fewer spans.
+    /// Each family's rows go to [`crate::row::cut_tile`] eight at a time
+    /// (the three families at once, tiles in parallel): on each ray the
+    /// solids are visited in [`visit_order`], and a solid is skipped where
+    /// its span certainly starts at or above the ray's level (the top of its
+    /// material, lowered to the start of every span found that reaches the
+    /// top), ray by ray or a whole segment of a tile at once. The reasons,
+    /// and why this changes no bit, are in the `row` module's doc.
     fn remove_fast(&mut self, solids: &[Bounded], ids: &[u32]) {
         let Some((lo, hi)) = solids_bounds(solids) else {
             return;
