@@ -1130,6 +1130,60 @@ fn sweep_row<Kn: Kernel>(
     any_split
 }
 
+impl Scratch {
+    /// The tile's arrays for the rays `a_min..=b_max` of each row, `padded`
+    /// a row: the rays' coordinates, their material's ends, the levels at
+    /// those ends, no split.
+    #[inline(always)]
+    fn prepare(
+        &mut self,
+        frame: &RowFrame,
+        rows: &[Ray],
+        (a_min, b_max): (usize, usize),
+        padded: usize,
+    ) {
+        let (nu, pv) = (frame.nu, frame.pv);
+        self.pu.clear();
+        self.pu
+            .extend((0..padded).map(|j| frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h));
+        self.first.clear();
+        self.last.clear();
+        for r in 0..pv.len() {
+            for ray in &rows[r * nu + a_min..=r * nu + b_max] {
+                // Empty rays (and the padding): no solid passes the gate against
+                // their ends.
+                let (f, l) = match (ray.first(), ray.last()) {
+                    (Some(f), Some(l)) => (f.lo, l.hi),
+                    _ => (f64::INFINITY, f64::NEG_INFINITY),
+                };
+                self.first.push(f);
+                self.last.push(l);
+            }
+            self.first.resize((r + 1) * padded, f64::INFINITY);
+            self.last.resize((r + 1) * padded, f64::NEG_INFINITY);
+        }
+        let all = pv.len() * padded;
+        self.m.clear();
+        self.m.extend_from_slice(&self.last);
+        self.col.clear();
+        self.col.extend_from_slice(&self.m[..padded]);
+        for r in 1..pv.len() {
+            for j in 0..padded {
+                self.col[j] = self.col[j].max(self.m[r * padded + j]);
+            }
+        }
+        self.ms.clear();
+        self.ms.resize(all, 0.0);
+        self.mb.clear();
+        self.mb.extend_from_slice(&self.first);
+        self.mbs.clear();
+        self.mbs.resize(all, 0.0);
+        self.split.clear();
+        self.split.resize(all, false);
+        self.found.clear();
+    }
+}
+
 #[inline(always)]
 fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
     frame: &RowFrame,
@@ -1146,44 +1200,7 @@ fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
     let n = b_max + 1 - a_min;
     let padded = n.div_ceil(W) * W;
     let (nu, pv) = (frame.nu, frame.pv);
-    sc.pu.clear();
-    sc.pu
-        .extend((0..padded).map(|j| frame.origin_u + ((a_min + j) as f64 + 0.5) * frame.h));
-    sc.first.clear();
-    sc.last.clear();
-    for r in 0..pv.len() {
-        for ray in &rows[r * nu + a_min..=r * nu + b_max] {
-            // Empty rays (and the padding): no solid passes the gate against
-            // their ends.
-            let (f, l) = match (ray.first(), ray.last()) {
-                (Some(f), Some(l)) => (f.lo, l.hi),
-                _ => (f64::INFINITY, f64::NEG_INFINITY),
-            };
-            sc.first.push(f);
-            sc.last.push(l);
-        }
-        sc.first.resize((r + 1) * padded, f64::INFINITY);
-        sc.last.resize((r + 1) * padded, f64::NEG_INFINITY);
-    }
-    let all = pv.len() * padded;
-    sc.m.clear();
-    sc.m.extend_from_slice(&sc.last);
-    sc.col.clear();
-    sc.col.extend_from_slice(&sc.m[..padded]);
-    for r in 1..pv.len() {
-        for j in 0..padded {
-            sc.col[j] = sc.col[j].max(sc.m[r * padded + j]);
-        }
-    }
-    sc.ms.clear();
-    sc.ms.resize(all, 0.0);
-    sc.mb.clear();
-    sc.mb.extend_from_slice(&sc.first);
-    sc.mbs.clear();
-    sc.mbs.resize(all, 0.0);
-    sc.split.clear();
-    sc.split.resize(all, false);
-    sc.found.clear();
+    sc.prepare(frame, rows, (a_min, b_max), padded);
     let mut any_split = false;
     for act in active {
         let range = (act.a - a_min, act.b - a_min);
@@ -1245,7 +1262,22 @@ fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
             }
         };
     }
-    for r in 0..pv.len() {
+    cut_levels(sc, rows, (a_min, n, padded, nu), ids);
+    if any_split {
+        replay_splits(sc, rows, (a_min, padded, nu), ids);
+    }
+}
+
+/// Each ray whose spans all reached its top or its start loses (m, top)
+/// and (start, mb).
+#[inline(always)]
+fn cut_levels(
+    sc: &Scratch,
+    rows: &mut [Ray],
+    (a_min, n, padded, nu): (usize, usize, usize, usize),
+    ids: &[u32],
+) {
+    for r in 0..rows.len() / nu {
         for j in 0..n {
             let at = r * padded + j;
             if sc.split[at] {
@@ -1262,9 +1294,16 @@ fn cut_tile_k<const K: usize, const U: usize, const V: usize>(
             }
         }
     }
-    if !any_split {
-        return;
-    }
+}
+
+/// The rays with a span that ends inside their material, move by move.
+#[inline(always)]
+fn replay_splits(
+    sc: &mut Scratch,
+    rows: &mut [Ray],
+    (a_min, padded, nu): (usize, usize, usize),
+    ids: &[u32],
+) {
     // Rays with a span that ends inside the material: move by move, the
     // union of that move's such spans, with (−∞, mb] for the move that set
     // mb and [m, +∞) for the one that set m. Within the material this is
