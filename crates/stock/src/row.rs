@@ -813,6 +813,10 @@ pub(crate) struct Scratch {
     /// the arrays above), move, span.
     found: Vec<(u32, u32, Span)>,
     spans: Vec<Span>,
+    /// `found` grouped by ray (a counting sort), and where each ray's
+    /// group starts.
+    by_ray: Vec<(u32, u32, Span)>,
+    starts: Vec<u32>,
 }
 
 /// A solid that meets a tile: its index, its first and last ray (indices
@@ -1332,23 +1336,47 @@ fn replay_splits(
             }
         }
     }
-    // (Spans of one ray and one move are united: their order is free.)
-    sc.found
-        .sort_unstable_by_key(|&(at, seq, _)| u64::from(at) << 32 | u64::from(seq));
-    let mut i = 0;
-    while i < sc.found.len() {
-        let (at, seq) = (sc.found[i].0, sc.found[i].1);
-        sc.spans.clear();
-        while i < sc.found.len() && sc.found[i].0 == at && sc.found[i].1 == seq {
-            sc.spans.push(sc.found[i].2);
-            i += 1;
+    // Grouped by ray (counting them: there are many), then each ray's by
+    // move. (Spans of one ray and one move are united: their order is
+    // free.)
+    let all = rows.len() / nu * padded;
+    sc.starts.clear();
+    sc.starts.resize(all + 1, 0);
+    for &(at, _, _) in &sc.found {
+        sc.starts[at as usize + 1] += 1;
+    }
+    for at in 0..all {
+        sc.starts[at + 1] += sc.starts[at];
+    }
+    sc.by_ray.clear();
+    sc.by_ray
+        .resize(sc.found.len(), (0, 0, Span { lo: 0.0, hi: 0.0 }));
+    for &entry in &sc.found {
+        let at = entry.0 as usize;
+        sc.by_ray[sc.starts[at] as usize] = entry;
+        sc.starts[at] += 1;
+    }
+    // (Each start has moved to the next ray's: the groups end there.)
+    let mut begin = 0;
+    for at in 0..all {
+        let end = sc.starts[at] as usize;
+        if end == begin {
+            continue;
         }
-        let (r, j) = (at as usize / padded, at as usize % padded);
-        remove_spans(
-            &mut rows[r * nu + a_min + j],
-            &mut sc.spans,
-            ids[seq as usize],
-        );
+        let group = &mut sc.by_ray[begin..end];
+        group.sort_unstable_by_key(|&(_, seq, _)| seq);
+        let ray = &mut rows[at / padded * nu + a_min + at % padded];
+        let mut i = 0;
+        while i < group.len() {
+            let seq = group[i].1;
+            sc.spans.clear();
+            while i < group.len() && group[i].1 == seq {
+                sc.spans.push(group[i].2);
+                i += 1;
+            }
+            remove_spans(ray, &mut sc.spans, ids[seq as usize]);
+        }
+        begin = end;
     }
 }
 
