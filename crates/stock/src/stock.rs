@@ -519,7 +519,7 @@ impl Stock {
         move_id: u32,
     ) -> Result<MoveCut, CutError> {
         let mut solids = Vec::new();
-        let cut = self.move_solids(tool, from, to, 1, &mut solids)?;
+        let cut = self.move_solids(tool, from, to, &mut solids)?;
         self.remove(&solids, &[UNCUT, move_id]);
         self.last = Some((*tool, *to));
         Ok(cut)
@@ -545,8 +545,7 @@ impl Stock {
         let h = self.resolution;
         for (index, m) in moves.iter().enumerate() {
             fresh.clear();
-            let seq = u32::try_from(ids.len()).unwrap_or(u32::MAX);
-            let cut = match self.move_solids(tool, &m.from, &m.to, seq, &mut fresh) {
+            let cut = match self.move_solids(tool, &m.from, &m.to, &mut fresh) {
                 Ok(cut) => cut,
                 Err(source) => {
                     self.remove(&solids, &ids);
@@ -554,27 +553,22 @@ impl Stock {
                 }
             };
             cuts.push(cut);
-            if ids.len() > MOVES_PER_VISIT {
+            // A visit holds at most MOVES_PER_VISIT moves, close together:
+            // else what is gathered is cut and this move starts the next.
+            let bounds = solids_bounds(&fresh);
+            if ids.len() > MOVES_PER_VISIT || bounds.is_some_and(|b| !spread.admits(&b, h)) {
                 self.remove(&solids, &ids);
                 solids.clear();
                 ids.truncate(1);
                 spread = Spread::default();
-                for f in &mut fresh {
-                    f.seq = 1;
+                if let Some(b) = bounds {
+                    spread.admits(&b, h);
                 }
             }
-            if let Some(b) = solids_bounds(&fresh)
-                && !spread.admits(&b, h)
-            {
-                // Cut what is gathered; this move starts the next visit.
-                self.remove(&solids, &ids);
-                solids.clear();
-                ids.truncate(1);
-                spread = Spread::default();
-                spread.admits(&b, h);
-                for f in &mut fresh {
-                    f.seq = 1;
-                }
+            // (At most MOVES_PER_VISIT + 1 ids.)
+            let seq = ids.len() as u32;
+            for f in &mut fresh {
+                f.seq = seq;
             }
             solids.append(&mut fresh);
             ids.push(m.id);
@@ -584,17 +578,17 @@ impl Stock {
         Ok(cuts)
     }
 
-    /// The solids that sweep the tool from one pose to the next, as move
-    /// `seq` of a batch (appended to `solids`); the start pose is left out
-    /// when it is the last pose cut with the same tool.
+    /// The solids that sweep the tool from one pose to the next, as the
+    /// first move of a batch (appended to `solids`); the start pose is left
+    /// out when it is the last pose cut with the same tool.
     fn move_solids(
         &self,
         tool: &Tool,
         from: &ToolPose,
         to: &ToolPose,
-        seq: u32,
         solids: &mut Vec<Bounded>,
     ) -> Result<MoveCut, CutError> {
+        let seq = 1;
         let p0 = tool.place(from)?;
         let p1 = tool.place(to)?;
         let start_done = self
